@@ -1,0 +1,143 @@
+//! Errors of model set-up, assembly and the elastic solve.
+
+use thiserror::Error;
+
+use synovia_material::MaterialError;
+use synovia_mesh::MeshError;
+
+/// Everything that can go wrong between a model description and its elastic solution.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum FemError {
+    /// A mesh error (invalid geometry, unknown boundary part, …).
+    #[error("mesh of body `{body}`: {source}")]
+    Mesh {
+        /// Body name.
+        body: String,
+        /// The underlying error.
+        #[source]
+        source: MeshError,
+    },
+    /// A material error (non-physical parameters, …).
+    #[error(transparent)]
+    Material(#[from] MaterialError),
+    /// A body index or name does not exist.
+    #[error("no body `{0}` in the model")]
+    UnknownBody(String),
+    /// Two bodies have the same name.
+    #[error("two bodies are called `{0}`")]
+    DuplicateBody(String),
+    /// The model has no bodies.
+    #[error("the model has no bodies")]
+    NoBodies,
+    /// A boundary part of kind Prescribed or Traction has no data attached.
+    #[error("body `{body}`, boundary part `{part}` is of kind {kind} but no data was given for it (missing boundary data)")]
+    MissingBoundaryData {
+        /// Body name.
+        body: String,
+        /// Part name.
+        part: String,
+        /// Kind of the part.
+        kind: String,
+    },
+    /// Data was given for a part whose kind does not take it.
+    #[error("body `{body}`, boundary part `{part}` is of kind {kind}; it cannot take {given} (re-tag the part with Mesh::set_part_kind)")]
+    BoundaryKindMismatch {
+        /// Body name.
+        body: String,
+        /// Part name.
+        part: String,
+        /// Kind of the part.
+        kind: String,
+        /// What was given.
+        given: &'static str,
+    },
+    /// A function of the problem data (load, prescribed displacement) returned NaN or ∞.
+    #[error("{what} is not finite at x = {x:?}, t = {t}")]
+    NonFiniteData {
+        /// Which data.
+        what: String,
+        /// Where.
+        x: Vec<f64>,
+        /// When.
+        t: f64,
+    },
+    /// Two constraints on the same node contradict each other (e.g. clamped and prescribed to a
+    /// non-zero value).
+    #[error(
+        "body `{body}`, node {node}: constraints contradict each other (residual {residual:e})"
+    )]
+    ConflictingConstraints {
+        /// Body name.
+        body: String,
+        /// Node index in the body's mesh.
+        node: usize,
+        /// Size of the contradiction.
+        residual: f64,
+    },
+    /// Nodes of a tied (bonded) interface have no partner at the same position.
+    #[error("bonded interface `{body_a}:{part_a}` – `{body_b}:{part_b}`: unmatched nodes {unmatched_a:?} (first) and {unmatched_b:?} (second)")]
+    UnmatchedInterface {
+        /// First body.
+        body_a: String,
+        /// First part.
+        part_a: String,
+        /// Second body.
+        body_b: String,
+        /// Second part.
+        part_b: String,
+        /// Unmatched nodes of the first body (mesh indices).
+        unmatched_a: Vec<usize>,
+        /// Unmatched nodes of the second body (mesh indices).
+        unmatched_b: Vec<usize>,
+    },
+    /// Some bodies are not held against rigid motion (spec §4): the elastic problem is
+    /// semi-coercive and its stiffness matrix singular.
+    #[error("bodies {bodies:?} are semi-coercive: {free_modes} rigid-body mode(s) are not restrained by Dirichlet or symmetry data; add boundary conditions or solve it as a contact problem")]
+    SemiCoercive {
+        /// Names of the bodies of the unrestrained component.
+        bodies: Vec<String>,
+        /// Number of unrestrained rigid modes.
+        free_modes: usize,
+    },
+    /// The material is nonlinear; the linear elastic solve needs a constant stiffness.
+    #[error("body `{body}`: material `{material}` is nonlinear; the linear elastic solve needs Material::linear_stiffness")]
+    NonlinearMaterial {
+        /// Body name.
+        body: String,
+        /// Material name.
+        material: String,
+    },
+    /// The material stiffness has the wrong size for the dimension.
+    #[error("body `{body}`: material stiffness is {got}×{got}, expected {expected}×{expected}")]
+    MaterialSize {
+        /// Body name.
+        body: String,
+        /// Expected Voigt size.
+        expected: usize,
+        /// Actual size.
+        got: usize,
+    },
+    /// The system matrix is not positive definite (Cholesky met a non-positive pivot).
+    #[error("the system matrix is not positive definite: non-positive pivot at (permuted) index {index}")]
+    NotPositiveDefinite {
+        /// Pivot index in the factorisation order.
+        index: usize,
+    },
+    /// A sparse-matrix or factorisation failure that is not a numerical one (memory, sizes).
+    #[error("sparse linear algebra failed: {0}")]
+    Sparse(String),
+    /// A vector given to the library has the wrong length.
+    #[error("{what}: length {got}, expected {expected}")]
+    Length {
+        /// Which vector.
+        what: &'static str,
+        /// Expected length.
+        expected: usize,
+        /// Actual length.
+        got: usize,
+    },
+    /// A parameter is out of its domain.
+    #[error("invalid parameter: {0}")]
+    InvalidParameter(String),
+}

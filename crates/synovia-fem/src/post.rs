@@ -1,0 +1,147 @@
+//! Post-processing: strain and stress per cell, recovery to nodes, von Mises and principal
+//! stresses, strain energy.
+
+use nalgebra::{DVector, Matrix2, Matrix3};
+use synovia_mesh::math::{Real, Vector};
+
+use crate::element::{voigt_strain, SimplexGeometry};
+use crate::error::FemError;
+use crate::model::Model;
+
+/// Stress and strain fields of one body.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BodyFields {
+    /// Voigt strain per cell (engineering shear), `voigt_len(D)` each.
+    pub cell_strain: Vec<Vec<Real>>,
+    /// Voigt stress per cell.
+    pub cell_stress: Vec<Vec<Real>>,
+    /// Out-of-plane stress `σ_zz` per cell (2D; 0 in plane stress and 3D).
+    pub cell_stress_zz: Vec<Real>,
+    /// Von Mises stress per cell.
+    pub cell_von_mises: Vec<Real>,
+    /// Principal stresses per cell, descending (3 values: in 2D the in-plane pair and `σ_zz`,
+    /// sorted together).
+    pub cell_principal: Vec<[Real; 3]>,
+    /// Voigt stress recovered to nodes (measure-weighted average of the adjacent cells).
+    pub nodal_stress: Vec<Vec<Real>>,
+    /// Von Mises stress recovered to nodes.
+    pub nodal_von_mises: Vec<Real>,
+    /// Strain energy `½ ∫ C e(u) : e(u) dx` of the body.
+    pub strain_energy: Real,
+}
+
+/// Von Mises stress of a Voigt stress (with `σ_zz` for 2D):
+/// `σ_vm = sqrt(½[(σ1−σ2)² + (σ2−σ3)² + (σ3−σ1)²] + 3(τ_xy² + τ_yz² + τ_xz²))`.
+pub fn von_mises(voigt: &[Real], sigma_zz: Real) -> Real {
+    let (sx, sy, sz, tyz, txz, txy) = if voigt.len() == 3 {
+        (voigt[0], voigt[1], sigma_zz, 0.0, 0.0, voigt[2])
+    } else {
+        (voigt[0], voigt[1], voigt[2], voigt[3], voigt[4], voigt[5])
+    };
+    (0.5 * ((sx - sy).powi(2) + (sy - sz).powi(2) + (sz - sx).powi(2))
+        + 3.0 * (txy * txy + tyz * tyz + txz * txz))
+        .max(0.0)
+        .sqrt()
+}
+
+/// Principal stresses (descending) of a Voigt stress; in 2D the in-plane eigenvalues and
+/// `σ_zz`.
+pub fn principal_stresses(voigt: &[Real], sigma_zz: Real) -> [Real; 3] {
+    let mut p = if voigt.len() == 3 {
+        let m = Matrix2::new(voigt[0], voigt[2], voigt[2], voigt[1]);
+        let e = m.symmetric_eigenvalues();
+        [e[0], e[1], sigma_zz]
+    } else {
+        let m = Matrix3::new(
+            voigt[0], voigt[5], voigt[4], voigt[5], voigt[1], voigt[3], voigt[4], voigt[3],
+            voigt[2],
+        );
+        let e = m.symmetric_eigenvalues();
+        [e[0], e[1], e[2]]
+    };
+    p.sort_by(|a, b| b.total_cmp(a));
+    p
+}
+
+/// Computes the fields of every body from nodal displacements (`displacement[body][node]`).
+pub fn body_fields<const D: usize>(
+    model: &Model<D>,
+    displacement: &[Vec<Vector<D>>],
+) -> Result<Vec<BodyFields>, FemError> {
+    let mut out = Vec::with_capacity(model.bodies().len());
+    for (bi, body) in model.bodies().iter().enumerate() {
+        let u = displacement.get(bi).ok_or(FemError::Length {
+            what: "displacement bodies",
+            expected: model.bodies().len(),
+            got: displacement.len(),
+        })?;
+        if u.len() != body.mesh.n_nodes() {
+            return Err(FemError::Length {
+                what: "body displacement",
+                expected: body.mesh.n_nodes(),
+                got: u.len(),
+            });
+        }
+        let nc = body.mesh.n_cells();
+        let mut f = BodyFields {
+            cell_strain: Vec::with_capacity(nc),
+            cell_stress: Vec::with_capacity(nc),
+            cell_stress_zz: Vec::with_capacity(nc),
+            cell_von_mises: Vec::with_capacity(nc),
+            cell_principal: Vec::with_capacity(nc),
+            nodal_stress: Vec::new(),
+            nodal_von_mises: Vec::new(),
+            strain_energy: 0.0,
+        };
+        let nv = D * (D + 1) / 2;
+        let mut acc = vec![vec![0.0; nv]; body.mesh.n_nodes()];
+        let mut acc_vm = vec![0.0; body.mesh.n_nodes()];
+        let mut weight = vec![0.0; body.mesh.n_nodes()];
+        let mut ue = vec![0.0; D * (D + 1)];
+        for c in 0..nc {
+            let geo = SimplexGeometry::<D>::new(&body.mesh.cell_points(c)).ok_or_else(|| {
+                FemError::Mesh {
+                    body: body.name.clone(),
+                    source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
+                }
+            })?;
+            for (a, &n) in body.mesh.cell(c).iter().enumerate() {
+                for i in 0..D {
+                    ue[D * a + i] = u[n][i];
+                }
+            }
+            let eps = DVector::from_vec(voigt_strain::<D>(&geo.displacement_gradient(&ue)));
+            let sig = body.material.stress(&eps);
+            let szz = if D == 2 {
+                body.material.out_of_plane_stress(&eps)
+            } else {
+                0.0
+            };
+            f.strain_energy += geo.measure * body.material.energy_density(&eps);
+            let vm = von_mises(sig.as_slice(), szz);
+            for &n in body.mesh.cell(c) {
+                for (k, s) in sig.iter().enumerate() {
+                    acc[n][k] += geo.measure * s;
+                }
+                acc_vm[n] += geo.measure * vm;
+                weight[n] += geo.measure;
+            }
+            f.cell_principal
+                .push(principal_stresses(sig.as_slice(), szz));
+            f.cell_von_mises.push(vm);
+            f.cell_stress_zz.push(szz);
+            f.cell_strain.push(eps.iter().copied().collect());
+            f.cell_stress.push(sig.iter().copied().collect());
+        }
+        for ((s, vm), w) in acc.iter_mut().zip(acc_vm.iter_mut()).zip(&weight) {
+            if *w > 0.0 {
+                s.iter_mut().for_each(|x| *x /= w);
+                *vm /= w;
+            }
+        }
+        f.nodal_stress = acc;
+        f.nodal_von_mises = acc_vm;
+        out.push(f);
+    }
+    Ok(out)
+}

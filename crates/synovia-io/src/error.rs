@@ -1,0 +1,124 @@
+//! The error type of every synovia-io operation.
+
+use std::path::PathBuf;
+
+use synovia_mesh::MeshError;
+use thiserror::Error;
+
+/// Everything that can go wrong when writing or reading VTK XML files.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum IoError {
+    /// The operating system refused a file operation.
+    #[error("I/O error on `{}`: {source}", path.display())]
+    Io {
+        /// The file or directory concerned.
+        path: PathBuf,
+        /// The underlying error.
+        source: std::io::Error,
+    },
+    /// A field has the wrong number of values for its mesh and component count.
+    #[error(
+        "field `{name}` has {got} values, but {expected} are needed \
+         (components × number of points or cells)"
+    )]
+    FieldLength {
+        /// Field name.
+        name: String,
+        /// Number of values required.
+        expected: usize,
+        /// Number of values given.
+        got: usize,
+    },
+    /// A value is NaN or infinite (ParaView cannot handle such data sensibly).
+    #[error("`{name}` has a non-finite value (NaN or ±∞) at flat index {index}")]
+    NonFinite {
+        /// Field name (or `"time"` for a time step).
+        name: String,
+        /// Flat index into the field's values (or the time-step index).
+        index: usize,
+    },
+    /// A field is ill-formed: empty name, zero components, duplicate or reserved name.
+    #[error("invalid field `{name}`: {reason}")]
+    InvalidField {
+        /// Field name.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A piece does not carry the same fields as the first piece of the file (VTK requires
+    /// every piece of one file to have the same arrays).
+    #[error("piece {piece} does not match the fields of piece 0: {reason}")]
+    InconsistentPieces {
+        /// Index of the offending piece.
+        piece: usize,
+        /// What differs.
+        reason: String,
+    },
+    /// A data array exceeds the 4 GiB that a `UInt32` binary header can describe.
+    #[error("array `{name}` has {bytes} bytes, more than a UInt32 binary header can describe; use Encoding::Ascii")]
+    ArrayTooLarge {
+        /// Array name.
+        name: String,
+        /// Size in bytes.
+        bytes: usize,
+    },
+    /// A path cannot be written into an XML file because it is not valid UTF-8.
+    #[error("path `{}` is not valid UTF-8", path.display())]
+    NonUtf8Path {
+        /// The path.
+        path: PathBuf,
+    },
+    /// A time series got a time that is not larger than the previous one.
+    #[error("time {time} does not follow the previous time step {previous}")]
+    TimeNotIncreasing {
+        /// Previous time.
+        previous: f64,
+        /// Offending time.
+        time: f64,
+    },
+    /// A time-series name is unusable as a file-name stem.
+    #[error("invalid series name `{name}`: {reason}")]
+    InvalidName {
+        /// The name.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
+    /// A file read back is not a well-formed file of the kind this crate writes.
+    #[error("cannot parse `{}`: {message}", path.display())]
+    Parse {
+        /// The file (or `<string>` for in-memory input).
+        path: PathBuf,
+        /// What is wrong, with the byte position where known.
+        message: String,
+    },
+    /// A piece read back holds a cell of another type than the mesh requested needs.
+    #[error("cell {cell} has VTK type {found}, expected {expected}")]
+    CellType {
+        /// Cell index.
+        cell: usize,
+        /// The VTK type required (5 triangle, 10 tetrahedron).
+        expected: u8,
+        /// The VTK type found.
+        found: u8,
+    },
+    /// A piece read back does not form a valid [`synovia_mesh::Mesh`].
+    #[error("piece does not form a valid mesh: {0}")]
+    Mesh(#[from] MeshError),
+}
+
+impl IoError {
+    pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        IoError::Io {
+            path: path.into(),
+            source,
+        }
+    }
+    pub(crate) fn parse(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        IoError::Parse {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+}
