@@ -38,6 +38,7 @@ pub use synovia_io as io;
 pub use synovia_material as material;
 pub use synovia_mesh as mesh;
 
+pub mod output;
 pub mod verification;
 
 /// The types most programs need.

@@ -197,6 +197,27 @@ pub fn lumped_mass_into<const D: usize>(geo: &SimplexGeometry<D>, rho: Real, out
     out[..D * (D + 1)].iter_mut().for_each(|x| *x = m);
 }
 
+/// Mass element matrix with coefficient `c` (`ρ` for `M_ρ`, `α` for `M_α`, spec §7):
+/// consistent ([`consistent_mass_into`]) or row-sum lumped (diagonal), into `out`
+/// (`D(D+1)` square, row-major).
+pub fn mass_into<const D: usize>(
+    geo: &SimplexGeometry<D>,
+    c: Real,
+    lumped: bool,
+    out: &mut [Real],
+) {
+    if lumped {
+        let n = D * (D + 1);
+        out[..n * n].iter_mut().for_each(|x| *x = 0.0);
+        let m = c * geo.measure / (D + 1) as Real;
+        for k in 0..n {
+            out[k * n + k] = m;
+        }
+    } else {
+        consistent_mass_into(geo, c, out);
+    }
+}
+
 /// Load vector of a body force `f(x)` on a cell: `F_{a,i} = ∫_T f_i φ_a dx`, by `rule`.
 /// Returns `Err(x)` with the first point where `f` is not finite.
 pub fn body_force_into<const D: usize>(

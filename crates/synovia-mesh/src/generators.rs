@@ -49,18 +49,18 @@ pub enum Grading {
         /// Growth factor of successive cells away from the high end (`≥ 1`).
         ratio: Real,
     },
-    /// Local refinement of a tensor grid: the node density is `ratio` times higher in the window
-    /// `|x − center| ≤ width / 2` than far from it, and falls off linearly to the base density
-    /// over a transition zone of length `width` on either side (so the density is `1` for
-    /// `|x − center| ≥ 3 width / 2`). Cells in the window are about `ratio` times smaller than
-    /// far cells; the sizes change gradually in between. A window that misses `[a, b]` leaves the
-    /// grading uniform.
+    /// Local refinement of a tensor grid: cells in the window `|x − center| ≤ width / 2` are
+    /// `ratio` times smaller than cells far from it. In between, the cell size grows linearly
+    /// (each cell about 20 % larger than its neighbour on the window side), so the transition
+    /// zone is as long as the sizes need; if `n` is too small for it to fit in `[a, b]` the
+    /// refinement is correspondingly weaker. A window that misses `[a, b]` still refines the end
+    /// of `[a, b]` that is nearer to it, through the transition zone.
     Refined {
         /// Center of the fine window.
         center: Real,
         /// Width of the fine window (`> 0`).
         width: Real,
-        /// Density ratio fine / coarse (`≥ 1`; `1` is uniform).
+        /// Cell size ratio far / window (`≥ 1`; `1` is uniform).
         ratio: Real,
     },
 }
@@ -174,52 +174,97 @@ fn geometric(a: Real, b: Real, n: usize, ratio: Real) -> Vec<Real> {
     x
 }
 
-/// Nodes equidistributing the piecewise linear density of [`Grading::Refined`].
+/// Neighbouring cells of the transition zone of [`Grading::Refined`] differ in size by about
+/// this fraction.
+const REFINED_GROWTH: Real = 0.2;
+
+/// Nodes of [`Grading::Refined`]: equidistribution of the density `1 / h(x)`, with the relative
+/// size `h = 1 / ratio` in the window, `h = 1` far from it, and `h` linear in between with a
+/// slope chosen so that neighbouring cells grow by [`REFINED_GROWTH`].
 fn refined(a: Real, b: Real, n: usize, center: Real, width: Real, ratio: Real) -> Vec<Real> {
+    let uniform = || {
+        (0..=n)
+            .map(|i| a + (b - a) * (i as Real / n as Real))
+            .collect()
+    };
+    if ratio == 1.0 {
+        return uniform();
+    }
+    let hf = 1.0 / ratio;
     let hw = 0.5 * width;
-    let density = |x: Real| -> Real {
-        let d = (x - center).abs();
-        if d <= hw {
-            ratio
-        } else if d >= hw + width {
-            1.0
+    // Relative size with transition slope `s` (transition length (1 − hf) / s).
+    let size = |x: Real, s: Real| -> Real {
+        let d = (x - center).abs() - hw;
+        if d <= 0.0 {
+            hf
         } else {
-            ratio + (1.0 - ratio) * (d - hw) / width
+            (hf + s * d).min(1.0)
         }
     };
-    let mut breaks = vec![a, b];
-    for p in [
-        center - hw - width,
-        center - hw,
-        center + hw,
-        center + hw + width,
-    ] {
-        if p > a && p < b {
-            breaks.push(p);
+    let breaks = |s: Real| -> Vec<Real> {
+        let l = (1.0 - hf) / s;
+        let mut br = vec![a, b];
+        for p in [center - hw - l, center - hw, center + hw, center + hw + l] {
+            if p > a && p < b {
+                br.push(p);
+            }
+        }
+        br.sort_by(|p, q| p.total_cmp(q));
+        br
+    };
+    // ∫ dx / h over a piece where h is linear, from its end values.
+    let piece_integral = |len: Real, hs: Real, he: Real| -> Real {
+        let u = (he - hs) / hs;
+        if u.abs() < 1e-8 {
+            len / hs * (1.0 - 0.5 * u)
+        } else {
+            len * u.ln_1p() / (he - hs)
+        }
+    };
+    let cumulative = |br: &[Real], s: Real| -> Vec<Real> {
+        let mut cum = vec![0.0; br.len()];
+        for k in 1..br.len() {
+            let (p, q) = (br[k - 1], br[k]);
+            cum[k] = cum[k - 1] + piece_integral(q - p, size(p, s), size(q, s));
+        }
+        cum
+    };
+    // Fixed point s = growth · n / I(s): the coarse cell size I / n times s is the growth.
+    let mut s = REFINED_GROWTH * n as Real / ((b - a) * ratio);
+    for _ in 0..200 {
+        let br = breaks(s);
+        let total = cumulative(&br, s)[br.len() - 1];
+        let next = REFINED_GROWTH * n as Real / total;
+        let done = (next - s).abs() <= 1e-13 * s;
+        s = next;
+        if done {
+            break;
         }
     }
-    breaks.sort_by(|p, q| p.total_cmp(q));
-    // Cumulative integral at the break points (exact: the density is linear in between).
-    let mut cum = vec![0.0; breaks.len()];
-    for k in 1..breaks.len() {
-        let (s, e) = (breaks[k - 1], breaks[k]);
-        cum[k] = cum[k - 1] + 0.5 * (e - s) * (density(s) + density(e));
+    if !(s.is_finite() && s > 0.0) {
+        return uniform();
     }
-    let total = cum[breaks.len() - 1];
+    let br = breaks(s);
+    let cum = cumulative(&br, s);
+    let total = cum[br.len() - 1];
     let mut x = Vec::with_capacity(n + 1);
     let mut piece = 1;
     for i in 0..=n {
         let t = total * (i as Real / n as Real);
-        while piece + 1 < breaks.len() && cum[piece] < t {
+        while piece + 1 < br.len() && cum[piece] < t {
             piece += 1;
         }
-        let (s, e) = (breaks[piece - 1], breaks[piece]);
-        let (rs, re) = (density(s), density(e));
-        let slope = (re - rs) / (e - s);
+        let (p, q) = (br[piece - 1], br[piece]);
+        let (hs, he) = (size(p, s), size(q, s));
+        let k = (he - hs) / (q - p);
         let tau = (t - cum[piece - 1]).max(0.0);
-        // Solve rs y + slope y² / 2 = tau for y ≥ 0 (stable form).
-        let y = 2.0 * tau / (rs + (rs * rs + 2.0 * slope * tau).max(0.0).sqrt());
-        x.push((s + y).min(e));
+        // Solve ∫_0^y dt / (hs + k t) = tau.
+        let y = if (k * tau).abs() < 1e-12 {
+            hs * tau
+        } else {
+            hs * (k * tau).exp_m1() / k
+        };
+        x.push((p + y).min(q));
     }
     x
 }

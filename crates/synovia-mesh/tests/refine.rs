@@ -5,7 +5,7 @@ mod common;
 use std::collections::HashSet;
 
 use common::*;
-use synovia_mesh::generators::{box_mesh, disc, rectangle, Grading};
+use synovia_mesh::generators::{box_mesh, disc, hemisphere, rectangle, Grading};
 use synovia_mesh::refine::{
     refine_marked, refine_toward, refine_uniform, BoundaryProjection, SphereProjection,
     StraightMidpoint,
@@ -281,5 +281,29 @@ fn sphere_projection_validates_and_projects() -> Result<(), MeshError> {
     // One end off the circle: plain midpoint.
     let m = p.midpoint(&Point::<2>::new(3.0, 1.0), &Point::<2>::new(1.0, 2.0));
     assert_eq!(m, Point::<2>::new(2.0, 1.5));
+    Ok(())
+}
+
+#[test]
+fn sphere_projection_on_hemisphere_keeps_cap_round_and_top_flat() -> Result<(), MeshError> {
+    let c = Point::<3>::new(0.2, -0.1, 0.7);
+    let r = 0.9;
+    let coarse = hemisphere(c, r, 1)?;
+    let proj = SphereProjection::new(c, r)?;
+    let fine = refine_uniform(&coarse, 1, &proj)?;
+    assert!(fine.n_cells() >= 8 * coarse.n_cells());
+    assert!(max_sphere_deviation(&fine, "cap", &c, r)? < 1e-12);
+    let top = fine.boundary_part("top")?;
+    assert!(top.nodes().iter().all(|&i| fine.node(i)[2] == c[2]));
+    assert_conforming(&fine, |p| {
+        p[2] == c[2] || ((p - c).norm() - r).abs() < 1e-12
+    });
+    let exact = 2.0 * std::f64::consts::PI * r.powi(3) / 3.0;
+    assert!(rel(fine.measure(), exact) < 0.6 * rel(coarse.measure(), exact));
+    assert!(
+        min_quality(&fine) > 0.25,
+        "min radius ratio {}",
+        min_quality(&fine)
+    );
     Ok(())
 }
