@@ -32,16 +32,12 @@ fn table(dim: usize, rows: &[ConvergenceRow]) {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     // ## Step 1: 2D, four refinements
-    let rows2: Vec<ConvergenceRow> = [8, 16, 32, 64, 128]
-        .iter()
-        .map(|&n| bonded_mms::<2>(n))
-        .collect::<Result<_, _>>()?;
+    let rows2: Vec<ConvergenceRow> =
+        [8, 16, 32, 64, 128].iter().map(|&n| bonded_mms::<2>(n)).collect::<Result<_, _>>()?;
     table(2, &rows2);
     // ## Step 2: 3D, four refinements
-    let rows3: Vec<ConvergenceRow> = [4, 8, 12, 16, 24]
-        .iter()
-        .map(|&n| bonded_mms::<3>(n))
-        .collect::<Result<_, _>>()?;
+    let rows3: Vec<ConvergenceRow> =
+        [4, 8, 12, 16, 24].iter().map(|&n| bonded_mms::<3>(n)).collect::<Result<_, _>>()?;
     table(3, &rows3);
     // ## Step 3: rates on the finest pair and the fit over all meshes
     let last = |v: Vec<f64>| v.last().copied().unwrap_or(f64::NAN);
@@ -56,10 +52,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         fitted_rate(&rows3, |r| r.energy_error),
         fitted_rate(&rows3, |r| r.l2_error)
     );
-    assert!(
-        e2 >= 0.95 && l2 >= 1.9 && e3 >= 0.95 && l3 >= 1.9,
-        "convergence rates below the P1 theory"
-    );
+    assert!(e2 >= 0.95 && l2 >= 1.9 && e3 >= 0.95 && l3 >= 1.9, "convergence rates below the P1 theory");
     let f2 = rows2.last().copied().ok_or("no rows")?;
     let f3 = rows3.last().copied().ok_or("no rows")?;
     println!(

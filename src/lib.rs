@@ -44,8 +44,8 @@ pub mod verification;
 /// The types most programs need.
 pub mod prelude {
     pub use synovia_fem::{
-        solve_elastic, BodyFields, BodyId, ComponentMask, ElasticParams, ElasticSolution,
-        ElasticSolver, FemError, Model,
+        solve_elastic, BodyFields, BodyId, ComponentMask, ElasticParams, ElasticSolution, ElasticSolver,
+        FemError, Model,
     };
     pub use synovia_material::{
         anisotropic, isotropic, plane_strain, plane_stress, transversely_isotropic, KelvinVoigt,

@@ -19,22 +19,14 @@ pub fn elastic_vtu<const D: usize>(
     let mut w = VtuWriter::new(encoding);
     for (bi, body) in model.bodies().iter().enumerate() {
         let f = &fields[bi];
-        let stress: Vec<Tensor<D>> = f
-            .cell_stress
-            .iter()
-            .map(|s| stress_tensor::<D>(s))
-            .collect();
+        let stress: Vec<Tensor<D>> = f.cell_stress.iter().map(|s| stress_tensor::<D>(s)).collect();
         let energy: Vec<f64> = f
             .cell_strain
             .iter()
             .zip(&f.cell_stress)
             .map(|(e, s)| 0.5 * e.iter().zip(s).map(|(a, b)| a * b).sum::<f64>())
             .collect();
-        let principal: Vec<f64> = f
-            .cell_principal
-            .iter()
-            .flat_map(|p| p.iter().copied())
-            .collect();
+        let principal: Vec<f64> = f.cell_principal.iter().flat_map(|p| p.iter().copied()).collect();
         w.add_piece(
             &body.mesh,
             vec![

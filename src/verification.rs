@@ -23,8 +23,8 @@ use nalgebra::{DMatrix, Vector2, Vector3};
 use synovia_fem::element::{stress_tensor, voigt_strain, SimplexGeometry};
 use synovia_fem::{ElasticParams, ElasticSolver, FemError, Model, QuadratureRule};
 use synovia_material::{
-    anisotropic, isotropic, plane_strain, transversely_isotropic,
-    transversely_isotropic_plane_strain, LinearElastic, Material, TransverseIsotropy,
+    anisotropic, isotropic, plane_strain, transversely_isotropic, transversely_isotropic_plane_strain,
+    LinearElastic, Material, TransverseIsotropy,
 };
 use synovia_mesh::generators::{box_mesh, rectangle, Grading};
 use synovia_mesh::math::{Point, Real, Tensor, Vector};
@@ -49,11 +49,7 @@ impl<const D: usize> SineField<D> {
                 b[k][j] = dirs[k][j];
             }
         }
-        Self {
-            a: [0.05, 0.04, 0.03],
-            b,
-            c: [0.3, 1.1, -0.4],
-        }
+        Self { a: [0.05, 0.04, 0.03], b, c: [0.3, 1.1, -0.4] }
     }
     /// `u(x)`.
     pub fn value(&self, x: &Point<D>) -> Vector<D> {
@@ -78,8 +74,7 @@ impl<const D: usize> SineField<D> {
     pub fn body_force(&self, c: &DMatrix<Real>, x: &Point<D>) -> Vector<D> {
         let mut f = Vector::<D>::zeros();
         for j in 0..D {
-            let de =
-                nalgebra::DVector::from_vec(voigt_strain::<D>(&self.gradient_derivative(x, j)));
+            let de = nalgebra::DVector::from_vec(voigt_strain::<D>(&self.gradient_derivative(x, j)));
             let ds = stress_tensor::<D>((c * de).as_slice());
             for i in 0..D {
                 f[i] -= ds[(i, j)];
@@ -108,9 +103,7 @@ pub struct ConvergenceRow {
 
 /// Observed convergence rate between consecutive rows: `log(e_i/e_{i+1}) / log(h_i/h_{i+1})`.
 pub fn rates(rows: &[ConvergenceRow], error: impl Fn(&ConvergenceRow) -> Real) -> Vec<Real> {
-    rows.windows(2)
-        .map(|w| (error(&w[0]) / error(&w[1])).ln() / (w[0].h / w[1].h).ln())
-        .collect()
+    rows.windows(2).map(|w| (error(&w[0]) / error(&w[1])).ln() / (w[0].h / w[1].h).ln()).collect()
 }
 
 /// Least-squares slope of `log e` against `log h` over all rows.
@@ -137,30 +130,17 @@ fn left_material<const D: usize>() -> Result<LinearElastic<D>, FemError> {
 /// The anisotropic material of the right body: a transversely isotropic material with a tilted
 /// axis, handed over as a general (fully populated) Voigt matrix.
 fn right_material<const D: usize>() -> Result<LinearElastic<D>, FemError> {
-    let p = TransverseIsotropy {
-        e_p: 1.0,
-        nu_p: 0.25,
-        e_a: 4.0,
-        nu_ap: 0.3,
-        g_a: 0.6,
-    };
+    let p = TransverseIsotropy { e_p: 1.0, nu_p: 0.25, e_a: 4.0, nu_ap: 0.3, g_a: 0.6 };
     let c = if D == 2 {
-        transversely_isotropic_plane_strain(p, Vector2::new(0.8, 0.6))?
-            .stiffness()
-            .clone()
+        transversely_isotropic_plane_strain(p, Vector2::new(0.8, 0.6))?.stiffness().clone()
     } else {
-        transversely_isotropic(p, Vector3::new(0.6, 0.48, 0.64))?
-            .stiffness()
-            .clone()
+        transversely_isotropic(p, Vector3::new(0.6, 0.48, 0.64))?.stiffness().clone()
     };
     Ok(anisotropic::<D>(c)?)
 }
 
 fn mesh_error(body: &str) -> impl Fn(synovia_mesh::MeshError) -> FemError + '_ {
-    move |source| FemError::Mesh {
-        body: body.to_string(),
-        source,
-    }
+    move |source| FemError::Mesh { body: body.to_string(), source }
 }
 
 /// Solves the bonded two-body manufactured problem in dimension `D` with `n` cells per unit
@@ -168,66 +148,32 @@ fn mesh_error(body: &str) -> impl Fn(synovia_mesh::MeshError) -> FemError + '_ {
 pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> {
     let half = (n / 2).max(1);
     let (left, right): (Mesh<D>, Mesh<D>) = if D == 2 {
-        let l = rectangle(
-            0.0,
-            0.5,
-            0.0,
-            1.0,
-            half,
-            n,
-            Grading::Uniform,
-            Grading::Uniform,
-        )
-        .map_err(mesh_error("iso"))?;
-        let r = rectangle(
-            0.5,
-            1.0,
-            0.0,
-            1.0,
-            half,
-            n,
-            Grading::Uniform,
-            Grading::Uniform,
-        )
-        .map_err(mesh_error("aniso"))?;
+        let l = rectangle(0.0, 0.5, 0.0, 1.0, half, n, Grading::Uniform, Grading::Uniform)
+            .map_err(mesh_error("iso"))?;
+        let r = rectangle(0.5, 1.0, 0.0, 1.0, half, n, Grading::Uniform, Grading::Uniform)
+            .map_err(mesh_error("aniso"))?;
         (cast_mesh::<2, D>(l)?, cast_mesh::<2, D>(r)?)
     } else {
         let g = [Grading::Uniform; 3];
-        let l = box_mesh([0.0, 0.0, 0.0], [0.5, 1.0, 1.0], [half, n, n], g)
-            .map_err(mesh_error("iso"))?;
-        let r = box_mesh([0.5, 0.0, 0.0], [1.0, 1.0, 1.0], [half, n, n], g)
-            .map_err(mesh_error("aniso"))?;
+        let l = box_mesh([0.0, 0.0, 0.0], [0.5, 1.0, 1.0], [half, n, n], g).map_err(mesh_error("iso"))?;
+        let r = box_mesh([0.5, 0.0, 0.0], [1.0, 1.0, 1.0], [half, n, n], g).map_err(mesh_error("aniso"))?;
         (cast_mesh::<3, D>(l)?, cast_mesh::<3, D>(r)?)
     };
-    let sides: Vec<&str> = if D == 2 {
-        vec!["bottom", "top"]
-    } else {
-        vec!["bottom", "top", "front", "back"]
-    };
+    let sides: Vec<&str> =
+        if D == 2 { vec!["bottom", "top"] } else { vec!["bottom", "top", "front", "back"] };
     let mut left = left;
     let mut right = right;
-    left.set_part_kind("left", BoundaryKind::Prescribed)
-        .map_err(mesh_error("iso"))?;
+    left.set_part_kind("left", BoundaryKind::Prescribed).map_err(mesh_error("iso"))?;
     for p in &sides {
-        left.set_part_kind(p, BoundaryKind::Prescribed)
-            .map_err(mesh_error("iso"))?;
-        right
-            .set_part_kind(p, BoundaryKind::Prescribed)
-            .map_err(mesh_error("aniso"))?;
+        left.set_part_kind(p, BoundaryKind::Prescribed).map_err(mesh_error("iso"))?;
+        right.set_part_kind(p, BoundaryKind::Prescribed).map_err(mesh_error("aniso"))?;
     }
+    right.remove_boundary_part("left").map_err(mesh_error("aniso"))?;
     right
-        .remove_boundary_part("left")
+        .add_boundary_part("interface", BoundaryKind::TractionFree, |x, _| (x[0] - 0.5).abs() < 1e-12)
         .map_err(mesh_error("aniso"))?;
-    right
-        .add_boundary_part("interface", BoundaryKind::TractionFree, |x, _| {
-            (x[0] - 0.5).abs() < 1e-12
-        })
-        .map_err(mesh_error("aniso"))?;
-    left.set_part_kind("right", BoundaryKind::Traction)
-        .map_err(mesh_error("iso"))?;
-    right
-        .set_part_kind("right", BoundaryKind::Traction)
-        .map_err(mesh_error("aniso"))?;
+    left.set_part_kind("right", BoundaryKind::Traction).map_err(mesh_error("iso"))?;
+    right.set_part_kind("right", BoundaryKind::Traction).map_err(mesh_error("aniso"))?;
 
     let ml = left_material::<D>()?;
     let mr = right_material::<D>()?;
@@ -248,19 +194,11 @@ pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> 
     let c3 = cr.clone();
     model.traction(br, "right", move |x, nrm, _| exact.stress(&c3, x) * nrm)?;
     let (c4, c5) = (cl.clone(), cr.clone());
-    model.traction(bl, "right", move |x, nrm, _| {
-        (exact.stress(&c4, x) - exact.stress(&c5, x)) * nrm
-    })?;
+    model.traction(bl, "right", move |x, nrm, _| (exact.stress(&c4, x) - exact.stress(&c5, x)) * nrm)?;
     model.tie(bl, "right", br, "interface")?;
 
     let t0 = std::time::Instant::now();
-    let mut solver = ElasticSolver::new(
-        &model,
-        ElasticParams {
-            load_degree: 4,
-            ..Default::default()
-        },
-    )?;
+    let mut solver = ElasticSolver::new(&model, ElasticParams { load_degree: 4, ..Default::default() })?;
     let sol = solver.solve(&model, 0.0)?;
     let solve_s = t0.elapsed().as_secs_f64();
 
@@ -282,8 +220,7 @@ pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> 
                     ue[D * a + i] = u[nd][i];
                 }
             }
-            let eh =
-                nalgebra::DVector::from_vec(voigt_strain::<D>(&geo.displacement_gradient(&ue)));
+            let eh = nalgebra::DVector::from_vec(voigt_strain::<D>(&geo.displacement_gradient(&ue)));
             for (lam, w) in rule.barycentric.iter().zip(&rule.weights) {
                 let mut x = Point::<D>::zeros();
                 let mut uh = Vector::<D>::zeros();
@@ -318,25 +255,13 @@ pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> 
 /// dimension-specific, the study is generic).
 fn cast_mesh<const A: usize, const B: usize>(m: Mesh<A>) -> Result<Mesh<B>, FemError> {
     if A != B {
-        return Err(FemError::InvalidParameter(format!(
-            "dimension {A} is not {B}"
-        )));
+        return Err(FemError::InvalidParameter(format!("dimension {A} is not {B}")));
     }
-    let nodes: Vec<Point<B>> = m
-        .nodes()
-        .iter()
-        .map(|p| Point::<B>::from_fn(|i, _| p[i]))
-        .collect();
+    let nodes: Vec<Point<B>> = m.nodes().iter().map(|p| Point::<B>::from_fn(|i, _| p[i])).collect();
     let parts = m
         .boundary_parts()
         .iter()
-        .map(|p| {
-            (
-                p.name().to_string(),
-                p.kind(),
-                p.facets().map(|f| f.to_vec()).collect(),
-            )
-        })
+        .map(|p| (p.name().to_string(), p.kind(), p.facets().map(|f| f.to_vec()).collect()))
         .collect();
     Mesh::<B>::from_parts(nodes, m.cells_flat().to_vec(), parts).map_err(mesh_error("cast"))
 }

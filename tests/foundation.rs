@@ -9,33 +9,13 @@ use synovia::fem::{DofMap, ElasticParams, ElasticSolver, SymmetricMatrix};
 use synovia::prelude::*;
 
 fn cantilever() -> Model<2> {
-    let mut mesh = rectangle(
-        0.0,
-        4.0,
-        0.0,
-        1.0,
-        16,
-        4,
-        Grading::Uniform,
-        Grading::Uniform,
-    )
-    .expect("mesh");
-    mesh.set_part_kind("left", BoundaryKind::Clamped)
-        .expect("part");
-    mesh.set_part_kind("right", BoundaryKind::Prescribed)
-        .expect("part");
+    let mut mesh = rectangle(0.0, 4.0, 0.0, 1.0, 16, 4, Grading::Uniform, Grading::Uniform).expect("mesh");
+    mesh.set_part_kind("left", BoundaryKind::Clamped).expect("part");
+    mesh.set_part_kind("right", BoundaryKind::Prescribed).expect("part");
     let mut model = Model::<2>::new();
-    let b = model
-        .add_body(
-            "beam",
-            mesh,
-            Arc::new(plane_strain(100.0, 0.3).expect("ok")),
-        )
-        .expect("body");
+    let b = model.add_body("beam", mesh, Arc::new(plane_strain(100.0, 0.3).expect("ok"))).expect("body");
     // the tip is pushed down linearly in time
-    model
-        .prescribe(b, "right", |_, t| Vector::<2>::new(0.0, -0.01 * t))
-        .expect("prescribe");
+    model.prescribe(b, "right", |_, t| Vector::<2>::new(0.0, -0.01 * t)).expect("prescribe");
     model
 }
 
@@ -62,24 +42,13 @@ fn time_dependent_dirichlet_data_scales_the_solution_with_one_factorisation() {
 
 #[test]
 fn strain_energy_equals_half_the_work_of_the_loads() {
-    let mut mesh =
-        box_mesh([0.0; 3], [2.0, 1.0, 1.0], [6, 3, 3], [Grading::Uniform; 3]).expect("mesh");
-    mesh.set_part_kind("left", BoundaryKind::Clamped)
-        .expect("part");
-    mesh.set_part_kind("right", BoundaryKind::Traction)
-        .expect("part");
+    let mut mesh = box_mesh([0.0; 3], [2.0, 1.0, 1.0], [6, 3, 3], [Grading::Uniform; 3]).expect("mesh");
+    mesh.set_part_kind("left", BoundaryKind::Clamped).expect("part");
+    mesh.set_part_kind("right", BoundaryKind::Traction).expect("part");
     let mut model = Model::<3>::new();
-    let b = model
-        .add_body("block", mesh, Arc::new(isotropic(50.0, 0.25).expect("ok")))
-        .expect("body");
-    model
-        .traction(b, "right", |x, _, _| {
-            Vector::<3>::new(0.1 * x[1], 0.0, -0.2)
-        })
-        .expect("traction");
-    model
-        .body_force(b, |_, _| Vector::<3>::new(0.0, 0.05, 0.0))
-        .expect("force");
+    let b = model.add_body("block", mesh, Arc::new(isotropic(50.0, 0.25).expect("ok"))).expect("body");
+    model.traction(b, "right", |x, _, _| Vector::<3>::new(0.1 * x[1], 0.0, -0.2)).expect("traction");
+    model.body_force(b, |_, _| Vector::<3>::new(0.0, 0.05, 0.0)).expect("force");
     let mut solver = ElasticSolver::new(&model, ElasticParams::default()).expect("factorise");
     let sol = solver.solve(&model, 0.0).expect("solve");
     let fields = solver.fields(&model, &sol).expect("fields");
@@ -87,20 +56,12 @@ fn strain_energy_equals_half_the_work_of_the_loads() {
     let work: f64 = rhs.iter().zip(&sol.reduced).map(|(f, u)| f * u).sum();
     let energy = fields[0].strain_energy;
     assert!(energy > 0.0);
-    assert!(
-        (energy - 0.5 * work).abs() < 1e-10 * energy,
-        "energy {energy} vs work/2 {}",
-        0.5 * work
-    );
+    assert!((energy - 0.5 * work).abs() < 1e-10 * energy, "energy {energy} vs work/2 {}", 0.5 * work);
     // and ½ uᵀ K u
     let quad = 0.5 * solver.stiffness().quadratic_form(&sol.reduced);
     assert!((quad - energy).abs() < 1e-10 * energy);
     // von Mises and principal stresses are consistent: σ_vm² = ½ Σ (σ_i − σ_j)²
-    for (vm, p) in fields[0]
-        .cell_von_mises
-        .iter()
-        .zip(&fields[0].cell_principal)
-    {
+    for (vm, p) in fields[0].cell_von_mises.iter().zip(&fields[0].cell_principal) {
         let v2 = 0.5 * ((p[0] - p[1]).powi(2) + (p[1] - p[2]).powi(2) + (p[2] - p[0]).powi(2));
         assert!((vm * vm - v2).abs() < 1e-9 * (1.0 + v2));
         assert!(p[0] >= p[1] && p[1] >= p[2]);
@@ -113,17 +74,11 @@ fn reassembly_reuses_the_pattern_without_reallocation() {
     let dofs = DofMap::new(&model).expect("dofs");
     let (mut k, _) = pattern(&model, &dofs).expect("pattern");
     let c = plane_strain(100.0, 0.3).expect("ok").stiffness().clone();
-    assemble_matrix(&model, &dofs, &mut k, |_, _, geo, out| {
-        stiffness_into(geo, &c, out)
-    })
-    .expect("assemble");
+    assemble_matrix(&model, &dofs, &mut k, |_, _, geo, out| stiffness_into(geo, &c, out)).expect("assemble");
     let ptr = k.values().as_ptr();
     let first: Vec<f64> = k.values().to_vec();
     let c2 = &c * 2.0;
-    assemble_matrix(&model, &dofs, &mut k, |_, _, geo, out| {
-        stiffness_into(geo, &c2, out)
-    })
-    .expect("assemble");
+    assemble_matrix(&model, &dofs, &mut k, |_, _, geo, out| stiffness_into(geo, &c2, out)).expect("assemble");
     assert_eq!(ptr, k.values().as_ptr(), "values were reallocated");
     for (a, b) in first.iter().zip(k.values()) {
         assert!((2.0 * a - b).abs() <= 1e-12 * a.abs().max(1.0));
@@ -133,37 +88,21 @@ fn reassembly_reuses_the_pattern_without_reallocation() {
 #[test]
 fn mass_matrices_integrate_the_density() {
     // free body (no constraints): 1ᵀ M 1 per component = ρ |Ω|
-    let mesh =
-        rectangle(0.0, 3.0, 0.0, 2.0, 6, 5, Grading::Uniform, Grading::Uniform).expect("mesh");
+    let mesh = rectangle(0.0, 3.0, 0.0, 2.0, 6, 5, Grading::Uniform, Grading::Uniform).expect("mesh");
     let mut model = Model::<2>::new();
-    model
-        .add_body("b", mesh, Arc::new(plane_strain(1.0, 0.3).expect("ok")))
-        .expect("body");
+    model.add_body("b", mesh, Arc::new(plane_strain(1.0, 0.3).expect("ok"))).expect("body");
     let dofs = DofMap::new(&model).expect("dofs");
     let (mut m, _) = pattern(&model, &dofs).expect("pattern");
     let rho = 1.7;
     for lumped in [false, true] {
-        assemble_matrix(&model, &dofs, &mut m, |_, _, geo, out| {
-            mass_into(geo, rho, lumped, out)
-        })
-        .expect("mass");
-        let ones_x: Vec<f64> = (0..dofs.n_dofs())
-            .map(|i| if i % 2 == 0 { 1.0 } else { 0.0 })
-            .collect();
+        assemble_matrix(&model, &dofs, &mut m, |_, _, geo, out| mass_into(geo, rho, lumped, out))
+            .expect("mass");
+        let ones_x: Vec<f64> = (0..dofs.n_dofs()).map(|i| if i % 2 == 0 { 1.0 } else { 0.0 }).collect();
         let total = m.quadratic_form(&ones_x);
-        assert!(
-            (total - rho * 6.0).abs() < 1e-12,
-            "lumped = {lumped}: {total}"
-        );
+        assert!((total - rho * 6.0).abs() < 1e-12, "lumped = {lumped}: {total}");
         // the second moment ∫ ρ x² is exact for the consistent mass only
         let xs: Vec<f64> = (0..dofs.n_dofs())
-            .map(|i| {
-                if i % 2 == 0 {
-                    model.bodies()[0].mesh.node(i / 2)[0]
-                } else {
-                    0.0
-                }
-            })
+            .map(|i| if i % 2 == 0 { model.bodies()[0].mesh.node(i / 2)[0] } else { 0.0 })
             .collect();
         let second = m.quadratic_form(&xs);
         let exact = rho * 2.0 * 27.0 / 3.0;
@@ -197,30 +136,15 @@ fn sprs_round_trip_preserves_the_matrix() {
 #[test]
 fn metis_and_amd_orderings_give_the_same_solution() {
     let mut mesh = box_mesh([0.0; 3], [1.0; 3], [4, 4, 4], [Grading::Uniform; 3]).expect("mesh");
-    mesh.set_part_kind("bottom", BoundaryKind::Clamped)
-        .expect("part");
-    mesh.set_part_kind("top", BoundaryKind::Traction)
-        .expect("part");
+    mesh.set_part_kind("bottom", BoundaryKind::Clamped).expect("part");
+    mesh.set_part_kind("top", BoundaryKind::Traction).expect("part");
     let mut model = Model::<3>::new();
-    let b = model
-        .add_body("cube", mesh, Arc::new(isotropic(10.0, 0.3).expect("ok")))
-        .expect("body");
-    model
-        .traction(b, "top", |x, _, _| Vector::<3>::new(x[1], 0.0, -1.0))
-        .expect("traction");
+    let b = model.add_body("cube", mesh, Arc::new(isotropic(10.0, 0.3).expect("ok"))).expect("body");
+    model.traction(b, "top", |x, _, _| Vector::<3>::new(x[1], 0.0, -1.0)).expect("traction");
     let mut sols = Vec::new();
-    for ordering in [
-        synovia::fem::OrderingChoice::Amd,
-        synovia::fem::OrderingChoice::Metis,
-    ] {
-        let mut s = ElasticSolver::new(
-            &model,
-            ElasticParams {
-                ordering,
-                ..Default::default()
-            },
-        )
-        .expect("factorise");
+    for ordering in [synovia::fem::OrderingChoice::Amd, synovia::fem::OrderingChoice::Metis] {
+        let mut s =
+            ElasticSolver::new(&model, ElasticParams { ordering, ..Default::default() }).expect("factorise");
         sols.push(s.solve(&model, 0.0).expect("solve").reduced);
     }
     let scale = sols[0].iter().fold(0.0_f64, |a, b| a.max(b.abs()));
@@ -245,9 +169,7 @@ fn vtu_output_of_a_solution_reads_back() {
     let data = synovia::io::read_vtu(&path).expect("read");
     let piece = &data.pieces[0];
     assert_eq!(piece.n_points(), model.bodies()[0].mesh.n_nodes());
-    let disp = piece
-        .point_field("displacement")
-        .expect("displacement field");
+    let disp = piece.point_field("displacement").expect("displacement field");
     for (i, u) in sol.displacement[0].iter().enumerate() {
         let t = disp.tuple(i).expect("tuple");
         assert_eq!([t[0], t[1], t[2]], [u[0], u[1], 0.0]);

@@ -62,18 +62,9 @@ pub fn pattern<const D: usize>(
             columns.push(rows);
         }
     }
-    let blocks = groups
-        .iter()
-        .map(|g| g.first_dof..g.first_dof + g.n_dofs)
-        .collect();
+    let blocks = groups.iter().map(|g| g.first_dof..g.first_dof + g.n_dofs).collect();
     let m = SymmetricMatrix::from_columns(dofs.n_dofs(), columns)?;
-    Ok((
-        m,
-        Ordering::Metis {
-            blocks,
-            adjacency: adj,
-        },
-    ))
+    Ok((m, Ordering::Metis { blocks, adjacency: adj }))
 }
 
 /// The constant Voigt stiffness `C⁽⁰⁾` of every body (errors for nonlinear materials and wrong
@@ -84,19 +75,12 @@ pub fn body_stiffnesses<const D: usize>(model: &Model<D>) -> Result<Vec<DMatrix<
         .bodies()
         .iter()
         .map(|b| {
-            let c = b
-                .material
-                .linear_stiffness()
-                .ok_or_else(|| FemError::NonlinearMaterial {
-                    body: b.name.clone(),
-                    material: b.material.name(),
-                })?;
+            let c = b.material.linear_stiffness().ok_or_else(|| FemError::NonlinearMaterial {
+                body: b.name.clone(),
+                material: b.material.name(),
+            })?;
             if c.nrows() != nv || c.ncols() != nv {
-                return Err(FemError::MaterialSize {
-                    body: b.name.clone(),
-                    expected: nv,
-                    got: c.nrows(),
-                });
+                return Err(FemError::MaterialSize { body: b.name.clone(), expected: nv, got: c.nrows() });
             }
             Ok(c)
         })
@@ -130,11 +114,7 @@ pub fn assemble_matrix<const D: usize>(
     kernel: impl Fn(usize, usize, &SimplexGeometry<D>, &mut [Real]),
 ) -> Result<(), FemError> {
     if matrix.n() != dofs.n_dofs() {
-        return Err(FemError::Length {
-            what: "matrix",
-            expected: dofs.n_dofs(),
-            got: matrix.n(),
-        });
+        return Err(FemError::Length { what: "matrix", expected: dofs.n_dofs(), got: matrix.n() });
     }
     matrix.zero();
     let n = D * (D + 1);
@@ -171,9 +151,7 @@ pub fn assemble_matrix<const D: usize>(
                             let mut v = 0.0;
                             for i in 0..D {
                                 for j in 0..D {
-                                    v += ga.basis[k][i]
-                                        * ke[(D * a + i) * n + D * b + j]
-                                        * gb.basis[l][j];
+                                    v += ga.basis[k][i] * ke[(D * a + i) * n + D * b + j] * gb.basis[l][j];
                                 }
                             }
                             matrix.add(r, col, v)?;
@@ -201,10 +179,7 @@ pub fn subtract_lift<const D: usize>(
     for (bi, body) in model.bodies().iter().enumerate() {
         for c in 0..body.mesh.n_cells() {
             let cell = body.mesh.cell(c);
-            if cell
-                .iter()
-                .all(|&i| lifts[dofs.group_of(BodyId(bi), i)].norm_squared() == 0.0)
-            {
+            if cell.iter().all(|&i| lifts[dofs.group_of(BodyId(bi), i)].norm_squared() == 0.0) {
                 continue;
             }
             let (geo, _) = cell_geometry(model, bi, c)?;
@@ -233,13 +208,7 @@ pub fn subtract_lift<const D: usize>(
 
 /// Adds the nodal vector `f` of node `node` of body `b` to the reduced right-hand side.
 #[inline]
-fn add_nodal<const D: usize>(
-    dofs: &DofMap<D>,
-    b: usize,
-    node: usize,
-    f: &Vector<D>,
-    rhs: &mut [Real],
-) {
+fn add_nodal<const D: usize>(dofs: &DofMap<D>, b: usize, node: usize, f: &Vector<D>, rhs: &mut [Real]) {
     let g = &dofs.groups()[dofs.group_of(BodyId(b), node)];
     for k in 0..g.n_dofs {
         rhs[g.first_dof + k] += g.basis[k].dot(f);
@@ -282,10 +251,7 @@ pub fn add_loads<const D: usize>(
         let part = body
             .mesh
             .boundary_part(&tr.part)
-            .map_err(|source| FemError::Mesh {
-                body: body.name.clone(),
-                source,
-            })?;
+            .map_err(|source| FemError::Mesh { body: body.name.clone(), source })?;
         let p = |x: &Point<D>, n: &Vector<D>| (tr.value)(x, n, t);
         for facet in part.facets() {
             let pts: Vec<Point<D>> = facet.iter().map(|&i| *body.mesh.node(i)).collect();

@@ -22,7 +22,7 @@ use synovia_mesh::matching::match_nodes;
 use synovia_mesh::math::{Point, Real, Vector};
 use synovia_mesh::BoundaryKind;
 
-use crate::error::FemError;
+use crate::error::{FemError, UnmatchedInterface};
 use crate::model::{BodyId, Model};
 
 /// Where the right-hand side `g_j(t)` of a node constraint comes from.
@@ -120,37 +120,30 @@ impl<const D: usize> DofMap<D> {
             let pa = ba
                 .mesh
                 .boundary_part(&tie.part_a)
-                .map_err(|source| FemError::Mesh {
-                    body: ba.name.clone(),
-                    source,
-                })?
+                .map_err(|source| FemError::Mesh { body: ba.name.clone(), source })?
                 .nodes();
             let pb = bb
                 .mesh
                 .boundary_part(&tie.part_b)
-                .map_err(|source| FemError::Mesh {
-                    body: bb.name.clone(),
-                    source,
-                })?
+                .map_err(|source| FemError::Mesh { body: bb.name.clone(), source })?
                 .nodes();
             let xa: Vec<Point<D>> = pa.iter().map(|&i| *ba.mesh.node(i)).collect();
             let xb: Vec<Point<D>> = pb.iter().map(|&i| *bb.mesh.node(i)).collect();
             let tol = tie
                 .tolerance
                 .unwrap_or_else(|| 1e-8 * ba.mesh.min_edge_length().min(bb.mesh.min_edge_length()));
-            let pairs = match_nodes(&xa, &xb, tol).map_err(|u| FemError::UnmatchedInterface {
-                body_a: ba.name.clone(),
-                part_a: tie.part_a.clone(),
-                body_b: bb.name.clone(),
-                part_b: tie.part_b.clone(),
-                unmatched_a: u.first.iter().map(|&i| pa[i]).collect(),
-                unmatched_b: u.second.iter().map(|&j| pb[j]).collect(),
+            let pairs = match_nodes(&xa, &xb, tol).map_err(|u| {
+                FemError::UnmatchedInterface(Box::new(UnmatchedInterface {
+                    body_a: ba.name.clone(),
+                    part_a: tie.part_a.clone(),
+                    body_b: bb.name.clone(),
+                    part_b: tie.part_b.clone(),
+                    unmatched_a: u.first.iter().map(|&i| pa[i]).collect(),
+                    unmatched_b: u.second.iter().map(|&j| pb[j]).collect(),
+                }))
             })?;
             for (i, j) in pairs {
-                uf.union(
-                    node_offset[tie.body_a.0] + pa[i],
-                    node_offset[tie.body_b.0] + pb[j],
-                );
+                uf.union(node_offset[tie.body_a.0] + pa[i], node_offset[tie.body_b.0] + pb[j]);
             }
             body_uf.union(tie.body_a.0, tie.body_b.0);
         }
@@ -202,19 +195,14 @@ impl<const D: usize> DofMap<D> {
                         }
                     }
                     BoundaryKind::Symmetry => {
-                        let normals = body.mesh.nodal_normals(part.name()).map_err(|source| {
-                            FemError::Mesh {
-                                body: body.name.clone(),
-                                source,
-                            }
-                        })?;
+                        let normals = body
+                            .mesh
+                            .nodal_normals(part.name())
+                            .map_err(|source| FemError::Mesh { body: body.name.clone(), source })?;
                         for (n, normal) in normals {
-                            groups[group_of[node_offset[bi] + n]].constraints.push(
-                                NodeConstraint {
-                                    direction: normal,
-                                    value: ConstraintValue::Zero,
-                                },
-                            );
+                            groups[group_of[node_offset[bi] + n]]
+                                .constraints
+                                .push(NodeConstraint { direction: normal, value: ConstraintValue::Zero });
                         }
                     }
                     _ => {}
@@ -226,10 +214,7 @@ impl<const D: usize> DofMap<D> {
             let part = body
                 .mesh
                 .boundary_part(&p.part)
-                .map_err(|source| FemError::Mesh {
-                    body: body.name.clone(),
-                    source,
-                })?;
+                .map_err(|source| FemError::Mesh { body: body.name.clone(), source })?;
             for n in part.nodes() {
                 let grp = &mut groups[group_of[node_offset[p.body.0] + n]];
                 for k in 0..D {
@@ -250,13 +235,7 @@ impl<const D: usize> DofMap<D> {
             grp.first_dof = next;
             next += grp.n_dofs;
         }
-        Ok(Self {
-            node_offset,
-            group_of,
-            groups,
-            n_dofs: next,
-            body_component,
-        })
+        Ok(Self { node_offset, group_of, groups, n_dofs: next, body_component })
     }
 
     /// Number of reduced (free) unknowns.
@@ -305,11 +284,8 @@ impl<const D: usize> DofMap<D> {
                     }
                 });
             }
-            let proj: Vec<Real> = grp
-                .ortho
-                .iter()
-                .map(|(_, l)| l.iter().zip(&g).map(|(a, b)| a * b).sum())
-                .collect();
+            let proj: Vec<Real> =
+                grp.ortho.iter().map(|(_, l)| l.iter().zip(&g).map(|(a, b)| a * b).sum()).collect();
             for (j, alpha) in &grp.dependent {
                 let pred: Real = alpha.iter().zip(&proj).map(|(a, b)| a * b).sum();
                 let scale = pred.abs().max(g[*j].abs());
@@ -332,11 +308,7 @@ impl<const D: usize> DofMap<D> {
     }
 
     /// The displacement of every node of every body, `u = u_p + N ũ`, from reduced unknowns.
-    pub fn expand(
-        &self,
-        reduced: &[Real],
-        lifts: &[Vector<D>],
-    ) -> Result<Vec<Vec<Vector<D>>>, FemError> {
+    pub fn expand(&self, reduced: &[Real], lifts: &[Vector<D>]) -> Result<Vec<Vec<Vector<D>>>, FemError> {
         if reduced.len() != self.n_dofs {
             return Err(FemError::Length {
                 what: "reduced solution",
@@ -359,12 +331,7 @@ impl<const D: usize> DofMap<D> {
 
     /// `u_p + N ũ` of group `gi`.
     #[inline]
-    pub fn group_displacement(
-        &self,
-        gi: usize,
-        reduced: &[Real],
-        lifts: &[Vector<D>],
-    ) -> Vector<D> {
+    pub fn group_displacement(&self, gi: usize, reduced: &[Real], lifts: &[Vector<D>]) -> Vector<D> {
         let grp = &self.groups[gi];
         let mut u = lifts[gi];
         for k in 0..grp.n_dofs {
@@ -398,9 +365,8 @@ impl<const D: usize> DofMap<D> {
         let nm = if D == 2 { 3 } else { 6 };
         let comps: BTreeSet<usize> = self.body_component.iter().copied().collect();
         for comp in comps {
-            let bodies: Vec<usize> = (0..self.body_component.len())
-                .filter(|&b| self.body_component[b] == comp)
-                .collect();
+            let bodies: Vec<usize> =
+                (0..self.body_component.len()).filter(|&b| self.body_component[b] == comp).collect();
             // centroid and size of the component
             let mut centre = Point::<D>::zeros();
             let mut count: Real = 0.0;
@@ -439,16 +405,10 @@ impl<const D: usize> DofMap<D> {
             }
             let eig = gram.symmetric_eigen().eigenvalues;
             let max = eig.iter().fold(0.0_f64, |a, &b| a.max(b));
-            let free = eig
-                .iter()
-                .filter(|&&e| e <= 1e-10 * max.max(Real::MIN_POSITIVE))
-                .count();
+            let free = eig.iter().filter(|&&e| e <= 1e-10 * max.max(Real::MIN_POSITIVE)).count();
             if free > 0 {
                 return Err(FemError::SemiCoercive {
-                    bodies: bodies
-                        .iter()
-                        .map(|&b| model.bodies()[b].name.clone())
-                        .collect(),
+                    bodies: bodies.iter().map(|&b| model.bodies()[b].name.clone()).collect(),
                     free_modes: free,
                 });
             }

@@ -39,10 +39,7 @@ pub struct ElasticParams {
 
 impl Default for ElasticParams {
     fn default() -> Self {
-        Self {
-            ordering: OrderingChoice::Auto,
-            load_degree: 2,
-        }
+        Self { ordering: OrderingChoice::Auto, load_degree: 2 }
     }
 }
 
@@ -101,9 +98,7 @@ impl<const D: usize> ElasticSolver<D> {
         let setup_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let body_c = body_stiffnesses(model)?;
-        assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| {
-            stiffness_into(geo, &body_c[b], out)
-        })?;
+        assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| stiffness_into(geo, &body_c[b], out))?;
         let assembly_s = t1.elapsed().as_secs_f64();
         let ordering = match (params.ordering, D) {
             (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => Ordering::Amd,
@@ -122,14 +117,7 @@ impl<const D: usize> ElasticSolver<D> {
             numeric_s: ci.numeric_s,
             solve_s: 0.0,
         };
-        Ok(Self {
-            dofs,
-            stiffness,
-            cholesky,
-            body_c,
-            params,
-            info,
-        })
+        Ok(Self { dofs, stiffness, cholesky, body_c, params, info })
     }
 
     /// The reduced right-hand side `F̃(t) = Pᵀ (F(t) − K u_p(t))`.
@@ -138,9 +126,7 @@ impl<const D: usize> ElasticSolver<D> {
         let mut rhs = vec![0.0; self.dofs.n_dofs()];
         add_loads(model, &self.dofs, t, self.params.load_degree, &mut rhs)?;
         let c = &self.body_c;
-        subtract_lift(model, &self.dofs, &lifts, &mut rhs, |b, _, geo, out| {
-            stiffness_into(geo, &c[b], out)
-        })?;
+        subtract_lift(model, &self.dofs, &lifts, &mut rhs, |b, _, geo, out| stiffness_into(geo, &c[b], out))?;
         Ok((rhs, lifts))
     }
 
@@ -151,11 +137,7 @@ impl<const D: usize> ElasticSolver<D> {
         self.cholesky.solve_in_place(&mut x)?;
         let displacement = self.dofs.expand(&x, &lifts)?;
         self.info.solve_s = t0.elapsed().as_secs_f64();
-        Ok(ElasticSolution {
-            time: t,
-            reduced: x,
-            displacement,
-        })
+        Ok(ElasticSolution { time: t, reduced: x, displacement })
     }
 
     /// Strain, stress, von Mises, principal stresses and energy of a solution.
@@ -186,9 +168,6 @@ impl<const D: usize> ElasticSolver<D> {
 }
 
 /// One-shot convenience: factorise and solve the model at time `t` with default parameters.
-pub fn solve_elastic<const D: usize>(
-    model: &Model<D>,
-    t: Real,
-) -> Result<ElasticSolution<D>, FemError> {
+pub fn solve_elastic<const D: usize>(model: &Model<D>, t: Real) -> Result<ElasticSolution<D>, FemError> {
     ElasticSolver::new(model, ElasticParams::default())?.solve(model, t)
 }

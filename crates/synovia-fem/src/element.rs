@@ -28,10 +28,7 @@ impl<const D: usize> SimplexGeometry<D> {
             j.set_column(k, &(vertices[k + 1] - vertices[0]));
         }
         let (inv, det) = inverse_with_det(&j)?;
-        Some(Self {
-            measure: det / factorial(D),
-            inv_jt: inv.transpose(),
-        })
+        Some(Self { measure: det / factorial(D), inv_jt: inv.transpose() })
     }
 
     /// `∇φ_a` for local vertex `a ∈ 0..=D`.
@@ -131,11 +128,7 @@ fn b_entry<const D: usize>(g: &Vector<D>, r: usize, i: usize) -> Real {
 /// `a(u, v) = ∫_T C e(u) : e(v) dx` (spec §2), for a constant Voigt stiffness `C`
 /// (`voigt_len(D)` square, engineering-shear convention). Written into `out`, a
 /// `D(D+1) × D(D+1)` row-major buffer, node-major dof order.
-pub fn stiffness_into<const D: usize>(
-    geo: &SimplexGeometry<D>,
-    c: &DMatrix<Real>,
-    out: &mut [Real],
-) {
+pub fn stiffness_into<const D: usize>(geo: &SimplexGeometry<D>, c: &DMatrix<Real>, out: &mut [Real]) {
     let n = D * (D + 1);
     let nv = D * (D + 1) / 2;
     // B: nv × n
@@ -200,12 +193,7 @@ pub fn lumped_mass_into<const D: usize>(geo: &SimplexGeometry<D>, rho: Real, out
 /// Mass element matrix with coefficient `c` (`ρ` for `M_ρ`, `α` for `M_α`, spec §7):
 /// consistent ([`consistent_mass_into`]) or row-sum lumped (diagonal), into `out`
 /// (`D(D+1)` square, row-major).
-pub fn mass_into<const D: usize>(
-    geo: &SimplexGeometry<D>,
-    c: Real,
-    lumped: bool,
-    out: &mut [Real],
-) {
+pub fn mass_into<const D: usize>(geo: &SimplexGeometry<D>, c: Real, lumped: bool, out: &mut [Real]) {
     if lumped {
         let n = D * (D + 1);
         out[..n * n].iter_mut().for_each(|x| *x = 0.0);
@@ -282,11 +270,7 @@ mod tests {
     fn iso_plane_strain(e: f64, nu: f64) -> DMatrix<f64> {
         let l = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
         let m = e / (2.0 * (1.0 + nu));
-        DMatrix::from_row_slice(
-            3,
-            3,
-            &[l + 2.0 * m, l, 0.0, l, l + 2.0 * m, 0.0, 0.0, 0.0, m],
-        )
+        DMatrix::from_row_slice(3, 3, &[l + 2.0 * m, l, 0.0, l, l + 2.0 * m, 0.0, 0.0, 0.0, m])
     }
 
     #[test]
@@ -310,11 +294,7 @@ mod tests {
 
     #[test]
     fn stiffness_is_symmetric_psd_with_rigid_kernel() {
-        let v = [
-            Point::<2>::new(0.0, 0.0),
-            Point::<2>::new(1.0, 0.1),
-            Point::<2>::new(0.3, 0.8),
-        ];
+        let v = [Point::<2>::new(0.0, 0.0), Point::<2>::new(1.0, 0.1), Point::<2>::new(0.3, 0.8)];
         let geo = SimplexGeometry::<2>::new(&v).expect("ok");
         let mut k = vec![0.0; 36];
         stiffness_into(&geo, &iso_plane_strain(10.0, 0.3), &mut k);
@@ -325,13 +305,7 @@ mod tests {
             let u = nalgebra::DVector::from_fn(6, |i, _| mode[i % 2]);
             assert!((&km * u).norm() < 1e-12);
         }
-        let rot = nalgebra::DVector::from_fn(6, |i, _| {
-            if i % 2 == 0 {
-                -v[i / 2][1]
-            } else {
-                v[i / 2][0]
-            }
-        });
+        let rot = nalgebra::DVector::from_fn(6, |i, _| if i % 2 == 0 { -v[i / 2][1] } else { v[i / 2][0] });
         assert!((&km * rot).norm() < 1e-12);
         let eig = km.symmetric_eigen().eigenvalues;
         assert_eq!(eig.iter().filter(|&&x| x > 1e-9).count(), 3);

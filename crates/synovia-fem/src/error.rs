@@ -64,9 +64,7 @@ pub enum FemError {
     },
     /// Two constraints on the same node contradict each other (e.g. clamped and prescribed to a
     /// non-zero value).
-    #[error(
-        "body `{body}`, node {node}: constraints contradict each other (residual {residual:e})"
-    )]
+    #[error("body `{body}`, node {node}: constraints contradict each other (residual {residual:e})")]
     ConflictingConstraints {
         /// Body name.
         body: String,
@@ -76,21 +74,8 @@ pub enum FemError {
         residual: f64,
     },
     /// Nodes of a tied (bonded) interface have no partner at the same position.
-    #[error("bonded interface `{body_a}:{part_a}` – `{body_b}:{part_b}`: unmatched nodes {unmatched_a:?} (first) and {unmatched_b:?} (second)")]
-    UnmatchedInterface {
-        /// First body.
-        body_a: String,
-        /// First part.
-        part_a: String,
-        /// Second body.
-        body_b: String,
-        /// Second part.
-        part_b: String,
-        /// Unmatched nodes of the first body (mesh indices).
-        unmatched_a: Vec<usize>,
-        /// Unmatched nodes of the second body (mesh indices).
-        unmatched_b: Vec<usize>,
-    },
+    #[error("{0}")]
+    UnmatchedInterface(Box<UnmatchedInterface>),
     /// Some bodies are not held against rigid motion (spec §4): the elastic problem is
     /// semi-coercive and its stiffness matrix singular.
     #[error("bodies {bodies:?} are semi-coercive: {free_modes} rigid-body mode(s) are not restrained by Dirichlet or symmetry data; add boundary conditions or solve it as a contact problem")]
@@ -140,4 +125,22 @@ pub enum FemError {
     /// A parameter is out of its domain.
     #[error("invalid parameter: {0}")]
     InvalidParameter(String),
+}
+
+/// Details of [`FemError::UnmatchedInterface`].
+#[derive(Debug, Clone, PartialEq, Error)]
+#[error("bonded interface `{body_a}:{part_a}` – `{body_b}:{part_b}`: unmatched nodes {unmatched_a:?} (first) and {unmatched_b:?} (second)")]
+pub struct UnmatchedInterface {
+    /// First body.
+    pub body_a: String,
+    /// First part.
+    pub part_a: String,
+    /// Second body.
+    pub body_b: String,
+    /// Second part.
+    pub part_b: String,
+    /// Unmatched nodes of the first body (mesh indices).
+    pub unmatched_a: Vec<usize>,
+    /// Unmatched nodes of the second body (mesh indices).
+    pub unmatched_b: Vec<usize>,
 }

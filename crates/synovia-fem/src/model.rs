@@ -15,8 +15,7 @@ use crate::error::FemError;
 pub type VectorField<const D: usize> = Arc<dyn Fn(&Point<D>, Real) -> Vector<D> + Send + Sync>;
 
 /// A traction field `P(x, n, t)` on a boundary part (`n` the outward unit normal of the facet).
-pub type TractionField<const D: usize> =
-    Arc<dyn Fn(&Point<D>, &Vector<D>, Real) -> Vector<D> + Send + Sync>;
+pub type TractionField<const D: usize> = Arc<dyn Fn(&Point<D>, &Vector<D>, Real) -> Vector<D> + Send + Sync>;
 
 /// Index of a body in a [`Model`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -127,22 +126,8 @@ impl<const D: usize> fmt::Debug for Model<D> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("Model")
             .field("bodies", &self.bodies)
-            .field(
-                "prescribed",
-                &self
-                    .prescribed
-                    .iter()
-                    .map(|p| (&p.body, &p.part))
-                    .collect::<Vec<_>>(),
-            )
-            .field(
-                "tractions",
-                &self
-                    .tractions
-                    .iter()
-                    .map(|p| (&p.body, &p.part))
-                    .collect::<Vec<_>>(),
-            )
+            .field("prescribed", &self.prescribed.iter().map(|p| (&p.body, &p.part)).collect::<Vec<_>>())
+            .field("tractions", &self.tractions.iter().map(|p| (&p.body, &p.part)).collect::<Vec<_>>())
             .field("ties", &self.ties)
             .finish()
     }
@@ -151,12 +136,7 @@ impl<const D: usize> fmt::Debug for Model<D> {
 impl<const D: usize> Model<D> {
     /// An empty model.
     pub fn new() -> Self {
-        Self {
-            bodies: Vec::new(),
-            prescribed: Vec::new(),
-            tractions: Vec::new(),
-            ties: Vec::new(),
-        }
+        Self { bodies: Vec::new(), prescribed: Vec::new(), tractions: Vec::new(), ties: Vec::new() }
     }
 
     /// Adds a body; names must be unique.
@@ -169,12 +149,7 @@ impl<const D: usize> Model<D> {
         if self.bodies.iter().any(|b| b.name == name) {
             return Err(FemError::DuplicateBody(name.to_string()));
         }
-        self.bodies.push(Body {
-            name: name.to_string(),
-            mesh,
-            material,
-            body_force: None,
-        });
+        self.bodies.push(Body { name: name.to_string(), mesh, material, body_force: None });
         Ok(BodyId(self.bodies.len() - 1))
     }
 
@@ -207,12 +182,7 @@ impl<const D: usize> Model<D> {
         components: ComponentMask,
         value: impl Fn(&Point<D>, Real) -> Vector<D> + Send + Sync + 'static,
     ) -> Result<&mut Self, FemError> {
-        self.check_part(
-            body,
-            part,
-            BoundaryKind::Prescribed,
-            "a prescribed displacement",
-        )?;
+        self.check_part(body, part, BoundaryKind::Prescribed, "a prescribed displacement")?;
         self.prescribed.push(PrescribedDisplacement {
             body,
             part: part.to_string(),
@@ -230,11 +200,7 @@ impl<const D: usize> Model<D> {
         value: impl Fn(&Point<D>, &Vector<D>, Real) -> Vector<D> + Send + Sync + 'static,
     ) -> Result<&mut Self, FemError> {
         self.check_part(body, part, BoundaryKind::Traction, "a traction")?;
-        self.tractions.push(PrescribedTraction {
-            body,
-            part: part.to_string(),
-            value: Arc::new(value),
-        });
+        self.tractions.push(PrescribedTraction { body, part: part.to_string(), value: Arc::new(value) });
         Ok(self)
     }
 
@@ -250,10 +216,7 @@ impl<const D: usize> Model<D> {
             let body = self.body(b)?;
             body.mesh
                 .boundary_part(p)
-                .map_err(|source| FemError::Mesh {
-                    body: body.name.clone(),
-                    source,
-                })?;
+                .map_err(|source| FemError::Mesh { body: body.name.clone(), source })?;
         }
         self.ties.push(Tie {
             body_a,
@@ -273,13 +236,8 @@ impl<const D: usize> Model<D> {
         given: &'static str,
     ) -> Result<(), FemError> {
         let b = self.body(body)?;
-        let p = b
-            .mesh
-            .boundary_part(part)
-            .map_err(|source| FemError::Mesh {
-                body: b.name.clone(),
-                source,
-            })?;
+        let p =
+            b.mesh.boundary_part(part).map_err(|source| FemError::Mesh { body: b.name.clone(), source })?;
         if p.kind() != expected {
             return Err(FemError::BoundaryKindMismatch {
                 body: b.name.clone(),
@@ -299,14 +257,12 @@ impl<const D: usize> Model<D> {
         for (bi, body) in self.bodies.iter().enumerate() {
             for part in body.mesh.boundary_parts() {
                 let has = match part.kind() {
-                    BoundaryKind::Prescribed => self
-                        .prescribed
-                        .iter()
-                        .any(|p| p.body == BodyId(bi) && p.part == part.name()),
-                    BoundaryKind::Traction => self
-                        .tractions
-                        .iter()
-                        .any(|p| p.body == BodyId(bi) && p.part == part.name()),
+                    BoundaryKind::Prescribed => {
+                        self.prescribed.iter().any(|p| p.body == BodyId(bi) && p.part == part.name())
+                    }
+                    BoundaryKind::Traction => {
+                        self.tractions.iter().any(|p| p.body == BodyId(bi) && p.part == part.name())
+                    }
                     _ => true,
                 };
                 if !has {
@@ -327,15 +283,11 @@ impl<const D: usize> Model<D> {
     }
     /// Body `id`.
     pub fn body(&self, id: BodyId) -> Result<&Body<D>, FemError> {
-        self.bodies
-            .get(id.0)
-            .ok_or_else(|| FemError::UnknownBody(format!("#{}", id.0)))
+        self.bodies.get(id.0).ok_or_else(|| FemError::UnknownBody(format!("#{}", id.0)))
     }
     /// Mutable body `id`.
     pub fn body_mut(&mut self, id: BodyId) -> Result<&mut Body<D>, FemError> {
-        self.bodies
-            .get_mut(id.0)
-            .ok_or_else(|| FemError::UnknownBody(format!("#{}", id.0)))
+        self.bodies.get_mut(id.0).ok_or_else(|| FemError::UnknownBody(format!("#{}", id.0)))
     }
     /// The id of the body called `name`.
     pub fn body_id(&self, name: &str) -> Result<BodyId, FemError> {

@@ -53,8 +53,7 @@ pub fn principal_stresses(voigt: &[Real], sigma_zz: Real) -> [Real; 3] {
         [e[0], e[1], sigma_zz]
     } else {
         let m = Matrix3::new(
-            voigt[0], voigt[5], voigt[4], voigt[5], voigt[1], voigt[3], voigt[4], voigt[3],
-            voigt[2],
+            voigt[0], voigt[5], voigt[4], voigt[5], voigt[1], voigt[3], voigt[4], voigt[3], voigt[2],
         );
         let e = m.symmetric_eigenvalues();
         [e[0], e[1], e[2]]
@@ -99,11 +98,9 @@ pub fn body_fields<const D: usize>(
         let mut weight = vec![0.0; body.mesh.n_nodes()];
         let mut ue = vec![0.0; D * (D + 1)];
         for c in 0..nc {
-            let geo = SimplexGeometry::<D>::new(&body.mesh.cell_points(c)).ok_or_else(|| {
-                FemError::Mesh {
-                    body: body.name.clone(),
-                    source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
-                }
+            let geo = SimplexGeometry::<D>::new(&body.mesh.cell_points(c)).ok_or_else(|| FemError::Mesh {
+                body: body.name.clone(),
+                source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
             })?;
             for (a, &n) in body.mesh.cell(c).iter().enumerate() {
                 for i in 0..D {
@@ -112,11 +109,7 @@ pub fn body_fields<const D: usize>(
             }
             let eps = DVector::from_vec(voigt_strain::<D>(&geo.displacement_gradient(&ue)));
             let sig = body.material.stress(&eps);
-            let szz = if D == 2 {
-                body.material.out_of_plane_stress(&eps)
-            } else {
-                0.0
-            };
+            let szz = if D == 2 { body.material.out_of_plane_stress(&eps) } else { 0.0 };
             f.strain_energy += geo.measure * body.material.energy_density(&eps);
             let vm = von_mises(sig.as_slice(), szz);
             for &n in body.mesh.cell(c) {
@@ -126,8 +119,7 @@ pub fn body_fields<const D: usize>(
                 acc_vm[n] += geo.measure * vm;
                 weight[n] += geo.measure;
             }
-            f.cell_principal
-                .push(principal_stresses(sig.as_slice(), szz));
+            f.cell_principal.push(principal_stresses(sig.as_slice(), szz));
             f.cell_von_mises.push(vm);
             f.cell_stress_zz.push(szz);
             f.cell_strain.push(eps.iter().copied().collect());

@@ -44,14 +44,8 @@ impl QuadratureRule {
                 _ => (0.585_410_196_624_968_5, 0.138_196_601_125_010_5),
             };
             let n = dim + 1;
-            let barycentric = (0..n)
-                .map(|k| (0..n).map(|i| if i == k { a } else { b }).collect())
-                .collect();
-            return Ok(Self {
-                barycentric,
-                weights: vec![1.0 / n as f64; n],
-                degree: 2,
-            });
+            let barycentric = (0..n).map(|k| (0..n).map(|i| if i == k { a } else { b }).collect()).collect();
+            return Ok(Self { barycentric, weights: vec![1.0 / n as f64; n], degree: 2 });
         }
         let npts = (degree + dim).div_ceil(2);
         let (x, w) = gauss_legendre_01(npts)?;
@@ -88,11 +82,7 @@ impl QuadratureRule {
                 }
             }
         }
-        Ok(Self {
-            barycentric,
-            weights,
-            degree,
-        })
+        Ok(Self { barycentric, weights, degree })
     }
 
     /// Number of points.
@@ -110,17 +100,10 @@ impl QuadratureRule {
 fn gauss_legendre_01(n: usize) -> Result<(Vec<f64>, Vec<f64>), FemError> {
     let (x, w): (&[f64], &[f64]) = match n {
         1 => (&[0.0], &[2.0]),
-        2 => (
-            &[-0.577_350_269_189_625_8, 0.577_350_269_189_625_8],
-            &[1.0, 1.0],
-        ),
+        2 => (&[-0.577_350_269_189_625_8, 0.577_350_269_189_625_8], &[1.0, 1.0]),
         3 => (
             &[-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4],
-            &[
-                0.555_555_555_555_555_6,
-                0.888_888_888_888_888_9,
-                0.555_555_555_555_555_6,
-            ],
+            &[0.555_555_555_555_555_6, 0.888_888_888_888_889, 0.555_555_555_555_555_6],
         ),
         4 => (
             &[
@@ -176,10 +159,7 @@ fn gauss_legendre_01(n: usize) -> Result<(Vec<f64>, Vec<f64>), FemError> {
             )))
         }
     };
-    Ok((
-        x.iter().map(|t| 0.5 * (t + 1.0)).collect(),
-        w.iter().map(|t| 0.5 * t).collect(),
-    ))
+    Ok((x.iter().map(|t| 0.5 * (t + 1.0)).collect(), w.iter().map(|t| 0.5 * t).collect()))
 }
 
 #[cfg(test)]

@@ -12,8 +12,7 @@ use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
 use faer::sparse::linalg::cholesky::{
-    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky,
-    SymmetricOrdering,
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
 use faer::{Conj, MatMut, Par, Side};
 
@@ -78,18 +77,12 @@ impl CholeskySolver {
             ),
             Some(fwd) => {
                 if fwd.len() != n {
-                    return Err(FemError::Length {
-                        what: "ordering",
-                        expected: n,
-                        got: fwd.len(),
-                    });
+                    return Err(FemError::Length { what: "ordering", expected: n, got: fwd.len() });
                 }
                 let mut inv = vec![usize::MAX; n];
                 for (i, &p) in fwd.iter().enumerate() {
                     if p >= n || inv[p] != usize::MAX {
-                        return Err(FemError::InvalidParameter(
-                            "ordering is not a permutation".into(),
-                        ));
+                        return Err(FemError::InvalidParameter("ordering is not a permutation".into()));
                     }
                     inv[p] = i;
                 }
@@ -104,44 +97,27 @@ impl CholeskySolver {
         }
         .map_err(|e| FemError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
         let len = symbolic.len_val();
-        let info = CholeskyInfo {
-            symbolic_s: t0.elapsed().as_secs_f64(),
-            numeric_s: 0.0,
-            factor_nnz: len,
-        };
-        Ok(Self {
-            symbolic: Arc::new(symbolic),
-            factor: Vec::new(),
-            factorized: false,
-            info,
-        })
+        let info = CholeskyInfo { symbolic_s: t0.elapsed().as_secs_f64(), numeric_s: 0.0, factor_nnz: len };
+        Ok(Self { symbolic: Arc::new(symbolic), factor: Vec::new(), factorized: false, info })
     }
 
     /// Numeric factorisation of `a` (same pattern as analysed), reusing the symbolic analysis.
     pub fn factorize(&mut self, a: &SymmetricMatrix) -> Result<(), FemError> {
         let t0 = Instant::now();
         if a.n() != self.symbolic.nrows() {
-            return Err(FemError::Length {
-                what: "matrix",
-                expected: self.symbolic.nrows(),
-                got: a.n(),
-            });
+            return Err(FemError::Length { what: "matrix", expected: self.symbolic.nrows(), got: a.n() });
         }
         self.factorized = false;
         let len = self.symbolic.len_val();
         self.factor.clear();
-        self.factor.try_reserve_exact(len).map_err(|_| {
-            FemError::Sparse(format!(
-                "out of memory for a Cholesky factor of {len} entries"
-            ))
-        })?;
+        self.factor
+            .try_reserve_exact(len)
+            .map_err(|_| FemError::Sparse(format!("out of memory for a Cholesky factor of {len} entries")))?;
         self.factor.resize(len, 0.0);
         let par = faer::get_global_parallelism();
-        let req = self
-            .symbolic
-            .factorize_numeric_llt_scratch::<f64>(par, Default::default());
-        let mut mem = MemBuffer::try_new(req)
-            .map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;
+        let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        let mut mem =
+            MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;
         self.symbolic
             .factorize_numeric_llt::<f64>(
                 &mut self.factor,
@@ -171,9 +147,7 @@ impl CholeskySolver {
     /// Solves `A X = B` in place for several right-hand sides (columns of `b`).
     pub fn solve_many_in_place(&self, b: MatMut<'_, f64>) -> Result<(), FemError> {
         if !self.factorized {
-            return Err(FemError::Sparse(
-                "solve called before a successful factorisation".into(),
-            ));
+            return Err(FemError::Sparse("solve called before a successful factorisation".into()));
         }
         if b.nrows() != self.symbolic.nrows() {
             return Err(FemError::Length {
@@ -184,8 +158,8 @@ impl CholeskySolver {
         }
         let par = Par::Seq;
         let req = self.symbolic.solve_in_place_scratch::<f64>(b.ncols(), par);
-        let mut mem = MemBuffer::try_new(req)
-            .map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;
+        let mut mem =
+            MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;
         LltRef::new(&self.symbolic, &self.factor).solve_in_place_with_conj(
             Conj::No,
             b,
@@ -216,9 +190,7 @@ fn metis_order(
     adjacency: &[Vec<usize>],
 ) -> Result<Vec<usize>, FemError> {
     // keep only blocks with dofs
-    let live: Vec<usize> = (0..blocks.len())
-        .filter(|&k| !blocks[k].is_empty())
-        .collect();
+    let live: Vec<usize> = (0..blocks.len()).filter(|&k| !blocks[k].is_empty()).collect();
     let mut new_id = vec![usize::MAX; blocks.len()];
     for (i, &k) in live.iter().enumerate() {
         new_id[k] = i;
@@ -227,8 +199,7 @@ fn metis_order(
     if nv == 0 {
         return Ok(Vec::new());
     }
-    let too_big =
-        |_| FemError::InvalidParameter("graph too large for METIS' 32-bit indices".into());
+    let too_big = |_| FemError::InvalidParameter("graph too large for METIS' 32-bit indices".into());
     let mut xadj: Vec<i32> = Vec::with_capacity(nv + 1);
     let mut adjncy: Vec<i32> = Vec::new();
     xadj.push(0);
@@ -244,30 +215,18 @@ fn metis_order(
     let mut perm = vec![0i32; nv];
     let mut iperm = vec![0i32; nv];
     let mut options = [0i32; metis_sys::METIS_NOPTIONS as usize];
-    let status = metis_node_nd(
-        &mut nvtxs,
-        &mut xadj,
-        &mut adjncy,
-        &mut options,
-        &mut perm,
-        &mut iperm,
-    );
+    let status = metis_node_nd(&mut nvtxs, &mut xadj, &mut adjncy, &mut options, &mut perm, &mut iperm);
     if status != metis_sys::rstatus_et_METIS_OK {
-        return Err(FemError::Sparse(format!(
-            "METIS_NodeND failed with status {status}"
-        )));
+        return Err(FemError::Sparse(format!("METIS_NodeND failed with status {status}")));
     }
     let mut fwd = Vec::with_capacity(n);
     for &p in &perm {
-        let k = live[usize::try_from(p)
-            .map_err(|_| FemError::Sparse("METIS returned a negative index".into()))?];
+        let k = live
+            [usize::try_from(p).map_err(|_| FemError::Sparse("METIS returned a negative index".into()))?];
         fwd.extend(blocks[k].clone());
     }
     if fwd.len() != n {
-        return Err(FemError::Sparse(format!(
-            "block ranges cover {} of {n} dofs",
-            fwd.len()
-        )));
+        return Err(FemError::Sparse(format!("block ranges cover {} of {n} dofs", fwd.len())));
     }
     Ok(fwd)
 }
@@ -283,9 +242,7 @@ fn metis_node_nd(
     iperm: &mut [i32],
 ) -> i32 {
     debug_assert!(
-        xadj.len() == *nvtxs as usize + 1
-            && perm.len() == *nvtxs as usize
-            && iperm.len() == perm.len()
+        xadj.len() == *nvtxs as usize + 1 && perm.len() == *nvtxs as usize && iperm.len() == perm.len()
     );
     // SAFETY: `options` has METIS_NOPTIONS entries, as METIS_SetDefaultOptions requires.
     // METIS_NodeND reads `nvtxs` vertices from the CSR graph `xadj` (nvtxs + 1 entries, checked

@@ -31,10 +31,7 @@ impl SymmetricMatrix {
         }
         let nnz = row_idx.len();
         let pattern = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        Ok(Self {
-            pattern,
-            values: vec![0.0; nnz],
-        })
+        Ok(Self { pattern, values: vec![0.0; nnz] })
     }
 
     /// Dimension.
@@ -84,9 +81,7 @@ impl SymmetricMatrix {
                 self.values[p] += v;
                 Ok(())
             }
-            None => Err(FemError::Sparse(format!(
-                "entry ({r}, {c}) is outside the pattern"
-            ))),
+            None => Err(FemError::Sparse(format!("entry ({r}, {c}) is outside the pattern"))),
         }
     }
 
@@ -109,9 +104,7 @@ impl SymmetricMatrix {
         for j in 0..self.n() {
             let xj = x[j];
             let mut acc = 0.0;
-            for p in cp[j]..cp[j + 1] {
-                let i = ri[p];
-                let a = self.values[p];
+            for (&i, &a) in ri[cp[j]..cp[j + 1]].iter().zip(&self.values[cp[j]..cp[j + 1]]) {
                 if i == j {
                     acc += a * xj;
                 } else {
@@ -148,10 +141,10 @@ impl SymmetricMatrix {
         let cp = self.pattern.col_ptr();
         let ri = self.pattern.row_idx();
         for j in 0..n {
-            for p in cp[j]..cp[j + 1] {
-                tri.add_triplet(ri[p], j, self.values[p]);
-                if ri[p] != j {
-                    tri.add_triplet(j, ri[p], self.values[p]);
+            for (&i, &v) in ri[cp[j]..cp[j + 1]].iter().zip(&self.values[cp[j]..cp[j + 1]]) {
+                tri.add_triplet(i, j, v);
+                if i != j {
+                    tri.add_triplet(j, i, v);
                 }
             }
         }
@@ -162,11 +155,7 @@ impl SymmetricMatrix {
     /// must be symmetric. Errors on a non-square matrix.
     pub fn from_sprs(m: &sprs::CsMat<f64>) -> Result<Self, FemError> {
         if m.rows() != m.cols() {
-            return Err(FemError::Sparse(format!(
-                "matrix is {}×{}, not square",
-                m.rows(),
-                m.cols()
-            )));
+            return Err(FemError::Sparse(format!("matrix is {}×{}, not square", m.rows(), m.cols())));
         }
         let n = m.rows();
         let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];

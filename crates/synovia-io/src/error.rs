@@ -110,15 +110,9 @@ pub enum IoError {
 
 impl IoError {
     pub(crate) fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
-        IoError::Io {
-            path: path.into(),
-            source,
-        }
+        IoError::Io { path: path.into(), source }
     }
     pub(crate) fn parse(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
-        IoError::Parse {
-            path: path.into(),
-            message: message.into(),
-        }
+        IoError::Parse { path: path.into(), message: message.into() }
     }
 }

@@ -38,12 +38,7 @@ impl Field {
         components: usize,
         values: Vec<f64>,
     ) -> Self {
-        Self {
-            name: name.into(),
-            location,
-            components,
-            values,
-        }
+        Self { name: name.into(), location, components, values }
     }
 
     /// A scalar field on the points (one value per node).
@@ -94,16 +89,8 @@ impl Field {
         if self.components != 2 {
             return self;
         }
-        let values = self
-            .values
-            .chunks_exact(2)
-            .flat_map(|c| [c[0], c[1], 0.0])
-            .collect();
-        Field {
-            values,
-            components: 3,
-            ..self
-        }
+        let values = self.values.chunks_exact(2).flat_map(|c| [c[0], c[1], 0.0]).collect();
+        Field { values, components: 3, ..self }
     }
 }
 

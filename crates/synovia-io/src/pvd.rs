@@ -36,10 +36,7 @@ pub struct PvdWriter {
 impl PvdWriter {
     /// An empty collection that [`PvdWriter::write`] will write to `path`.
     pub fn new(path: impl Into<PathBuf>) -> Self {
-        Self {
-            path: path.into(),
-            entries: Vec::new(),
-        }
+        Self { path: path.into(), entries: Vec::new() }
     }
 
     /// Where the collection is written.
@@ -76,10 +73,7 @@ impl PvdWriter {
         vtu_file: impl AsRef<Path>,
     ) -> Result<&mut Self, IoError> {
         if !time.is_finite() {
-            return Err(IoError::NonFinite {
-                name: "timestep".into(),
-                index: self.entries.len(),
-            });
+            return Err(IoError::NonFinite { name: "timestep".into(), index: self.entries.len() });
         }
         let file = vtu_file.as_ref();
         utf8_path(file)?;
@@ -87,11 +81,7 @@ impl PvdWriter {
             Some(dir) if !dir.as_os_str().is_empty() => file.strip_prefix(dir).unwrap_or(file),
             _ => file,
         };
-        self.entries.push(PvdEntry {
-            time,
-            part,
-            file: file.to_path_buf(),
-        });
+        self.entries.push(PvdEntry { time, part, file: file.to_path_buf() });
         Ok(self)
     }
 
@@ -110,10 +100,7 @@ impl PvdWriter {
     /// Whatever the sink returns.
     pub fn write_to<W: Write>(&self, mut w: W) -> io::Result<()> {
         writeln!(w, r#"<?xml version="1.0"?>"#)?;
-        writeln!(
-            w,
-            r#"<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">"#
-        )?;
+        writeln!(w, r#"<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">"#)?;
         writeln!(w, "  <Collection>")?;
         for e in &self.entries {
             // Paths were checked to be UTF-8 in `add_part`.
@@ -211,11 +198,7 @@ fn parse_pvd(xml: &str) -> Result<Vec<PvdEntry>, String> {
                     .get("file")
                     .filter(|f| !f.is_empty())
                     .ok_or_else(|| format!("<DataSet> at byte {position} has no file"))?;
-                entries.push(PvdEntry {
-                    time,
-                    part,
-                    file: PathBuf::from(file),
-                });
+                entries.push(PvdEntry { time, part, file: PathBuf::from(file) });
             }
             _ => {}
         }
@@ -251,10 +234,8 @@ impl TimeSeriesWriter {
     /// [`IoError::InvalidName`] when `name` is empty, `.`/`..`, or contains a path separator
     /// or control character; [`IoError::Io`] when the directory cannot be created.
     pub fn new(dir: impl Into<PathBuf>, name: &str, encoding: Encoding) -> Result<Self, IoError> {
-        let invalid = |reason: &str| IoError::InvalidName {
-            name: name.to_string(),
-            reason: reason.to_string(),
-        };
+        let invalid =
+            |reason: &str| IoError::InvalidName { name: name.to_string(), reason: reason.to_string() };
         if name.is_empty() || name == "." || name == ".." {
             return Err(invalid("not a usable file-name stem"));
         }
@@ -265,12 +246,7 @@ impl TimeSeriesWriter {
         std::fs::create_dir_all(&dir).map_err(|e| IoError::io(&dir, e))?;
         utf8_path(&dir)?;
         let pvd = PvdWriter::new(dir.join(format!("{name}.pvd")));
-        Ok(Self {
-            dir,
-            name: name.to_string(),
-            encoding,
-            pvd,
-        })
+        Ok(Self { dir, name: name.to_string(), encoding, pvd })
     }
 
     /// Path of the `.pvd` collection.
@@ -292,19 +268,14 @@ impl TimeSeriesWriter {
     /// is then unchanged).
     pub fn write_step(&mut self, time: f64, vtu: &VtuWriter) -> Result<PathBuf, IoError> {
         if !time.is_finite() {
-            return Err(IoError::NonFinite {
-                name: "timestep".into(),
-                index: self.n_steps(),
-            });
+            return Err(IoError::NonFinite { name: "timestep".into(), index: self.n_steps() });
         }
         if let Some(previous) = self.pvd.entries().last().map(|e| e.time) {
             if time <= previous {
                 return Err(IoError::TimeNotIncreasing { previous, time });
             }
         }
-        let file = self
-            .dir
-            .join(format!("{}_{:04}.vtu", self.name, self.n_steps()));
+        let file = self.dir.join(format!("{}_{:04}.vtu", self.name, self.n_steps()));
         vtu.write(&file)?;
         let mut pvd = self.pvd.clone();
         pvd.add(time, &file)?;

@@ -79,11 +79,7 @@ impl VtuPiece {
     pub fn to_mesh<const D: usize>(&self) -> Result<Mesh<D>, IoError> {
         let expected = if D == 2 { VTK_TRIANGLE } else { VTK_TETRA };
         if let Some((cell, &found)) = self.types.iter().enumerate().find(|(_, &t)| t != expected) {
-            return Err(IoError::CellType {
-                cell,
-                expected,
-                found,
-            });
+            return Err(IoError::CellType { cell, expected, found });
         }
         let nodes = self
             .points
@@ -165,10 +161,7 @@ fn parse_vtu_document(xml: &str) -> Result<VtuData, String> {
     let mut reader = Reader::from_str(xml);
     let mut p = Parser {
         stack: Vec::new(),
-        header: Header {
-            big_endian: false,
-            header_bytes: 4,
-        },
+        header: Header { big_endian: false, header_bytes: 4 },
         pieces: Vec::new(),
         piece: None,
         array: None,
@@ -204,24 +197,18 @@ fn parse_vtu_document(xml: &str) -> Result<VtuData, String> {
             }
             Event::Text(t) => {
                 if let Some(a) = &mut p.array {
-                    let text = t
-                        .decode()
-                        .map_err(|e| format!("bad text at byte {position}: {e}"))?;
+                    let text = t.decode().map_err(|e| format!("bad text at byte {position}: {e}"))?;
                     a.text.push_str(&text);
                 }
             }
             Event::CData(t) => {
                 if let Some(a) = &mut p.array {
-                    let text = t
-                        .decode()
-                        .map_err(|e| format!("bad CDATA at byte {position}: {e}"))?;
+                    let text = t.decode().map_err(|e| format!("bad CDATA at byte {position}: {e}"))?;
                     a.text.push_str(&text);
                 }
             }
             Event::GeneralRef(_) if p.array.is_some() => {
-                return Err(format!(
-                    "unexpected entity reference inside a DataArray at byte {position}"
-                ));
+                return Err(format!("unexpected entity reference inside a DataArray at byte {position}"));
             }
             Event::Eof => {
                 return Err(match p.stack.last() {
@@ -238,20 +225,13 @@ fn parse_vtu_document(xml: &str) -> Result<VtuData, String> {
 }
 
 impl Parser {
-    fn open(
-        &mut self,
-        name: &str,
-        attrs: HashMap<String, String>,
-        position: u64,
-    ) -> Result<(), String> {
+    fn open(&mut self, name: &str, attrs: HashMap<String, String>, position: u64) -> Result<(), String> {
         let parent = self.stack.last().map(String::as_str);
         let expect_parent = |want: &str| {
             if parent == Some(want) {
                 Ok(())
             } else {
-                Err(format!(
-                    "<{name}> at byte {position} is not inside <{want}>"
-                ))
+                Err(format!("<{name}> at byte {position} is not inside <{want}>"))
             }
         };
         match (parent, name) {
@@ -283,12 +263,9 @@ impl Parser {
             (_, "Piece") => {
                 expect_parent("UnstructuredGrid")?;
                 let count = |key: &str| -> Result<usize, String> {
-                    let v = attrs
-                        .get(key)
-                        .ok_or_else(|| format!("<Piece> at byte {position} lacks {key}"))?;
-                    v.trim()
-                        .parse()
-                        .map_err(|_| format!("<Piece> at byte {position}: bad {key}=\"{v}\""))
+                    let v =
+                        attrs.get(key).ok_or_else(|| format!("<Piece> at byte {position} lacks {key}"))?;
+                    v.trim().parse().map_err(|_| format!("<Piece> at byte {position}: bad {key}=\"{v}\""))
                 };
                 self.piece = Some(PieceBuilder {
                     n_points: count("NumberOfPoints")?,
@@ -311,12 +288,7 @@ impl Parser {
                     Some("Cells") => Section::Cells,
                     _ => Section::Ignored,
                 };
-                self.array = Some(RawArray {
-                    section,
-                    attrs,
-                    text: String::new(),
-                    position,
-                });
+                self.array = Some(RawArray { section, attrs, text: String::new(), position });
             }
             _ => {}
         }
@@ -337,8 +309,8 @@ impl Parser {
             "Piece" => {
                 if let Some(builder) = self.piece.take() {
                     let index = self.pieces.len();
-                    let piece = finish_piece(builder, self.header)
-                        .map_err(|m| format!("piece {index}: {m}"))?;
+                    let piece =
+                        finish_piece(builder, self.header).map_err(|m| format!("piece {index}: {m}"))?;
                     self.pieces.push(piece);
                 }
             }
@@ -355,8 +327,8 @@ fn finish_piece(b: PieceBuilder, header: Header) -> Result<VtuPiece, String> {
     let (mut connectivity, mut offsets, mut types) = (None, None, None);
     for a in &b.arrays {
         let components = components_of(a)?;
-        let values = decode(a, header)
-            .map_err(|m| format!("DataArray `{}` at byte {}: {m}", a.name(), a.position))?;
+        let values =
+            decode(a, header).map_err(|m| format!("DataArray `{}` at byte {}: {m}", a.name(), a.position))?;
         let count_err = |want: usize| {
             format!(
                 "DataArray `{}` at byte {} has {} values, expected {want}",
@@ -374,9 +346,7 @@ fn finish_piece(b: PieceBuilder, header: Header) -> Result<VtuPiece, String> {
                 points = Some(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect());
             }
             Section::Cells => {
-                let idx = values
-                    .to_indices()
-                    .map_err(|m| format!("DataArray `{}`: {m}", a.name()))?;
+                let idx = values.to_indices().map_err(|m| format!("DataArray `{}`: {m}", a.name()))?;
                 match a.name() {
                     "connectivity" => connectivity = Some(idx),
                     "offsets" if idx.len() == nc => offsets = Some(idx),
@@ -416,9 +386,7 @@ fn finish_piece(b: PieceBuilder, header: Header) -> Result<VtuPiece, String> {
     let mut start = 0;
     for (c, (&end, &ty)) in piece.offsets.iter().zip(&piece.types).enumerate() {
         if end < start || end > piece.connectivity.len() {
-            return Err(format!(
-                "cell {c}: offset {end} out of order or past the connectivity"
-            ));
+            return Err(format!("cell {c}: offset {end} out of order or past the connectivity"));
         }
         let want = match ty {
             VTK_TRIANGLE => Some(3),
@@ -437,9 +405,7 @@ fn finish_piece(b: PieceBuilder, header: Header) -> Result<VtuPiece, String> {
         ));
     }
     if let Some(&bad) = piece.connectivity.iter().find(|&&i| i >= np) {
-        return Err(format!(
-            "connectivity refers to point {bad}, but there are {np} points"
-        ));
+        return Err(format!("connectivity refers to point {bad}, but there are {np} points"));
     }
     Ok(piece)
 }
@@ -481,20 +447,15 @@ impl Values {
     fn to_indices(&self) -> Result<Vec<usize>, String> {
         match self {
             Values::Float(_) => Err("expected an integer type".into()),
-            Values::Int(v) => v
-                .iter()
-                .map(|&i| usize::try_from(i).map_err(|_| format!("negative index {i}")))
-                .collect(),
+            Values::Int(v) => {
+                v.iter().map(|&i| usize::try_from(i).map_err(|_| format!("negative index {i}"))).collect()
+            }
         }
     }
 }
 
 fn decode(a: &RawArray, header: Header) -> Result<Values, String> {
-    let ty = a
-        .attrs
-        .get("type")
-        .map(String::as_str)
-        .ok_or("no type attribute")?;
+    let ty = a.attrs.get("type").map(String::as_str).ok_or("no type attribute")?;
     let is_float = match ty {
         "Float32" | "Float64" => true,
         "Int8" | "UInt8" | "Int16" | "UInt16" | "Int32" | "UInt32" | "Int64" | "UInt64" => false,
@@ -504,14 +465,12 @@ fn decode(a: &RawArray, header: Header) -> Result<Values, String> {
         Some("ascii") => {
             let tokens = a.text.split_ascii_whitespace();
             if is_float {
-                let v: Result<Vec<f64>, _> = tokens
-                    .map(|t| t.parse::<f64>().map_err(|_| format!("bad number {t:?}")))
-                    .collect();
+                let v: Result<Vec<f64>, _> =
+                    tokens.map(|t| t.parse::<f64>().map_err(|_| format!("bad number {t:?}"))).collect();
                 Ok(Values::Float(v?))
             } else {
-                let v: Result<Vec<i64>, _> = tokens
-                    .map(|t| t.parse::<i64>().map_err(|_| format!("bad integer {t:?}")))
-                    .collect();
+                let v: Result<Vec<i64>, _> =
+                    tokens.map(|t| t.parse::<i64>().map_err(|_| format!("bad integer {t:?}"))).collect();
                 Ok(Values::Int(v?))
             }
         }
@@ -537,9 +496,8 @@ fn decode_base64(text: &str, header: Header) -> Result<Vec<u8>, String> {
         Err(first_error) => {
             // Some VTK writers encode the header and the data as two base64 blocks.
             let split = 4 * hb.div_ceil(3);
-            let (h, d) = compact
-                .split_at_checked(split)
-                .ok_or_else(|| format!("invalid base64: {first_error}"))?;
+            let (h, d) =
+                compact.split_at_checked(split).ok_or_else(|| format!("invalid base64: {first_error}"))?;
             match (STANDARD.decode(h), STANDARD.decode(d)) {
                 (Ok(h), Ok(d)) if h.len() == hb => (h, d),
                 _ => return Err(format!("invalid base64: {first_error}")),
@@ -557,11 +515,7 @@ fn decode_base64(text: &str, header: Header) -> Result<Vec<u8>, String> {
         }
         (4, Some(h)) => {
             let a: [u8; 4] = h.try_into().map_err(|_| "bad header")?;
-            u64::from(if header.big_endian {
-                u32::from_be_bytes(a)
-            } else {
-                u32::from_le_bytes(a)
-            })
+            u64::from(if header.big_endian { u32::from_be_bytes(a) } else { u32::from_le_bytes(a) })
         }
         _ => return Err("bad binary header".into()),
     };
@@ -581,21 +535,14 @@ fn binary_values(bytes: &[u8], ty: &str, big: bool) -> Result<Values, String> {
         ($t:ty, $conv:expr) => {{
             const N: usize = std::mem::size_of::<$t>();
             if !bytes.chunks_exact(N).remainder().is_empty() {
-                return Err(format!(
-                    "{} bytes is not a whole number of {ty}",
-                    bytes.len()
-                ));
+                return Err(format!("{} bytes is not a whole number of {ty}", bytes.len()));
             }
             bytes
                 .chunks_exact(N)
                 .map(|c| {
                     let mut a = [0u8; N];
                     a.copy_from_slice(c);
-                    let v = if big {
-                        <$t>::from_be_bytes(a)
-                    } else {
-                        <$t>::from_le_bytes(a)
-                    };
+                    let v = if big { <$t>::from_be_bytes(a) } else { <$t>::from_le_bytes(a) };
                     $conv(v)
                 })
                 .collect::<Result<Vec<_>, String>>()?

@@ -49,10 +49,8 @@ pub(crate) fn attributes(e: &BytesStart<'_>) -> Result<HashMap<String, String>, 
     for a in e.attributes() {
         let a = a.map_err(|err| format!("bad attribute: {err}"))?;
         let key = String::from_utf8_lossy(a.key.as_ref()).into_owned();
-        let value = a
-            .unescape_value()
-            .map_err(|err| format!("bad value of attribute `{key}`: {err}"))?
-            .into_owned();
+        let value =
+            a.unescape_value().map_err(|err| format!("bad value of attribute `{key}`: {err}"))?.into_owned();
         out.insert(key, value);
     }
     Ok(out)
@@ -65,7 +63,5 @@ pub(crate) fn element_name(e: &BytesStart<'_>) -> String {
 
 /// The path as UTF-8, or [`IoError::NonUtf8Path`].
 pub(crate) fn utf8_path(path: &Path) -> Result<&str, IoError> {
-    path.to_str().ok_or_else(|| IoError::NonUtf8Path {
-        path: path.to_path_buf(),
-    })
+    path.to_str().ok_or_else(|| IoError::NonUtf8Path { path: path.to_path_buf() })
 }

@@ -56,10 +56,7 @@ impl Piece {
         self.points.len() / 3
     }
     fn n_cells(&self) -> usize {
-        self.connectivity
-            .len()
-            .checked_div(self.nodes_per_cell)
-            .unwrap_or(0)
+        self.connectivity.len().checked_div(self.nodes_per_cell).unwrap_or(0)
     }
 }
 
@@ -79,10 +76,7 @@ pub struct VtuWriter {
 impl VtuWriter {
     /// An empty writer using `encoding` for every data array.
     pub fn new(encoding: Encoding) -> Self {
-        Self {
-            encoding,
-            pieces: Vec::new(),
-        }
+        Self { encoding, pieces: Vec::new() }
     }
 
     /// The encoding of the data arrays.
@@ -146,14 +140,7 @@ impl VtuWriter {
                 reason: format!("node index {i} does not fit in Int64"),
             })?);
         }
-        let piece = Piece {
-            points,
-            connectivity,
-            nodes_per_cell: D + 1,
-            cell_type,
-            point_data,
-            cell_data,
-        };
+        let piece = Piece { points, connectivity, nodes_per_cell: D + 1, cell_type, point_data, cell_data };
         if self.encoding == Encoding::Base64 {
             check_sizes(&piece)?;
         }
@@ -199,10 +186,7 @@ impl VtuWriter {
 
     fn write_piece<W: Write>(&self, w: &mut W, body: usize, piece: &Piece) -> io::Result<()> {
         let (n_points, n_cells) = (piece.n_points(), piece.n_cells());
-        writeln!(
-            w,
-            r#"    <Piece NumberOfPoints="{n_points}" NumberOfCells="{n_cells}">"#
-        )?;
+        writeln!(w, r#"    <Piece NumberOfPoints="{n_points}" NumberOfCells="{n_cells}">"#)?;
         writeln!(w, "      <PointData>")?;
         for f in &piece.point_data {
             self.write_array(w, Some(&f.name), f.components, &f.values)?;
@@ -220,9 +204,8 @@ impl VtuWriter {
         writeln!(w, "      </Points>")?;
         writeln!(w, "      <Cells>")?;
         self.write_array(w, Some("connectivity"), 1, &piece.connectivity)?;
-        let offsets: Vec<i64> = (1..=n_cells)
-            .map(|c| i64::try_from(c * piece.nodes_per_cell).unwrap_or(i64::MAX))
-            .collect();
+        let offsets: Vec<i64> =
+            (1..=n_cells).map(|c| i64::try_from(c * piece.nodes_per_cell).unwrap_or(i64::MAX)).collect();
         self.write_array(w, Some("offsets"), 1, &offsets)?;
         self.write_array(w, Some("types"), 1, &vec![piece.cell_type; n_cells])?;
         writeln!(w, "      </Cells>")?;
@@ -296,10 +279,8 @@ pub fn write_vtu<const D: usize>(
 }
 
 fn validate_field(field: &Field, n_entities: usize, earlier: &[Field]) -> Result<(), IoError> {
-    let invalid = |reason: &str| IoError::InvalidField {
-        name: field.name.clone(),
-        reason: reason.to_string(),
-    };
+    let invalid =
+        |reason: &str| IoError::InvalidField { name: field.name.clone(), reason: reason.to_string() };
     if field.name.is_empty() {
         return Err(invalid("the name is empty"));
     }
@@ -307,9 +288,7 @@ fn validate_field(field: &Field, n_entities: usize, earlier: &[Field]) -> Result
         return Err(invalid("the name contains control characters"));
     }
     if field.location == FieldLocation::Cell && field.name == BODY_FIELD {
-        return Err(invalid(
-            "`body` is reserved: the writer adds the piece index as cell field `body`",
-        ));
+        return Err(invalid("`body` is reserved: the writer adds the piece index as cell field `body`"));
     }
     if earlier.iter().any(|f| f.name == field.name) {
         return Err(invalid("another field at the same location has this name"));
@@ -319,27 +298,16 @@ fn validate_field(field: &Field, n_entities: usize, earlier: &[Field]) -> Result
     }
     let expected = field.components.saturating_mul(n_entities);
     if field.values.len() != expected {
-        return Err(IoError::FieldLength {
-            name: field.name.clone(),
-            expected,
-            got: field.values.len(),
-        });
+        return Err(IoError::FieldLength { name: field.name.clone(), expected, got: field.values.len() });
     }
     if let Some(index) = field.values.iter().position(|v| !v.is_finite()) {
-        return Err(IoError::NonFinite {
-            name: field.name.clone(),
-            index,
-        });
+        return Err(IoError::NonFinite { name: field.name.clone(), index });
     }
     Ok(())
 }
 
 /// Orders `fields` like `reference` (the first piece's), failing when the sets differ.
-fn match_fields(
-    piece: usize,
-    reference: &[Field],
-    mut fields: Vec<Field>,
-) -> Result<Vec<Field>, IoError> {
+fn match_fields(piece: usize, reference: &[Field], mut fields: Vec<Field>) -> Result<Vec<Field>, IoError> {
     let mismatch = |reason: String| IoError::InconsistentPieces { piece, reason };
     let mut ordered = Vec::with_capacity(reference.len());
     for r in reference {
@@ -357,10 +325,7 @@ fn match_fields(
         ordered.push(f);
     }
     if let Some(extra) = fields.first() {
-        return Err(mismatch(format!(
-            "{:?} field `{}` is not in piece 0",
-            extra.location, extra.name
-        )));
+        return Err(mismatch(format!("{:?} field `{}` is not in piece 0", extra.location, extra.name)));
     }
     Ok(ordered)
 }
@@ -368,10 +333,7 @@ fn match_fields(
 fn check_sizes(piece: &Piece) -> Result<(), IoError> {
     let check = |name: &str, bytes: usize| {
         if u32::try_from(bytes).is_err() {
-            Err(IoError::ArrayTooLarge {
-                name: name.to_string(),
-                bytes,
-            })
+            Err(IoError::ArrayTooLarge { name: name.to_string(), bytes })
         } else {
             Ok(())
         }

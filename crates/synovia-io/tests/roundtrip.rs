@@ -44,14 +44,7 @@ fn kuhn_cube() -> Mesh<3> {
         .map(|k| Point::<3>::new((k & 1) as f64, ((k >> 1) & 1) as f64, ((k >> 2) & 1) as f64))
         .collect();
     let mut cells = Vec::new();
-    for perm in [
-        [0, 1, 2],
-        [0, 2, 1],
-        [1, 0, 2],
-        [1, 2, 0],
-        [2, 0, 1],
-        [2, 1, 0],
-    ] {
+    for perm in [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]] {
         let mut v = 0usize;
         cells.push(v);
         for axis in perm {
@@ -86,11 +79,7 @@ fn tricky(i: usize) -> f64 {
 fn assert_bits_eq(name: &str, got: &[f64], want: &[f64]) {
     assert_eq!(got.len(), want.len(), "{name}: length");
     for (k, (g, w)) in got.iter().zip(want).enumerate() {
-        assert_eq!(
-            g.to_bits(),
-            w.to_bits(),
-            "{name}[{k}]: got {g:e}, want {w:e}"
-        );
+        assert_eq!(g.to_bits(), w.to_bits(), "{name}[{k}]: got {g:e}, want {w:e}");
     }
 }
 
@@ -124,23 +113,16 @@ fn assert_geometry<const D: usize>(piece: &VtuPiece, mesh: &Mesh<D>, cell_type: 
 }
 
 fn fields_2d(mesh: &Mesh<2>) -> Vec<Field> {
-    let u: Vec<Vector<2>> = (0..mesh.n_nodes())
-        .map(|i| Vector::<2>::new(tricky(2 * i), tricky(2 * i + 1)))
-        .collect();
+    let u: Vec<Vector<2>> =
+        (0..mesh.n_nodes()).map(|i| Vector::<2>::new(tricky(2 * i), tricky(2 * i + 1))).collect();
     let stress: Vec<Tensor<2>> = (0..mesh.n_cells())
         .map(|c| Tensor::<2>::new(tricky(c), tricky(c + 3), tricky(c + 3), tricky(c + 11)))
         .collect();
     vec![
         Field::point_vectors("displacement", &u),
-        Field::point_scalars(
-            "temperature",
-            (0..mesh.n_nodes()).map(|i| tricky(i + 5)).collect(),
-        ),
+        Field::point_scalars("temperature", (0..mesh.n_nodes()).map(|i| tricky(i + 5)).collect()),
         Field::cell_tensors("stress", &stress),
-        Field::cell_scalars(
-            "a<b & \"c\"",
-            (0..mesh.n_cells()).map(|c| c as f64).collect(),
-        ),
+        Field::cell_scalars("a<b & \"c\"", (0..mesh.n_cells()).map(|c| c as f64).collect()),
     ]
 }
 
@@ -148,15 +130,11 @@ fn fields_3d(mesh: &Mesh<3>) -> Vec<Field> {
     let u: Vec<Vector<3>> = (0..mesh.n_nodes())
         .map(|i| Vector::<3>::new(tricky(3 * i), tricky(3 * i + 1), tricky(3 * i + 2)))
         .collect();
-    let stress: Vec<Tensor<3>> = (0..mesh.n_cells())
-        .map(|c| Tensor::<3>::from_fn(|i, j| tricky(9 * c + 3 * i + j)))
-        .collect();
+    let stress: Vec<Tensor<3>> =
+        (0..mesh.n_cells()).map(|c| Tensor::<3>::from_fn(|i, j| tricky(9 * c + 3 * i + j))).collect();
     vec![
         Field::point_vectors("displacement", &u),
-        Field::point_scalars(
-            "pressure",
-            (0..mesh.n_nodes()).map(|i| tricky(i + 2)).collect(),
-        ),
+        Field::point_scalars("pressure", (0..mesh.n_nodes()).map(|i| tricky(i + 2)).collect()),
         Field::cell_tensors("stress", &stress),
     ]
 }
@@ -168,9 +146,7 @@ fn roundtrip_2d_both_encodings() -> TestResult {
     let fields = fields_2d(&mesh);
     for encoding in [Encoding::Ascii, Encoding::Base64] {
         let path = dir.join(format!("grid_{encoding:?}.vtu"));
-        VtuWriter::new(encoding)
-            .add_piece(&mesh, fields.clone())?
-            .write(&path)?;
+        VtuWriter::new(encoding).add_piece(&mesh, fields.clone())?.write(&path)?;
         let data = read_vtu(&path)?;
         assert_eq!(data.pieces.len(), 1);
         let piece = &data.pieces[0];
@@ -182,19 +158,13 @@ fn roundtrip_2d_both_encodings() -> TestResult {
         let stress = piece.cell_field("stress").ok_or("stress")?;
         assert_eq!(stress.tuple(0).ok_or("tuple")?[2], 0.0);
         assert_eq!(stress.tuple(0).ok_or("tuple")?[8], 0.0);
-        assert_eq!(
-            stress.tuple(0).ok_or("tuple")?[1].to_bits(),
-            tricky(3).to_bits()
-        );
+        assert_eq!(stress.tuple(0).ok_or("tuple")?[1].to_bits(), tricky(3).to_bits());
         let body = piece.cell_field(BODY_FIELD).ok_or("body")?;
         assert_eq!(body.values, vec![0.0; mesh.n_cells()]);
         assert_eq!(piece.point_data.len(), 2);
         assert_eq!(piece.cell_data.len(), 3);
         assert_eq!(piece.to_mesh::<2>()?, mesh);
-        assert!(matches!(
-            piece.to_mesh::<3>(),
-            Err(IoError::CellType { cell: 0, .. })
-        ));
+        assert!(matches!(piece.to_mesh::<3>(), Err(IoError::CellType { cell: 0, .. })));
         let text = std::fs::read_to_string(&path)?;
         assert!(text.contains(match encoding {
             Encoding::Ascii => r#"format="ascii""#,
@@ -213,9 +183,7 @@ fn roundtrip_3d_both_encodings() -> TestResult {
     let fields = fields_3d(&mesh);
     for encoding in [Encoding::Ascii, Encoding::Base64] {
         let path = dir.join(format!("cube_{encoding:?}.vtu"));
-        VtuWriter::new(encoding)
-            .add_piece(&mesh, fields.clone())?
-            .write(&path)?;
+        VtuWriter::new(encoding).add_piece(&mesh, fields.clone())?.write(&path)?;
         let piece = &read_vtu(&path)?.pieces[0];
         assert_geometry(piece, &mesh, VTK_TETRA);
         for f in &fields {
@@ -226,9 +194,7 @@ fn roundtrip_3d_both_encodings() -> TestResult {
     // The convenience writer produces the same document as an explicit base64 writer.
     let path = dir.join("convenience.vtu");
     write_vtu(&path, &mesh, &fields)?;
-    let explicit = VtuWriter::new(Encoding::Base64)
-        .add_piece(&mesh, fields.clone())?
-        .to_xml_string();
+    let explicit = VtuWriter::new(Encoding::Base64).add_piece(&mesh, fields.clone())?.to_xml_string();
     assert_eq!(std::fs::read_to_string(&path)?, explicit);
     assert_eq!(parse_vtu(&explicit)?, read_vtu(&path)?);
     let _ = std::fs::remove_dir_all(&dir);
@@ -239,10 +205,7 @@ fn roundtrip_3d_both_encodings() -> TestResult {
 fn ascii_uses_shortest_round_trip_numbers() -> TestResult {
     let mesh = grid_2d(1);
     let xml = VtuWriter::new(Encoding::Ascii)
-        .add_piece(
-            &mesh,
-            vec![Field::point_scalars("s", vec![0.1, 1.0, -2.5e-7, 3.0])],
-        )?
+        .add_piece(&mesh, vec![Field::point_scalars("s", vec![0.1, 1.0, -2.5e-7, 3.0])])?
         .to_xml_string();
     assert!(xml.contains(" 1e-1 1e0 -2.5e-7 3e0"), "{xml}");
     Ok(())
@@ -255,15 +218,9 @@ fn two_component_fields_are_padded() -> TestResult {
     let xml = VtuWriter::new(Encoding::Base64)
         .add_piece(&mesh, vec![Field::new("v", FieldLocation::Point, 2, v)])?
         .to_xml_string();
-    let f = parse_vtu(&xml)?.pieces[0]
-        .point_field("v")
-        .cloned()
-        .ok_or("v")?;
+    let f = parse_vtu(&xml)?.pieces[0].point_field("v").cloned().ok_or("v")?;
     assert_eq!(f.components, 3);
-    assert_eq!(
-        f.values,
-        vec![1.0, 2.0, 0.0, 3.0, 4.0, 0.0, 5.0, 6.0, 0.0, 7.0, 8.0, 0.0]
-    );
+    assert_eq!(f.values, vec![1.0, 2.0, 0.0, 3.0, 4.0, 0.0, 5.0, 6.0, 0.0, 7.0, 8.0, 0.0]);
     Ok(())
 }
 
@@ -273,32 +230,18 @@ fn two_pieces_in_one_file() -> TestResult {
     let square = grid_2d(2);
     let cube = kuhn_cube();
     let square_fields = vec![
-        Field::point_vectors(
-            "u",
-            &square
-                .nodes()
-                .iter()
-                .map(|x| x * 0.5)
-                .collect::<Vec<Vector<2>>>(),
-        ),
-        Field::cell_scalars(
-            "p",
-            (0..square.n_cells()).map(|c| c as f64 + 0.25).collect(),
-        ),
+        Field::point_vectors("u", &square.nodes().iter().map(|x| x * 0.5).collect::<Vec<Vector<2>>>()),
+        Field::cell_scalars("p", (0..square.n_cells()).map(|c| c as f64 + 0.25).collect()),
     ];
     // Same fields, other order: the writer reorders them like the first piece.
     let cube_fields = vec![
         Field::cell_scalars("p", (0..cube.n_cells()).map(|c| -(c as f64)).collect()),
-        Field::point_vectors(
-            "u",
-            &cube.nodes().iter().map(|x| x * 2.0).collect::<Vec<_>>(),
-        ),
+        Field::point_vectors("u", &cube.nodes().iter().map(|x| x * 2.0).collect::<Vec<_>>()),
     ];
     for encoding in [Encoding::Ascii, Encoding::Base64] {
         let path = dir.join("two.vtu");
         let mut w = VtuWriter::new(encoding);
-        w.add_piece(&square, square_fields.clone())?
-            .add_piece(&cube, cube_fields.clone())?;
+        w.add_piece(&square, square_fields.clone())?.add_piece(&cube, cube_fields.clone())?;
         assert_eq!(w.n_pieces(), 2);
         w.write(&path)?;
         let data = read_vtu(&path)?;
@@ -330,16 +273,10 @@ fn pieces_must_carry_the_same_fields() -> TestResult {
     w.add_piece(&square, vec![scalars("a")])?;
     for fields in [vec![], vec![scalars("b")], vec![scalars("a"), scalars("b")]] {
         let err = w.add_piece(&square, fields).err().ok_or("accepted")?;
-        assert!(
-            matches!(err, IoError::InconsistentPieces { piece: 1, .. }),
-            "{err}"
-        );
+        assert!(matches!(err, IoError::InconsistentPieces { piece: 1, .. }), "{err}");
     }
     let err = w
-        .add_piece(
-            &square,
-            vec![Field::new("a", FieldLocation::Point, 3, vec![0.0; 12])],
-        )
+        .add_piece(&square, vec![Field::new("a", FieldLocation::Point, 3, vec![0.0; 12])])
         .err()
         .ok_or("accepted")?;
     assert!(matches!(err, IoError::InconsistentPieces { .. }), "{err}");
@@ -355,9 +292,7 @@ fn time_series_with_pvd() -> TestResult {
     let mut series = TimeSeriesWriter::new(dir.join("out"), "knee", Encoding::Base64)?;
     let mut written = Vec::new();
     for (k, &t) in times.iter().enumerate() {
-        let s: Vec<f64> = (0..mesh.n_nodes())
-            .map(|i| t * i as f64 + k as f64)
-            .collect();
+        let s: Vec<f64> = (0..mesh.n_nodes()).map(|i| t * i as f64 + k as f64).collect();
         written.push(series.write_mesh(t, &mesh, vec![Field::point_scalars("s", s)])?);
         // After every step the collection lists exactly the steps so far.
         assert_eq!(read_pvd(series.pvd_path())?.len(), k + 1);
@@ -397,21 +332,13 @@ fn pvd_writer_parts_and_paths() -> TestResult {
         .add_part(0.0, 1, dir.join("b_0.vtu"))?
         .add(0.5, "sub/a_1.vtu")?
         .add(1.0, "/abs/a_2.vtu")?;
-    assert!(matches!(
-        pvd.add(f64::INFINITY, "x.vtu"),
-        Err(IoError::NonFinite { index: 4, .. })
-    ));
+    assert!(matches!(pvd.add(f64::INFINITY, "x.vtu"), Err(IoError::NonFinite { index: 4, .. })));
     pvd.write()?;
     let entries = read_pvd(pvd.path())?;
     let files: Vec<PathBuf> = entries.iter().map(|e| e.file.clone()).collect();
     assert_eq!(
         files,
-        [
-            dir.join("a_0.vtu"),
-            dir.join("b_0.vtu"),
-            dir.join("sub/a_1.vtu"),
-            PathBuf::from("/abs/a_2.vtu")
-        ]
+        [dir.join("a_0.vtu"), dir.join("b_0.vtu"), dir.join("sub/a_1.vtu"), PathBuf::from("/abs/a_2.vtu")]
     );
     let parts: Vec<usize> = entries.iter().map(|e| e.part).collect();
     assert_eq!(parts, [0, 1, 0, 0]);
@@ -425,28 +352,15 @@ fn pvd_writer_parts_and_paths() -> TestResult {
 fn field_validation_errors() {
     let mesh = grid_2d(2);
     let (nn, nc) = (mesh.n_nodes(), mesh.n_cells());
-    let add = |f: Field| {
-        VtuWriter::new(Encoding::Ascii)
-            .add_piece(&mesh, vec![f])
-            .map(|_| ())
-    };
+    let add = |f: Field| VtuWriter::new(Encoding::Ascii).add_piece(&mesh, vec![f]).map(|_| ());
 
     match add(Field::point_scalars("s", vec![0.0; nn - 1])) {
-        Err(IoError::FieldLength {
-            name,
-            expected,
-            got,
-        }) => {
+        Err(IoError::FieldLength { name, expected, got }) => {
             assert_eq!((name.as_str(), expected, got), ("s", nn, nn - 1));
         }
         other => panic!("expected FieldLength, got {other:?}"),
     }
-    match add(Field::new(
-        "t",
-        FieldLocation::Cell,
-        9,
-        vec![0.0; 9 * nc + 1],
-    )) {
+    match add(Field::new("t", FieldLocation::Cell, 9, vec![0.0; 9 * nc + 1])) {
         Err(IoError::FieldLength { expected, .. }) => assert_eq!(expected, 9 * nc),
         other => panic!("expected FieldLength, got {other:?}"),
     }
@@ -470,21 +384,12 @@ fn field_validation_errors() {
     ] {
         assert!(matches!(add(bad), Err(IoError::InvalidField { .. })));
     }
-    let add_all = |fs: Vec<Field>| {
-        VtuWriter::new(Encoding::Ascii)
-            .add_piece(&mesh, fs)
-            .map(|_| ())
-    };
-    let dup = add_all(vec![
-        Field::point_scalars("d", vec![0.0; nn]),
-        Field::point_scalars("d", vec![1.0; nn]),
-    ]);
+    let add_all = |fs: Vec<Field>| VtuWriter::new(Encoding::Ascii).add_piece(&mesh, fs).map(|_| ());
+    let dup =
+        add_all(vec![Field::point_scalars("d", vec![0.0; nn]), Field::point_scalars("d", vec![1.0; nn])]);
     assert!(matches!(dup, Err(IoError::InvalidField { .. })));
     // Same name at different locations is fine.
-    let ok = add_all(vec![
-        Field::point_scalars("d", vec![0.0; nn]),
-        Field::cell_scalars("d", vec![1.0; nc]),
-    ]);
+    let ok = add_all(vec![Field::point_scalars("d", vec![0.0; nn]), Field::cell_scalars("d", vec![1.0; nc])]);
     assert!(ok.is_ok());
     assert!(matches!(
         TimeSeriesWriter::new(std::env::temp_dir(), "a/b", Encoding::Ascii),
@@ -505,9 +410,7 @@ fn truncated_files_are_parse_errors() -> TestResult {
     let mesh = grid_2d(1);
     let fields = vec![Field::point_scalars("s", vec![0.5; mesh.n_nodes()])];
     for encoding in [Encoding::Ascii, Encoding::Base64] {
-        let xml = VtuWriter::new(encoding)
-            .add_piece(&mesh, fields.clone())?
-            .to_xml_string();
+        let xml = VtuWriter::new(encoding).add_piece(&mesh, fields.clone())?.to_xml_string();
         let end = xml.rfind("</VTKFile>").ok_or("no end tag")?;
         let path = dir.join("cut.vtu");
         for cut in (0..end).step_by(23).chain([end - 1]) {
@@ -524,10 +427,7 @@ fn truncated_files_are_parse_errors() -> TestResult {
         std::fs::write(&pvd, &text.as_bytes()[..cut])?;
         assert_parse_error(read_pvd(&pvd), &format!("pvd cut at {cut}"));
     }
-    assert!(matches!(
-        read_vtu(dir.join("missing.vtu")),
-        Err(IoError::Io { .. })
-    ));
+    assert!(matches!(read_vtu(dir.join("missing.vtu")), Err(IoError::Io { .. })));
     let _ = std::fs::remove_dir_all(&dir);
     Ok(())
 }
@@ -536,59 +436,26 @@ fn truncated_files_are_parse_errors() -> TestResult {
 fn garbled_files_are_parse_errors() -> TestResult {
     let mesh = grid_2d(1);
     let fields = vec![Field::point_scalars("s", vec![0.5, 1.5, 2.5, 3.5])];
-    let ascii = VtuWriter::new(Encoding::Ascii)
-        .add_piece(&mesh, fields.clone())?
-        .to_xml_string();
-    let binary = VtuWriter::new(Encoding::Base64)
-        .add_piece(&mesh, fields)?
-        .to_xml_string();
+    let ascii = VtuWriter::new(Encoding::Ascii).add_piece(&mesh, fields.clone())?.to_xml_string();
+    let binary = VtuWriter::new(Encoding::Base64).add_piece(&mesh, fields)?.to_xml_string();
     let cases: Vec<(&str, String)> = vec![
         ("not xml", "hello world".to_string()),
         ("empty", String::new()),
         ("wrong root", "<Foo/>".to_string()),
-        (
-            "wrong type",
-            ascii.replace("UnstructuredGrid\" version", "PolyData\" version"),
-        ),
+        ("wrong type", ascii.replace("UnstructuredGrid\" version", "PolyData\" version")),
         ("bad number", ascii.replace("1.5e0", "1.5x0")),
         ("too few values", ascii.replace(" 1.5e0", "")),
-        (
-            "connectivity out of range",
-            ascii.replace("0 1 3 0 3 2", "0 1 3 0 3 9"),
-        ),
-        (
-            "negative index",
-            ascii.replace("0 1 3 0 3 2", "0 1 3 0 3 -2"),
-        ),
-        (
-            "offsets past end",
-            ascii.replace(">\n          3 6\n", ">\n          3 7\n"),
-        ),
-        (
-            "triangle with 4 nodes",
-            ascii.replace(">\n          3 6\n", ">\n          4 6\n"),
-        ),
-        (
-            "missing NumberOfCells",
-            ascii.replace(" NumberOfCells=\"2\"", ""),
-        ),
+        ("connectivity out of range", ascii.replace("0 1 3 0 3 2", "0 1 3 0 3 9")),
+        ("negative index", ascii.replace("0 1 3 0 3 2", "0 1 3 0 3 -2")),
+        ("offsets past end", ascii.replace(">\n          3 6\n", ">\n          3 7\n")),
+        ("triangle with 4 nodes", ascii.replace(">\n          3 6\n", ">\n          4 6\n")),
+        ("missing NumberOfCells", ascii.replace(" NumberOfCells=\"2\"", "")),
         ("mismatched tags", ascii.replace("</Points>", "</Pointz>")),
-        (
-            "unknown type",
-            ascii.replace("type=\"Float64\" Name=\"s\"", "type=\"Float99\" Name=\"s\""),
-        ),
+        ("unknown type", ascii.replace("type=\"Float64\" Name=\"s\"", "type=\"Float99\" Name=\"s\"")),
         ("bad base64", binary.replacen("AAAA", "A!AA", 1)),
         ("short base64", binary.replacen("AAAA", "", 1)),
-        (
-            "appended",
-            binary.replacen("format=\"binary\"", "format=\"appended\"", 1),
-        ),
-        (
-            "no points",
-            ascii
-                .replace("<Points>", "<Pointless>")
-                .replace("</Points>", "</Pointless>"),
-        ),
+        ("appended", binary.replacen("format=\"binary\"", "format=\"appended\"", 1)),
+        ("no points", ascii.replace("<Points>", "<Pointless>").replace("</Points>", "</Pointless>")),
     ];
     for (what, xml) in &cases {
         assert_parse_error(parse_vtu(xml), what);
@@ -596,10 +463,7 @@ fn garbled_files_are_parse_errors() -> TestResult {
     // Sanity: the unmodified documents parse, and each modification changed something.
     assert!(parse_vtu(&ascii).is_ok() && parse_vtu(&binary).is_ok());
     for (what, xml) in &cases {
-        assert!(
-            xml != &ascii && xml != &binary,
-            "case `{what}` did not modify the document"
-        );
+        assert!(xml != &ascii && xml != &binary, "case `{what}` did not modify the document");
     }
     let dir = scratch("garbled");
     let path = dir.join("binary.vtu");
@@ -628,10 +492,8 @@ fn garbled_files_are_parse_errors() -> TestResult {
 fn reads_foreign_variants() -> TestResult {
     use base64::engine::general_purpose::STANDARD;
     use base64::Engine;
-    let points: Vec<u8> = [0f32, 0., 0., 1., 0., 0., 0., 1., 0.]
-        .iter()
-        .flat_map(|v| v.to_le_bytes())
-        .collect();
+    let points: Vec<u8> =
+        [0f32, 0., 0., 1., 0., 0., 0., 1., 0.].iter().flat_map(|v| v.to_le_bytes()).collect();
     let header = STANDARD.encode((points.len() as u32).to_le_bytes());
     let xml = format!(
         r#"<?xml version="1.0"?>
@@ -650,14 +512,8 @@ fn reads_foreign_variants() -> TestResult {
     );
     let data = parse_vtu(&xml)?;
     let piece = &data.pieces[0];
-    assert_eq!(
-        piece.points,
-        vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
-    );
-    assert_eq!(
-        piece.cell_field("id").map(|f| f.values.clone()),
-        Some(vec![42.0])
-    );
+    assert_eq!(piece.points, vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    assert_eq!(piece.cell_field("id").map(|f| f.values.clone()), Some(vec![42.0]));
     let mesh = piece.to_mesh::<2>()?;
     assert_eq!(mesh.measure(), 0.5);
     Ok(())

@@ -48,11 +48,7 @@ impl IsotropicParameters {
     pub fn from_lame(lambda: f64, mu: f64) -> Result<Self, MaterialError> {
         let (lambda, mu) = check_lame(lambda, mu)?;
         if 3.0 * lambda + 2.0 * mu <= 0.0 {
-            return Err(MaterialError::InadmissibleLame {
-                lambda,
-                mu,
-                condition: "3*lambda + 2*mu > 0",
-            });
+            return Err(MaterialError::InadmissibleLame { lambda, mu, condition: "3*lambda + 2*mu > 0" });
         }
         Ok(Self::from_lame_unchecked(lambda, mu))
     }
@@ -106,32 +102,14 @@ impl IsotropicParameters {
     /// The plane strain stiffness `[[λ+2μ, λ, 0], [λ, λ+2μ, 0], [0, 0, μ]]`.
     pub fn plane_strain_stiffness(&self) -> VoigtMatrix {
         let (l, m) = (self.lambda, self.mu);
-        VoigtMatrix::from_row_slice(
-            3,
-            3,
-            &[l + 2.0 * m, l, 0.0, l, l + 2.0 * m, 0.0, 0.0, 0.0, m],
-        )
+        VoigtMatrix::from_row_slice(3, 3, &[l + 2.0 * m, l, 0.0, l, l + 2.0 * m, 0.0, 0.0, 0.0, m])
     }
 
     /// The plane stress stiffness `E/(1−ν²) [[1, ν, 0], [ν, 1, 0], [0, 0, (1−ν)/2]]`.
     pub fn plane_stress_stiffness(&self) -> VoigtMatrix {
         let (e, nu) = (self.youngs_modulus, self.poisson_ratio);
         let f = e / (1.0 - nu * nu);
-        VoigtMatrix::from_row_slice(
-            3,
-            3,
-            &[
-                f,
-                f * nu,
-                0.0,
-                f * nu,
-                f,
-                0.0,
-                0.0,
-                0.0,
-                f * (1.0 - nu) / 2.0,
-            ],
-        )
+        VoigtMatrix::from_row_slice(3, 3, &[f, f * nu, 0.0, f * nu, f, 0.0, 0.0, 0.0, f * (1.0 - nu) / 2.0])
     }
 }
 
@@ -148,21 +126,13 @@ fn check_lame(lambda: f64, mu: f64) -> Result<(f64, f64), MaterialError> {
 ///
 /// # Errors
 /// As [`IsotropicParameters::new`].
-pub fn lame_parameters(
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-) -> Result<(f64, f64), MaterialError> {
+pub fn lame_parameters(youngs_modulus: f64, poisson_ratio: f64) -> Result<(f64, f64), MaterialError> {
     let p = IsotropicParameters::new(youngs_modulus, poisson_ratio)?;
     Ok((p.lambda(), p.mu()))
 }
 
 fn build_3d(p: IsotropicParameters) -> Result<LinearElastic<3>, MaterialError> {
-    LinearElastic::from_parts(
-        p.stiffness_3d(),
-        None,
-        Symmetry::Isotropic(p),
-        Reduction::ThreeDimensional,
-    )
+    LinearElastic::from_parts(p.stiffness_3d(), None, Symmetry::Isotropic(p), Reduction::ThreeDimensional)
 }
 
 fn build_plane_strain(p: IsotropicParameters) -> Result<LinearElastic<2>, MaterialError> {
@@ -180,10 +150,7 @@ fn build_plane_strain(p: IsotropicParameters) -> Result<LinearElastic<2>, Materi
 ///
 /// # Errors
 /// As [`IsotropicParameters::new`].
-pub fn isotropic(
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-) -> Result<LinearElastic<3>, MaterialError> {
+pub fn isotropic(youngs_modulus: f64, poisson_ratio: f64) -> Result<LinearElastic<3>, MaterialError> {
     build_3d(IsotropicParameters::new(youngs_modulus, poisson_ratio)?)
 }
 
@@ -200,10 +167,7 @@ pub fn from_lame(lambda: f64, mu: f64) -> Result<LinearElastic<3>, MaterialError
 ///
 /// # Errors
 /// As [`IsotropicParameters::new`].
-pub fn plane_strain(
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-) -> Result<LinearElastic<2>, MaterialError> {
+pub fn plane_strain(youngs_modulus: f64, poisson_ratio: f64) -> Result<LinearElastic<2>, MaterialError> {
     build_plane_strain(IsotropicParameters::new(youngs_modulus, poisson_ratio)?)
 }
 
@@ -217,11 +181,7 @@ pub fn plane_strain(
 pub fn plane_strain_from_lame(lambda: f64, mu: f64) -> Result<LinearElastic<2>, MaterialError> {
     let (lambda, mu) = check_lame(lambda, mu)?;
     if lambda + mu <= 0.0 {
-        return Err(MaterialError::InadmissibleLame {
-            lambda,
-            mu,
-            condition: "lambda + mu > 0",
-        });
+        return Err(MaterialError::InadmissibleLame { lambda, mu, condition: "lambda + mu > 0" });
     }
     build_plane_strain(IsotropicParameters::from_lame_unchecked(lambda, mu))
 }
@@ -231,10 +191,7 @@ pub fn plane_strain_from_lame(lambda: f64, mu: f64) -> Result<LinearElastic<2>, 
 ///
 /// # Errors
 /// As [`IsotropicParameters::new`].
-pub fn plane_stress(
-    youngs_modulus: f64,
-    poisson_ratio: f64,
-) -> Result<LinearElastic<2>, MaterialError> {
+pub fn plane_stress(youngs_modulus: f64, poisson_ratio: f64) -> Result<LinearElastic<2>, MaterialError> {
     let p = IsotropicParameters::new(youngs_modulus, poisson_ratio)?;
     LinearElastic::from_parts(
         p.plane_stress_stiffness(),
@@ -266,19 +223,10 @@ mod tests {
             from_lame(1.0, 0.0),
             Err(MaterialError::NonPositiveShearModulus { mu }) if mu == 0.0
         ));
-        assert!(matches!(
-            from_lame(-1.0, 1.0),
-            Err(MaterialError::InadmissibleLame { .. })
-        ));
+        assert!(matches!(from_lame(-1.0, 1.0), Err(MaterialError::InadmissibleLame { .. })));
         // 3λ+2μ = −0.5 < 0 but λ+μ = 0.25 > 0: fine in plane strain only.
         assert!(plane_strain_from_lame(-0.75, 1.0).is_ok());
-        assert!(matches!(
-            plane_strain_from_lame(-1.0, 1.0),
-            Err(MaterialError::InadmissibleLame { .. })
-        ));
-        assert!(matches!(
-            from_lame(f64::INFINITY, 1.0),
-            Err(MaterialError::NonFinite { .. })
-        ));
+        assert!(matches!(plane_strain_from_lame(-1.0, 1.0), Err(MaterialError::InadmissibleLame { .. })));
+        assert!(matches!(from_lame(f64::INFINITY, 1.0), Err(MaterialError::NonFinite { .. })));
     }
 }

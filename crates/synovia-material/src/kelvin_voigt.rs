@@ -3,9 +3,7 @@
 use std::sync::Arc;
 
 use crate::voigt::{check_finite, check_positive_semidefinite, check_size, voigt_pairs};
-use crate::{
-    check_admissible, voigt_len, LinearElastic, Material, MaterialError, VoigtMatrix, VoigtVector,
-};
+use crate::{check_admissible, voigt_len, LinearElastic, Material, MaterialError, VoigtMatrix, VoigtVector};
 
 /// A Kelvin–Voigt viscoelastic body material (spec §2):
 ///
@@ -66,12 +64,7 @@ impl<const D: usize> KelvinVoigt<D> {
             check_size(&c1, voigt_len(D))?;
             check_positive_semidefinite(&c1)?;
         }
-        Ok(Self {
-            elastic,
-            viscous,
-            density: rho,
-            damping: alpha,
-        })
+        Ok(Self { elastic, viscous, density: rho, damping: alpha })
     }
 
     /// Convenience constructor from linear parts, `C⁽⁰⁾ = c0`, `C⁽¹⁾ = c1` (pass
@@ -85,11 +78,7 @@ impl<const D: usize> KelvinVoigt<D> {
         density: f64,
         damping: f64,
     ) -> Result<Self, MaterialError> {
-        let viscous: Option<Arc<dyn Material<D>>> = if c1.is_zero() {
-            None
-        } else {
-            Some(Arc::new(c1))
-        };
+        let viscous: Option<Arc<dyn Material<D>>> = if c1.is_zero() { None } else { Some(Arc::new(c1)) };
         Self::new(Arc::new(c0), viscous, density, damping)
     }
 

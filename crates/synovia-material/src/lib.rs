@@ -79,12 +79,12 @@ pub use isotropic::{
 pub use kelvin_voigt::KelvinVoigt;
 pub use linear::{anisotropic, LinearElastic, Reduction, Symmetry};
 pub use transverse::{
-    transversely_isotropic, transversely_isotropic_plane_strain,
-    transversely_isotropic_plane_stress, TransverseIsotropy,
+    transversely_isotropic, transversely_isotropic_plane_strain, transversely_isotropic_plane_stress,
+    TransverseIsotropy,
 };
 pub use voigt::{
-    bond_strain_matrix, bond_stress_matrix, check_admissible, mandel_form, min_eigenvalue,
-    voigt_len, voigt_pairs,
+    bond_strain_matrix, bond_stress_matrix, check_admissible, mandel_form, min_eigenvalue, voigt_len,
+    voigt_pairs,
 };
 
 /// A symmetric tensor in Voigt notation, a vector of length [`voigt_len`]`(D)`.

@@ -96,12 +96,7 @@ impl<const D: usize> LinearElastic<D> {
     ) -> Result<Self, MaterialError> {
         check_size(&c, voigt_len(D))?;
         check_admissible(&c)?;
-        Ok(Self {
-            stiffness: symmetrized(&c),
-            out_of_plane,
-            symmetry,
-            reduction,
-        })
+        Ok(Self { stiffness: symmetrized(&c), out_of_plane, symmetry, reduction })
     }
 
     /// The zero material `C = 0` (`σ = 0`, `Φ = 0`), e.g. "no viscosity" `C⁽¹⁾ = 0`.
@@ -195,19 +190,11 @@ impl<const D: usize> LinearElastic<D> {
                 for i in 0..D {
                     new_axis[i] = (0..D).map(|k| r[(i, k)] * axis[k]).sum();
                 }
-                Symmetry::TransverselyIsotropic {
-                    parameters: *parameters,
-                    axis: new_axis,
-                }
+                Symmetry::TransverselyIsotropic { parameters: *parameters, axis: new_axis }
             }
             other => other.clone(),
         };
-        Ok(Self {
-            stiffness,
-            out_of_plane,
-            symmetry,
-            reduction: self.reduction,
-        })
+        Ok(Self { stiffness, out_of_plane, symmetry, reduction: self.reduction })
     }
 
     /// The same stiffness with different symmetry metadata.
@@ -291,15 +278,12 @@ impl<const D: usize> Material<D> for LinearElastic<D> {
     fn name(&self) -> String {
         let sym = match &self.symmetry {
             Symmetry::Zero => "zero".to_string(),
-            Symmetry::Isotropic(p) => format!(
-                "isotropic (E = {}, nu = {})",
-                p.youngs_modulus(),
-                p.poisson_ratio()
-            ),
-            Symmetry::TransverselyIsotropic { axis, .. } => format!(
-                "transversely isotropic (axis = [{}, {}, {}])",
-                axis[0], axis[1], axis[2]
-            ),
+            Symmetry::Isotropic(p) => {
+                format!("isotropic (E = {}, nu = {})", p.youngs_modulus(), p.poisson_ratio())
+            }
+            Symmetry::TransverselyIsotropic { axis, .. } => {
+                format!("transversely isotropic (axis = [{}, {}, {}])", axis[0], axis[1], axis[2])
+            }
             Symmetry::Anisotropic => "anisotropic".to_string(),
         };
         let red = match self.reduction {
@@ -328,10 +312,7 @@ fn check_rotation<const D: usize>(r: &SMatrix<f64, D, D>) -> Result<(), Material
         _ => return Err(MaterialError::UnsupportedDimension(D)),
     };
     if defect > ROTATION_TOL || det <= 0.0 {
-        return Err(MaterialError::NotARotation {
-            orthogonality_defect: defect,
-            det,
-        });
+        return Err(MaterialError::NotARotation { orthogonality_defect: defect, det });
     }
     Ok(())
 }
@@ -351,16 +332,10 @@ mod tests {
             Err(MaterialError::NotARotation { det, .. }) if det < 0.0
         ));
         let scaled = Matrix3::identity() * 2.0;
-        assert!(matches!(
-            m.rotated(&scaled),
-            Err(MaterialError::NotARotation { .. })
-        ));
+        assert!(matches!(m.rotated(&scaled), Err(MaterialError::NotARotation { .. })));
         let nan = Matrix2::new(f64::NAN, 0.0, 0.0, 1.0);
         let m2 = crate::plane_strain(1.0, 0.25).unwrap();
-        assert!(matches!(
-            m2.rotated(&nan),
-            Err(MaterialError::NonFinite { .. })
-        ));
+        assert!(matches!(m2.rotated(&nan), Err(MaterialError::NonFinite { .. })));
     }
 
     #[test]

@@ -109,19 +109,12 @@ impl TransverseIsotropy {
         let s = self.local_compliance()?;
         let c = match s.clone().try_inverse() {
             Some(c) => c,
-            None => {
-                return Err(MaterialError::NotPositiveDefinite {
-                    min_eigenvalue: min_eigenvalue(&s)?,
-                })
-            }
+            None => return Err(MaterialError::NotPositiveDefinite { min_eigenvalue: min_eigenvalue(&s)? }),
         };
         LinearElastic::from_parts(
             c,
             None,
-            Symmetry::TransverselyIsotropic {
-                parameters: *self,
-                axis: Vector3::z(),
-            },
+            Symmetry::TransverselyIsotropic { parameters: *self, axis: Vector3::z() },
             Reduction::ThreeDimensional,
         )
     }
@@ -131,9 +124,7 @@ impl TransverseIsotropy {
 /// i.e. the rotation taking the local axis `z` to `a`.
 fn frame_with_axis(a: &Vector3<f64>) -> Matrix3<f64> {
     // Helper: the coordinate axis least aligned with `a`.
-    let k = (0..3)
-        .min_by(|&i, &j| a[i].abs().total_cmp(&a[j].abs()))
-        .unwrap_or(0);
+    let k = (0..3).min_by(|&i, &j| a[i].abs().total_cmp(&a[j].abs())).unwrap_or(0);
     let mut h = Vector3::zeros();
     h[k] = 1.0;
     let e1 = (h - a * a.dot(&h)).normalize();
@@ -143,9 +134,7 @@ fn frame_with_axis(a: &Vector3<f64>) -> Matrix3<f64> {
 
 fn unit_axis(axis: Vector3<f64>) -> Result<Vector3<f64>, MaterialError> {
     if !axis.iter().all(|v| v.is_finite()) {
-        return Err(MaterialError::NonFinite {
-            what: "material axis",
-        });
+        return Err(MaterialError::NonFinite { what: "material axis" });
     }
     let norm = axis.norm();
     if norm <= f64::MIN_POSITIVE.sqrt() {
@@ -171,10 +160,7 @@ pub fn transversely_isotropic(
     let local = parameters.local_material()?;
     let global = local.rotated(&frame_with_axis(&a))?;
     // Record the exact normalised axis (rather than R·e_z, which carries rounding).
-    Ok(global.with_symmetry(Symmetry::TransverselyIsotropic {
-        parameters,
-        axis: a,
-    }))
+    Ok(global.with_symmetry(Symmetry::TransverselyIsotropic { parameters, axis: a }))
 }
 
 /// 2D plane strain transversely isotropic material with the in-plane axis `(a_x, a_y)`: the
@@ -226,13 +212,7 @@ mod tests {
 
     #[test]
     fn axis_validation() {
-        let p = TransverseIsotropy {
-            e_p: 1.0,
-            nu_p: 0.3,
-            e_a: 2.0,
-            nu_ap: 0.2,
-            g_a: 0.5,
-        };
+        let p = TransverseIsotropy { e_p: 1.0, nu_p: 0.3, e_a: 2.0, nu_ap: 0.2, g_a: 0.5 };
         assert!(matches!(
             transversely_isotropic(p, Vector3::zeros()),
             Err(MaterialError::DegenerateAxis { norm }) if norm == 0.0

@@ -47,9 +47,7 @@ pub fn voigt_pairs(d: usize) -> Result<&'static [(usize, usize)], MaterialError>
 ///
 /// # Errors
 /// [`MaterialError::UnsupportedDimension`] unless `D ∈ {2, 3}`.
-pub fn bond_stress_matrix<const D: usize>(
-    r: &SMatrix<f64, D, D>,
-) -> Result<VoigtMatrix, MaterialError> {
+pub fn bond_stress_matrix<const D: usize>(r: &SMatrix<f64, D, D>) -> Result<VoigtMatrix, MaterialError> {
     let pairs = voigt_pairs(D)?;
     let n = pairs.len();
     Ok(VoigtMatrix::from_fn(n, n, |row, col| {
@@ -74,9 +72,7 @@ pub fn bond_stress_matrix<const D: usize>(
 ///
 /// # Errors
 /// [`MaterialError::UnsupportedDimension`] unless `D ∈ {2, 3}`.
-pub fn bond_strain_matrix<const D: usize>(
-    r: &SMatrix<f64, D, D>,
-) -> Result<VoigtMatrix, MaterialError> {
+pub fn bond_strain_matrix<const D: usize>(r: &SMatrix<f64, D, D>) -> Result<VoigtMatrix, MaterialError> {
     let pairs = voigt_pairs(D)?;
     let m = bond_stress_matrix(r)?;
     let s = |idx: usize| {
@@ -86,9 +82,7 @@ pub fn bond_strain_matrix<const D: usize>(
             2.0
         }
     };
-    Ok(VoigtMatrix::from_fn(m.nrows(), m.ncols(), |row, col| {
-        m[(row, col)] * s(row) / s(col)
-    }))
+    Ok(VoigtMatrix::from_fn(m.nrows(), m.ncols(), |row, col| m[(row, col)] * s(row) / s(col)))
 }
 
 /// The Mandel (Kelvin) form `C̃ = W C W` of a Voigt stiffness, `W = diag(1, …, 1, √2, …, √2)`
@@ -114,9 +108,7 @@ pub fn mandel_form(c: &VoigtMatrix) -> Result<VoigtMatrix, MaterialError> {
             std::f64::consts::SQRT_2
         }
     };
-    Ok(VoigtMatrix::from_fn(c.nrows(), c.ncols(), |row, col| {
-        w(row) * c[(row, col)] * w(col)
-    }))
+    Ok(VoigtMatrix::from_fn(c.nrows(), c.ncols(), |row, col| w(row) * c[(row, col)] * w(col)))
 }
 
 /// The smallest eigenvalue `λ_min` of the symmetric part `½(A + Aᵀ)` of a square matrix
@@ -127,10 +119,7 @@ pub fn mandel_form(c: &VoigtMatrix) -> Result<VoigtMatrix, MaterialError> {
 pub fn min_eigenvalue(a: &VoigtMatrix) -> Result<f64, MaterialError> {
     check_square(a)?;
     check_finite_matrix(a, "matrix entry")?;
-    Ok(sym_eigenvalues(a)
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min))
+    Ok(sym_eigenvalues(a).iter().copied().fold(f64::INFINITY, f64::min))
 }
 
 /// Checks that `C` is an admissible elasticity matrix: square, finite, symmetric
@@ -151,9 +140,7 @@ pub fn check_admissible(c: &VoigtMatrix) -> Result<(), MaterialError> {
     let max_abs = eig.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
     let tol = c.nrows() as f64 * f64::EPSILON * max_abs;
     if min <= tol {
-        return Err(MaterialError::NotPositiveDefinite {
-            min_eigenvalue: min,
-        });
+        return Err(MaterialError::NotPositiveDefinite { min_eigenvalue: min });
     }
     Ok(())
 }
@@ -163,24 +150,16 @@ pub(crate) fn check_positive_semidefinite(c: &VoigtMatrix) -> Result<(), Materia
     check_square(c)?;
     check_finite_matrix(c, "viscosity matrix entry")?;
     check_symmetric(c)?;
-    let min = sym_eigenvalues(c)
-        .iter()
-        .copied()
-        .fold(f64::INFINITY, f64::min);
+    let min = sym_eigenvalues(c).iter().copied().fold(f64::INFINITY, f64::min);
     if min < -PSD_TOL * c.norm() {
-        return Err(MaterialError::NotPositiveSemiDefinite {
-            min_eigenvalue: min,
-        });
+        return Err(MaterialError::NotPositiveSemiDefinite { min_eigenvalue: min });
     }
     Ok(())
 }
 
 pub(crate) fn check_square(a: &VoigtMatrix) -> Result<(), MaterialError> {
     if a.nrows() != a.ncols() {
-        return Err(MaterialError::NotSquare {
-            rows: a.nrows(),
-            cols: a.ncols(),
-        });
+        return Err(MaterialError::NotSquare { rows: a.nrows(), cols: a.ncols() });
     }
     Ok(())
 }
@@ -195,10 +174,7 @@ pub(crate) fn check_size(a: &VoigtMatrix, expected: usize) -> Result<(), Materia
     Ok(())
 }
 
-pub(crate) fn check_finite_matrix(
-    a: &VoigtMatrix,
-    what: &'static str,
-) -> Result<(), MaterialError> {
+pub(crate) fn check_finite_matrix(a: &VoigtMatrix, what: &'static str) -> Result<(), MaterialError> {
     if a.iter().all(|v| v.is_finite()) {
         Ok(())
     } else {
@@ -248,10 +224,7 @@ pub(crate) fn spd_inverse(a: &VoigtMatrix) -> Result<VoigtMatrix, MaterialError>
     match symmetrized(a).cholesky() {
         Some(ch) => Ok(symmetrized(&ch.inverse())),
         None => Err(MaterialError::NotPositiveDefinite {
-            min_eigenvalue: sym_eigenvalues(a)
-                .iter()
-                .copied()
-                .fold(f64::INFINITY, f64::min),
+            min_eigenvalue: sym_eigenvalues(a).iter().copied().fold(f64::INFINITY, f64::min),
         }),
     }
 }
@@ -281,11 +254,9 @@ mod tests {
 
     #[test]
     fn bond_matrices_are_inverse_transposes() {
-        let r: Matrix3<f64> = *Rotation3::from_axis_angle(
-            &nalgebra::Unit::new_normalize(Vector3::new(1.0, -2.0, 0.5)),
-            0.7,
-        )
-        .matrix();
+        let r: Matrix3<f64> =
+            *Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(Vector3::new(1.0, -2.0, 0.5)), 0.7)
+                .matrix();
         let m = bond_stress_matrix(&r).unwrap();
         let n = bond_strain_matrix(&r).unwrap();
         let prod = m.transpose() * n;
@@ -312,13 +283,7 @@ mod tests {
         // Strains: engineering shear.
         let ev = VoigtVector::from_iterator(
             6,
-            pairs.iter().map(|&(i, j)| {
-                if i == j {
-                    sigma[(i, j)]
-                } else {
-                    2.0 * sigma[(i, j)]
-                }
-            }),
+            pairs.iter().map(|&(i, j)| if i == j { sigma[(i, j)] } else { 2.0 * sigma[(i, j)] }),
         );
         let nv = bond_strain_matrix(&r).unwrap() * ev;
         for (idx, &(i, j)) in pairs.iter().enumerate() {

@@ -8,9 +8,9 @@ use nalgebra::{Matrix2, Matrix3, Rotation3, Unit, Vector2, Vector3};
 use synovia_material::{
     anisotropic, bond_strain_matrix, bond_stress_matrix, check_admissible, from_lame, isotropic,
     plane_strain, plane_strain_from_lame, plane_stress, transversely_isotropic,
-    transversely_isotropic_plane_strain, transversely_isotropic_plane_stress, voigt_len,
-    KelvinVoigt, LinearElastic, Material, MaterialError, Reduction, Symmetry, TransverseIsotropy,
-    VoigtMatrix, VoigtVector,
+    transversely_isotropic_plane_strain, transversely_isotropic_plane_stress, voigt_len, KelvinVoigt,
+    LinearElastic, Material, MaterialError, Reduction, Symmetry, TransverseIsotropy, VoigtMatrix,
+    VoigtVector,
 };
 
 // ---------------------------------------------------------------- helpers
@@ -19,11 +19,7 @@ use synovia_material::{
 fn assert_mat_close(a: &VoigtMatrix, b: &VoigtMatrix, tol: f64) {
     assert_eq!(a.shape(), b.shape());
     let err = (a - b).amax();
-    assert!(
-        err <= tol * b.amax(),
-        "matrices differ by {err} (scale {}):\n{a}\n{b}",
-        b.amax()
-    );
+    assert!(err <= tol * b.amax(), "matrices differ by {err} (scale {}):\n{a}\n{b}", b.amax());
 }
 
 fn sub(c: &VoigtMatrix, idx: &[usize]) -> VoigtMatrix {
@@ -37,13 +33,7 @@ fn inv(c: &VoigtMatrix) -> VoigtMatrix {
 /// A cartilage-like transversely isotropic set (admissible:
 /// `ν_pa = 0.5`, `1 − ν_p − 2 ν_ap ν_pa = 0.55 > 0`).
 fn ti_params() -> TransverseIsotropy {
-    TransverseIsotropy {
-        e_p: 10.0,
-        nu_p: 0.35,
-        e_a: 2.0,
-        nu_ap: 0.1,
-        g_a: 0.8,
-    }
+    TransverseIsotropy { e_p: 10.0, nu_p: 0.35, e_a: 2.0, nu_ap: 0.1, g_a: 0.8 }
 }
 
 fn rotation() -> Matrix3<f64> {
@@ -111,11 +101,7 @@ fn isotropic_3d_compliance_recovers_e_and_nu() {
     assert_relative_eq!(eps[1] * e, -nu, max_relative = 1e-12);
     // Lamé metadata.
     let (l, mu) = m.lame().unwrap();
-    assert_relative_eq!(
-        l,
-        e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
-        max_relative = 1e-14
-    );
+    assert_relative_eq!(l, e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)), max_relative = 1e-14);
     assert_relative_eq!(mu, e / (2.0 * (1.0 + nu)), max_relative = 1e-14);
     assert_eq!(m.reduction(), Reduction::ThreeDimensional);
 }
@@ -136,11 +122,7 @@ fn plane_strain_is_submatrix_of_3d() {
     let eps3 = VoigtVector::from_column_slice(&[eps[0], eps[1], 0.0, 0.0, 0.0, eps[2]]);
     let s3 = c3.stress(&eps3);
     assert_relative_eq!(szz, s3[2], max_relative = 1e-13);
-    assert_relative_eq!(
-        c3.plane_strain().out_of_plane_stress(&eps),
-        s3[2],
-        max_relative = 1e-13
-    );
+    assert_relative_eq!(c3.plane_strain().out_of_plane_stress(&eps), s3[2], max_relative = 1e-13);
     let s2 = ps.stress(&eps);
     for (i, k) in [0, 1, 5].into_iter().enumerate() {
         assert_relative_eq!(s2[i], s3[k], max_relative = 1e-13);
@@ -202,30 +184,16 @@ fn transversely_isotropic_axis_z_matches_closed_form() {
 #[test]
 fn transversely_isotropic_isotropic_limit() {
     let (e, nu) = (4.0, 0.3);
-    let p = TransverseIsotropy {
-        e_p: e,
-        nu_p: nu,
-        e_a: e,
-        nu_ap: nu,
-        g_a: e / (2.0 * (1.0 + nu)),
-    };
+    let p = TransverseIsotropy { e_p: e, nu_p: nu, e_a: e, nu_ap: nu, g_a: e / (2.0 * (1.0 + nu)) };
     let iso = isotropic(e, nu).unwrap();
     for axis in [Vector3::z(), Vector3::x(), Vector3::new(0.3, -1.0, 0.7)] {
         let ti = transversely_isotropic(p, axis).unwrap();
         assert_mat_close(ti.stiffness(), iso.stiffness(), 1e-12);
     }
     let ps = transversely_isotropic_plane_strain(p, Vector2::new(1.0, 1.0)).unwrap();
-    assert_mat_close(
-        ps.stiffness(),
-        plane_strain(e, nu).unwrap().stiffness(),
-        1e-12,
-    );
+    assert_mat_close(ps.stiffness(), plane_strain(e, nu).unwrap().stiffness(), 1e-12);
     let pss = transversely_isotropic_plane_stress(p, Vector2::new(1.0, -2.0)).unwrap();
-    assert_mat_close(
-        pss.stiffness(),
-        plane_stress(e, nu).unwrap().stiffness(),
-        1e-12,
-    );
+    assert_mat_close(pss.stiffness(), plane_stress(e, nu).unwrap().stiffness(), 1e-12);
 }
 
 #[test]
@@ -289,11 +257,7 @@ fn transversely_isotropic_plane_reductions() {
     assert_mat_close(pe.stiffness(), &sub(c3.stiffness(), &[0, 1, 5]), 1e-13);
     let eps = strain2();
     let eps3 = VoigtVector::from_column_slice(&[eps[0], eps[1], 0.0, 0.0, 0.0, eps[2]]);
-    assert_relative_eq!(
-        pe.out_of_plane_stress(&eps),
-        c3.stress(&eps3)[2],
-        max_relative = 1e-12
-    );
+    assert_relative_eq!(pe.out_of_plane_stress(&eps), c3.stress(&eps3)[2], max_relative = 1e-12);
     let pst = transversely_isotropic_plane_stress(p, axis2).unwrap();
     let expected = inv(&sub(&inv(c3.stiffness()), &[0, 1, 5]));
     assert_mat_close(pst.stiffness(), &expected, 1e-12);
@@ -330,11 +294,7 @@ fn anisotropic_accepts_spd_and_rotates() {
     // Energy invariance under the Bond pair (M, N).
     let n = bond_strain_matrix(&r).unwrap();
     let eps = strain3();
-    assert_relative_eq!(
-        m.energy_density(&eps),
-        mr.energy_density(&(&n * &eps)),
-        max_relative = 1e-12
-    );
+    assert_relative_eq!(m.energy_density(&eps), mr.energy_density(&(&n * &eps)), max_relative = 1e-12);
     // Kelvin moduli are invariant, rotating back recovers C.
     let k0 = m.kelvin_moduli();
     let k1 = mr.kelvin_moduli();
@@ -368,17 +328,11 @@ fn parameter_errors() {
         assert!(plane_stress(1.0, nu).is_err());
     }
     for (e, nu) in [(f64::NAN, 0.3), (f64::INFINITY, 0.3), (1.0, f64::NAN)] {
-        assert!(matches!(
-            isotropic(e, nu),
-            Err(MaterialError::NonFinite { .. })
-        ));
+        assert!(matches!(isotropic(e, nu), Err(MaterialError::NonFinite { .. })));
     }
     let err = isotropic(f64::NAN, 0.3).unwrap_err();
     assert!(err.to_string().contains("Young"), "{err}");
-    assert!(matches!(
-        plane_stress(f64::NEG_INFINITY, 0.3),
-        Err(MaterialError::NonFinite { .. })
-    ));
+    assert!(matches!(plane_stress(f64::NEG_INFINITY, 0.3), Err(MaterialError::NonFinite { .. })));
     let err = from_lame(1.0, -0.5).unwrap_err();
     assert_eq!(err, MaterialError::NonPositiveShearModulus { mu: -0.5 });
     assert!(err.to_string().contains("-0.5"));
@@ -412,10 +366,7 @@ fn transversely_isotropic_errors() {
     ));
     let mut p = ti_params();
     p.e_p = f64::NAN;
-    assert!(matches!(
-        transversely_isotropic(p, Vector3::z()),
-        Err(MaterialError::NonFinite { .. })
-    ));
+    assert!(matches!(transversely_isotropic(p, Vector3::z()), Err(MaterialError::NonFinite { .. })));
     assert!(matches!(
         transversely_isotropic_plane_strain(ti_params(), Vector2::zeros()),
         Err(MaterialError::DegenerateAxis { .. })
@@ -436,9 +387,8 @@ fn matrix_errors() {
     }
     assert!(err.to_string().contains(&c[(0, 4)].to_string()), "{err}");
 
-    let indefinite = VoigtMatrix::from_diagonal(&VoigtVector::from_column_slice(&[
-        1.0, 1.0, 1.0, 1.0, 1.0, -2.0,
-    ]));
+    let indefinite =
+        VoigtMatrix::from_diagonal(&VoigtVector::from_column_slice(&[1.0, 1.0, 1.0, 1.0, 1.0, -2.0]));
     let err = anisotropic::<3>(indefinite).unwrap_err();
     match err {
         MaterialError::NotPositiveDefinite { min_eigenvalue } => {
@@ -449,20 +399,11 @@ fn matrix_errors() {
     assert!(err.to_string().contains("-2"), "{err}");
 
     let err = anisotropic::<3>(VoigtMatrix::identity(5, 5)).unwrap_err();
-    assert_eq!(
-        err,
-        MaterialError::WrongVoigtSize {
-            expected: 6,
-            got: 5
-        }
-    );
+    assert_eq!(err, MaterialError::WrongVoigtSize { expected: 6, got: 5 });
     assert!(err.to_string().contains('5') && err.to_string().contains('6'));
     assert!(matches!(
         anisotropic::<2>(VoigtMatrix::identity(3, 4)),
-        Err(MaterialError::WrongVoigtSize {
-            expected: 3,
-            got: 4
-        })
+        Err(MaterialError::WrongVoigtSize { expected: 3, got: 4 })
     ));
     assert_eq!(
         anisotropic::<4>(VoigtMatrix::identity(10, 10)).unwrap_err(),
@@ -470,10 +411,7 @@ fn matrix_errors() {
     );
     let mut nan = spd6();
     nan[(2, 2)] = f64::NAN;
-    assert!(matches!(
-        anisotropic::<3>(nan),
-        Err(MaterialError::NonFinite { .. })
-    ));
+    assert!(matches!(anisotropic::<3>(nan), Err(MaterialError::NonFinite { .. })));
     // Symmetric within the relative tolerance 1e-10 is accepted.
     let mut nearly = spd6();
     nearly[(1, 3)] += 1e-13 * nearly.amax();
@@ -506,9 +444,7 @@ fn kelvin_voigt_errors() {
         Err(MaterialError::NotPositiveDefinite { .. })
     ));
     // A user material with an indefinite linear viscosity.
-    let bad = UserLinear(VoigtMatrix::from_diagonal(&VoigtVector::from_column_slice(
-        &[1.0, 1.0, -0.5],
-    )));
+    let bad = UserLinear(VoigtMatrix::from_diagonal(&VoigtVector::from_column_slice(&[1.0, 1.0, -0.5])));
     assert!(matches!(
         KelvinVoigt::<2>::new(
             Arc::new(plane_strain(1.0, 0.3).unwrap()),
@@ -522,10 +458,7 @@ fn kelvin_voigt_errors() {
     let wrong = UserLinear(VoigtMatrix::identity(6, 6));
     assert!(matches!(
         KelvinVoigt::<2>::new(Arc::new(wrong), None, 1.0, 0.0),
-        Err(MaterialError::WrongVoigtSize {
-            expected: 3,
-            got: 6
-        })
+        Err(MaterialError::WrongVoigtSize { expected: 3, got: 6 })
     ));
 }
 
@@ -538,11 +471,7 @@ fn kelvin_voigt_parts() {
     let kv = KelvinVoigt::from_linear(c0.clone(), c1.clone(), 1100.0, 0.0).unwrap();
     assert_eq!(kv.density(), 1100.0);
     assert_eq!(kv.damping(), 0.0);
-    assert_mat_close(
-        &kv.elastic().linear_stiffness().unwrap(),
-        c0.stiffness(),
-        0.0,
-    );
+    assert_mat_close(&kv.elastic().linear_stiffness().unwrap(), c0.stiffness(), 0.0);
     assert_mat_close(&kv.viscous_stiffness().unwrap(), c1.stiffness(), 0.0);
     let (e, edot) = (strain3(), strain3() * -3.0);
     let total = kv.total_stress(&e, &edot);
@@ -557,27 +486,14 @@ fn kelvin_voigt_parts() {
     let undamped = KelvinVoigt::from_linear(c0.clone(), LinearElastic::zero(), 1.0, 0.5).unwrap();
     assert!(undamped.viscous().is_none());
     assert_eq!(undamped.viscous_stress(&edot), VoigtVector::zeros(6));
-    assert_eq!(
-        undamped.viscous_stiffness().unwrap(),
-        VoigtMatrix::zeros(6, 6)
-    );
+    assert_eq!(undamped.viscous_stiffness().unwrap(), VoigtMatrix::zeros(6, 6));
     // Zero viscosity passed explicitly is fine (PSD).
-    let explicit = KelvinVoigt::<3>::new(
-        Arc::new(c0),
-        Some(Arc::new(LinearElastic::<3>::zero())),
-        1.0,
-        0.0,
-    )
-    .unwrap();
+    let explicit =
+        KelvinVoigt::<3>::new(Arc::new(c0), Some(Arc::new(LinearElastic::<3>::zero())), 1.0, 0.0).unwrap();
     assert!(explicit.viscous().is_some());
     // A 2D plane strain body keeps its out-of-plane stress.
-    let kv2 = KelvinVoigt::from_linear(
-        plane_strain(1.0, 0.3).unwrap(),
-        LinearElastic::zero(),
-        1.0,
-        0.0,
-    )
-    .unwrap();
+    let kv2 =
+        KelvinVoigt::from_linear(plane_strain(1.0, 0.3).unwrap(), LinearElastic::zero(), 1.0, 0.0).unwrap();
     assert!(kv2.out_of_plane_stress(&strain2()) != 0.0);
 }
 
@@ -590,18 +506,10 @@ fn all_3d() -> Vec<Box<dyn Material<3>>> {
         Box::new(transversely_isotropic(ti_params(), Vector3::new(1.0, 1.0, 1.0)).unwrap()),
         Box::new(anisotropic::<3>(spd6()).unwrap()),
         Box::new(
-            KelvinVoigt::from_linear(
-                isotropic(1.0, 0.2).unwrap(),
-                isotropic(0.5, 0.1).unwrap(),
-                1.0,
-                0.1,
-            )
-            .unwrap(),
+            KelvinVoigt::from_linear(isotropic(1.0, 0.2).unwrap(), isotropic(0.5, 0.1).unwrap(), 1.0, 0.1)
+                .unwrap(),
         ),
-        Box::new(Stiffening {
-            lin: isotropic(1.0, 0.25).unwrap(),
-            beta: 5e5,
-        }),
+        Box::new(Stiffening { lin: isotropic(1.0, 0.25).unwrap(), beta: 5e5 }),
     ]
 }
 
@@ -622,30 +530,14 @@ fn check_consistency<const D: usize>(m: &dyn Material<D>, eps: &VoigtVector) {
     let t = m.tangent(eps);
     // Tangent = FD of stress.
     let fd = fd_tangent(m, eps);
-    assert!(
-        (&t - &fd).amax() <= 1e-6 * t.amax(),
-        "{}: tangent",
-        m.name()
-    );
-    assert!(
-        (&t - t.transpose()).amax() <= 1e-12 * t.amax(),
-        "{}",
-        m.name()
-    );
+    assert!((&t - &fd).amax() <= 1e-6 * t.amax(), "{}: tangent", m.name());
+    assert!((&t - t.transpose()).amax() <= 1e-12 * t.amax(), "{}", m.name());
     // Stress = FD gradient of energy.
     let g = fd_gradient(m, eps);
-    assert!(
-        (&g - &sigma).amax() <= 1e-6 * sigma.amax(),
-        "{}: gradient",
-        m.name()
-    );
+    assert!((&g - &sigma).amax() <= 1e-6 * sigma.amax(), "{}: gradient", m.name());
     if let Some(c) = m.linear_stiffness() {
         // Linear: Φ = ½ ε·σ exactly.
-        assert_relative_eq!(
-            m.energy_density(eps),
-            0.5 * eps.dot(&sigma),
-            max_relative = 1e-13
-        );
+        assert_relative_eq!(m.energy_density(eps), 0.5 * eps.dot(&sigma), max_relative = 1e-13);
         assert!((&c * eps - &sigma).amax() <= 1e-15 * sigma.amax().max(1.0));
     }
     assert!(!m.name().is_empty());
@@ -719,10 +611,7 @@ impl Material<3> for Stiffening {
 #[test]
 fn kelvin_voigt_with_nonlinear_user_material() {
     let kv = KelvinVoigt::<3>::new(
-        Arc::new(Stiffening {
-            lin: isotropic(1.0, 0.3).unwrap(),
-            beta: 1e6,
-        }),
+        Arc::new(Stiffening { lin: isotropic(1.0, 0.3).unwrap(), beta: 1e6 }),
         Some(Arc::new(isotropic(0.1, 0.0).unwrap())),
         1.0,
         0.0,

@@ -42,9 +42,7 @@ pub enum MeshError {
         node: usize,
     },
     /// A cell has (numerically) zero measure.
-    #[error(
-        "cell {cell} is degenerate: |det| = {det:e} relative to its size (zero-measure element)"
-    )]
+    #[error("cell {cell} is degenerate: |det| = {det:e} relative to its size (zero-measure element)")]
     DegenerateCell {
         /// Cell index.
         cell: usize,
@@ -84,7 +82,9 @@ pub enum MeshError {
     InvalidParameter(String),
     /// Refinement produced a boundary facet that lies in no boundary facet of the input mesh
     /// (an internal inconsistency, reported instead of a panic).
-    #[error("refinement produced boundary facet {facet:?}, which lies in no boundary facet of the input mesh")]
+    #[error(
+        "refinement produced boundary facet {facet:?}, which lies in no boundary facet of the input mesh"
+    )]
     RefinementInconsistent {
         /// Node list of the new facet.
         facet: Vec<usize>,

@@ -95,19 +95,13 @@ fn check_ratio(name: &str, ratio: Real, min_inclusive: Option<Real>) -> Result<(
 /// two nodes coincide in floating point.
 pub fn nodes_1d(a: Real, b: Real, n: usize, grading: Grading) -> Result<Vec<Real>, MeshError> {
     if !(a.is_finite() && b.is_finite() && a < b) {
-        return Err(invalid(format!(
-            "nodes_1d: need finite a < b, got [{a}, {b}]"
-        )));
+        return Err(invalid(format!("nodes_1d: need finite a < b, got [{a}, {b}]")));
     }
     if n == 0 {
-        return Err(invalid(
-            "nodes_1d: the number of cells n must be at least 1",
-        ));
+        return Err(invalid("nodes_1d: the number of cells n must be at least 1"));
     }
     let mut x = match grading {
-        Grading::Uniform => (0..=n)
-            .map(|i| a + (b - a) * (i as Real / n as Real))
-            .collect(),
+        Grading::Uniform => (0..=n).map(|i| a + (b - a) * (i as Real / n as Real)).collect(),
         Grading::Geometric { ratio } => {
             check_ratio("Geometric", ratio, None)?;
             geometric(a, b, n, ratio)
@@ -120,15 +114,9 @@ pub fn nodes_1d(a: Real, b: Real, n: usize, grading: Grading) -> Result<Vec<Real
             check_ratio("TowardHigh", ratio, Some(1.0))?;
             geometric(a, b, n, 1.0 / ratio)
         }
-        Grading::Refined {
-            center,
-            width,
-            ratio,
-        } => {
+        Grading::Refined { center, width, ratio } => {
             if !center.is_finite() {
-                return Err(invalid(format!(
-                    "grading Refined: center must be finite, got {center}"
-                )));
+                return Err(invalid(format!("grading Refined: center must be finite, got {center}")));
             }
             if !(width.is_finite() && width > 0.0) {
                 return Err(invalid(format!(
@@ -141,9 +129,10 @@ pub fn nodes_1d(a: Real, b: Real, n: usize, grading: Grading) -> Result<Vec<Real
     };
     x[0] = a;
     x[n] = b;
-    if let Some(k) = x.windows(2).position(|w| {
-        w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) || !w[1].is_finite()
-    }) {
+    if let Some(k) = x
+        .windows(2)
+        .position(|w| w[1].partial_cmp(&w[0]) != Some(std::cmp::Ordering::Greater) || !w[1].is_finite())
+    {
         return Err(invalid(format!(
             "nodes_1d: grading {grading:?} with n = {n} on [{a}, {b}] makes nodes {k} and {} coincide",
             k + 1
@@ -155,13 +144,7 @@ pub fn nodes_1d(a: Real, b: Real, n: usize, grading: Grading) -> Result<Vec<Real
 /// Geometric sizes `h_k ∝ ratio^k`, scaled so that the largest is 1 (no overflow).
 fn geometric(a: Real, b: Real, n: usize, ratio: Real) -> Vec<Real> {
     let sizes: Vec<Real> = (0..n)
-        .map(|k| {
-            if ratio >= 1.0 {
-                (1.0 / ratio).powf((n - 1 - k) as Real)
-            } else {
-                ratio.powf(k as Real)
-            }
-        })
+        .map(|k| if ratio >= 1.0 { (1.0 / ratio).powf((n - 1 - k) as Real) } else { ratio.powf(k as Real) })
         .collect();
     let total: Real = sizes.iter().sum();
     let mut x = Vec::with_capacity(n + 1);
@@ -182,11 +165,7 @@ const REFINED_GROWTH: Real = 0.2;
 /// size `h = 1 / ratio` in the window, `h = 1` far from it, and `h` linear in between with a
 /// slope chosen so that neighbouring cells grow by [`REFINED_GROWTH`].
 fn refined(a: Real, b: Real, n: usize, center: Real, width: Real, ratio: Real) -> Vec<Real> {
-    let uniform = || {
-        (0..=n)
-            .map(|i| a + (b - a) * (i as Real / n as Real))
-            .collect()
-    };
+    let uniform = || (0..=n).map(|i| a + (b - a) * (i as Real / n as Real)).collect();
     if ratio == 1.0 {
         return uniform();
     }
@@ -259,11 +238,7 @@ fn refined(a: Real, b: Real, n: usize, center: Real, width: Real, ratio: Real) -
         let k = (he - hs) / (q - p);
         let tau = (t - cum[piece - 1]).max(0.0);
         // Solve ∫_0^y dt / (hs + k t) = tau.
-        let y = if (k * tau).abs() < 1e-12 {
-            hs * tau
-        } else {
-            hs * (k * tau).exp_m1() / k
-        };
+        let y = if (k * tau).abs() < 1e-12 { hs * tau } else { hs * (k * tau).exp_m1() / k };
         x.push((p + y).min(q));
     }
     x
@@ -271,16 +246,12 @@ fn refined(a: Real, b: Real, n: usize, center: Real, width: Real, ratio: Real) -
 
 /// Node coordinates of `[-1, 1]` in `2n` equal cells, exactly antisymmetric, `0` a node.
 fn symmetric_coords(n: usize) -> Vec<Real> {
-    (0..=2 * n)
-        .map(|i| (i as Real - n as Real) / n as Real)
-        .collect()
+    (0..=2 * n).map(|i| (i as Real - n as Real) / n as Real).collect()
 }
 
 /// Node coordinates of `[-1, 0]` in `n` equal cells, `-1` and `0` exact.
 fn lower_half_coords(n: usize) -> Vec<Real> {
-    (0..=n)
-        .map(|i| (i as Real - n as Real) / n as Real)
-        .collect()
+    (0..=n).map(|i| (i as Real - n as Real) / n as Real).collect()
 }
 
 /// All permutations of `0..d` with their signs.
@@ -332,23 +303,15 @@ fn structured<const D: usize>(
     let mut n_hex: usize = 1;
     for ax in 0..D {
         if coords[ax].len() < 2 {
-            return Err(invalid(format!(
-                "{what}: axis {ax} needs at least one cell"
-            )));
+            return Err(invalid(format!("{what}: axis {ax} needs at least one cell")));
         }
         n[ax] = coords[ax].len() - 1;
         stride[ax] = n_nodes;
-        n_nodes = n_nodes
-            .checked_mul(n[ax] + 1)
-            .ok_or_else(|| invalid(format!("{what}: too many nodes")))?;
-        n_hex = n_hex
-            .checked_mul(n[ax])
-            .ok_or_else(|| invalid(format!("{what}: too many cells")))?;
+        n_nodes = n_nodes.checked_mul(n[ax] + 1).ok_or_else(|| invalid(format!("{what}: too many nodes")))?;
+        n_hex = n_hex.checked_mul(n[ax]).ok_or_else(|| invalid(format!("{what}: too many cells")))?;
     }
     let perms = permutations(D);
-    n_hex
-        .checked_mul(perms.len() * (D + 1))
-        .ok_or_else(|| invalid(format!("{what}: too many cells")))?;
+    n_hex.checked_mul(perms.len() * (D + 1)).ok_or_else(|| invalid(format!("{what}: too many cells")))?;
 
     let index = |m: &[usize; D]| -> usize { (0..D).map(|ax| m[ax] * stride[ax]).sum() };
     let unflatten = |mut i: usize, dims: &[usize; D]| -> [usize; D] {
@@ -448,9 +411,7 @@ fn check_center<const D: usize>(what: &str, center: &Point<D>) -> Result<(), Mes
     if center.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
-        Err(invalid(format!(
-            "{what}: center has a non-finite coordinate"
-        )))
+        Err(invalid(format!("{what}: center has a non-finite coordinate")))
     }
 }
 
@@ -458,9 +419,7 @@ fn check_positive(what: &str, name: &str, value: Real) -> Result<(), MeshError> 
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(invalid(format!(
-            "{what}: {name} must be positive and finite, got {value}"
-        )))
+        Err(invalid(format!("{what}: {name} must be positive and finite, got {value}")))
     }
 }
 
@@ -495,12 +454,7 @@ pub fn rectangle(
         &coords,
         [false; 2],
         |p| *p,
-        &[
-            ("left", &[(0, false)]),
-            ("right", &[(0, true)]),
-            ("bottom", &[(1, false)]),
-            ("top", &[(1, true)]),
-        ],
+        &[("left", &[(0, false)]), ("right", &[(0, true)]), ("bottom", &[(1, false)]), ("top", &[(1, true)])],
     )
 }
 
@@ -511,12 +465,7 @@ pub fn rectangle(
 /// Boundary parts (all [`BoundaryKind::TractionFree`]): `"left"` / `"right"` (`x = lo[0]` /
 /// `x = hi[0]`), `"front"` / `"back"` (`y = lo[1]` / `y = hi[1]`), `"bottom"` / `"top"`
 /// (`z = lo[2]` / `z = hi[2]`).
-pub fn box_mesh(
-    lo: [Real; 3],
-    hi: [Real; 3],
-    n: [usize; 3],
-    g: [Grading; 3],
-) -> Result<Mesh<3>, MeshError> {
+pub fn box_mesh(lo: [Real; 3], hi: [Real; 3], n: [usize; 3], g: [Grading; 3]) -> Result<Mesh<3>, MeshError> {
     let coords = [
         nodes_1d(lo[0], hi[0], n[0], g[0])?,
         nodes_1d(lo[1], hi[1], n[1], g[1])?,
@@ -575,10 +524,7 @@ pub fn half_disc(center: Point<2>, radius: Real, n: usize) -> Result<Mesh<2>, Me
         &coords,
         [true; 2],
         |p| center + squircle(p) * radius,
-        &[
-            ("arc", &[(0, false), (0, true), (1, false)]),
-            ("top", &[(1, true)]),
-        ],
+        &[("arc", &[(0, false), (0, true), (1, false)]), ("top", &[(1, true)])],
     )
 }
 
@@ -593,26 +539,9 @@ pub fn ball(center: Point<3>, radius: Real, n: usize) -> Result<Mesh<3>, MeshErr
     check_center("ball", &center)?;
     check_positive("ball", "radius", radius)?;
     check_count("ball", "n", n)?;
-    let coords = [
-        symmetric_coords(n),
-        symmetric_coords(n),
-        symmetric_coords(n),
-    ];
-    let all: [Side; 6] = [
-        (0, false),
-        (0, true),
-        (1, false),
-        (1, true),
-        (2, false),
-        (2, true),
-    ];
-    structured(
-        "ball",
-        &coords,
-        [true; 3],
-        |p| center + squircle(p) * radius,
-        &[("boundary", &all)],
-    )
+    let coords = [symmetric_coords(n), symmetric_coords(n), symmetric_coords(n)];
+    let all: [Side; 6] = [(0, false), (0, true), (1, false), (1, true), (2, false), (2, true)];
+    structured("ball", &coords, [true; 3], |p| center + squircle(p) * radius, &[("boundary", &all)])
 }
 
 /// The lower hemisphere `{|x − center| ≤ radius, z ≤ center_z}`: a sphere resting on a flat,
@@ -626,11 +555,7 @@ pub fn hemisphere(center: Point<3>, radius: Real, n: usize) -> Result<Mesh<3>, M
     check_center("hemisphere", &center)?;
     check_positive("hemisphere", "radius", radius)?;
     check_count("hemisphere", "n", n)?;
-    let coords = [
-        symmetric_coords(n),
-        symmetric_coords(n),
-        lower_half_coords(n),
-    ];
+    let coords = [symmetric_coords(n), symmetric_coords(n), lower_half_coords(n)];
     let cap: [Side; 5] = [(0, false), (0, true), (1, false), (1, true), (2, false)];
     structured(
         "hemisphere",
@@ -657,12 +582,7 @@ pub fn half_disc_refined(
     check_positive("half_disc_refined", "refine_radius", refine_radius)?;
     let mesh = half_disc(center, radius, n)?;
     let proj = SphereProjection::new(center, radius)?;
-    refine_toward(
-        &mesh,
-        |x| (x - refine_center).norm() <= refine_radius,
-        levels,
-        &proj,
-    )
+    refine_toward(&mesh, |x| (x - refine_center).norm() <= refine_radius, levels, &proj)
 }
 
 /// [`hemisphere`] refined `levels` times toward the ball `|x − refine_center| ≤ refine_radius`
@@ -681,23 +601,12 @@ pub fn hemisphere_refined(
     check_positive("hemisphere_refined", "refine_radius", refine_radius)?;
     let mesh = hemisphere(center, radius, n)?;
     let proj = SphereProjection::new(center, radius)?;
-    refine_toward(
-        &mesh,
-        |x| (x - refine_center).norm() <= refine_radius,
-        levels,
-        &proj,
-    )
+    refine_toward(&mesh, |x| (x - refine_center).norm() <= refine_radius, levels, &proj)
 }
 
-fn check_layers(
-    what: &str,
-    radii: &[Real],
-    n_radial: &[usize],
-) -> Result<Vec<Vec<Real>>, MeshError> {
+fn check_layers(what: &str, radii: &[Real], n_radial: &[usize]) -> Result<Vec<Vec<Real>>, MeshError> {
     if radii.len() < 2 {
-        return Err(invalid(format!(
-            "{what}: need at least two radii (one layer)"
-        )));
+        return Err(invalid(format!("{what}: need at least two radii (one layer)")));
     }
     if n_radial.len() + 1 != radii.len() {
         return Err(invalid(format!(
@@ -753,9 +662,7 @@ pub fn layered_arc_2d(
     let (t0, t1) = angle_range;
     let span = t1 - t0;
     if !(t0.is_finite() && t1.is_finite() && span > 0.0 && span < 2.0 * std::f64::consts::PI) {
-        return Err(invalid(format!(
-            "{what}: need finite angles with 0 < θ1 − θ0 < 2π, got ({t0}, {t1})"
-        )));
+        return Err(invalid(format!("{what}: need finite angles with 0 < θ1 − θ0 < 2π, got ({t0}, {t1})")));
     }
     check_count(what, "n_angle", n_angle)?;
     let radial = check_layers(what, radii, n_radial)?;
@@ -809,9 +716,7 @@ pub fn layered_cap_3d(
     let what = "layered_cap_3d";
     check_center(what, &center)?;
     if !(half_angle.is_finite() && half_angle > 0.0 && half_angle < std::f64::consts::PI) {
-        return Err(invalid(format!(
-            "{what}: need 0 < half_angle < π, got {half_angle}"
-        )));
+        return Err(invalid(format!("{what}: need 0 < half_angle < π, got {half_angle}")));
     }
     check_count(what, "n_surface", n_surface)?;
     let radial = check_layers(what, radii, n_radial)?;
@@ -837,11 +742,7 @@ pub fn layered_cap_3d(
                 &coords,
                 [true, true, false],
                 |p| center + direction(p[0], p[1]) * p[2],
-                &[
-                    ("inner", &[(2, false)]),
-                    ("outer", &[(2, true)]),
-                    ("rim", &rim),
-                ],
+                &[("inner", &[(2, false)]), ("outer", &[(2, true)]), ("rim", &rim)],
             )
         })
         .collect()

@@ -29,11 +29,7 @@ pub fn match_nodes<const D: usize>(
     second: &[Point<D>],
     tol: Real,
 ) -> Result<Vec<(usize, usize)>, UnmatchedNodes> {
-    let cell = if tol > 0.0 && tol.is_finite() {
-        2.0 * tol
-    } else {
-        Real::MIN_POSITIVE
-    };
+    let cell = if tol > 0.0 && tol.is_finite() { 2.0 * tol } else { Real::MIN_POSITIVE };
     let key = |p: &Point<D>| -> [i64; 3] {
         let mut k = [0i64; 3];
         for (d, kd) in k.iter_mut().enumerate().take(D) {
@@ -78,10 +74,7 @@ pub fn match_nodes<const D: usize>(
     if unmatched_first.is_empty() && unmatched_second.is_empty() {
         Ok(pairs)
     } else {
-        Err(UnmatchedNodes {
-            first: unmatched_first,
-            second: unmatched_second,
-        })
+        Err(UnmatchedNodes { first: unmatched_first, second: unmatched_second })
     }
 }
 
@@ -104,14 +97,8 @@ mod tests {
 
     #[test]
     fn matches_permuted_points_and_reports_strays() {
-        let a: Vec<Point<2>> = (0..10)
-            .map(|i| Point::<2>::new(i as f64 * 0.1, 1.0))
-            .collect();
-        let mut b: Vec<Point<2>> = a
-            .iter()
-            .rev()
-            .map(|p| p + Point::<2>::new(1e-9, 0.0))
-            .collect();
+        let a: Vec<Point<2>> = (0..10).map(|i| Point::<2>::new(i as f64 * 0.1, 1.0)).collect();
+        let mut b: Vec<Point<2>> = a.iter().rev().map(|p| p + Point::<2>::new(1e-9, 0.0)).collect();
         let pairs = match_nodes(&a, &b, 1e-6).expect("all match");
         for (i, j) in pairs {
             assert!((a[i] - b[j]).norm() < 1e-6);

@@ -119,12 +119,8 @@ impl<const D: usize> Mesh<D> {
         for c in 0..mesh.n_cells() {
             match mesh.cell_orientation(c) {
                 CellOrientation::Positive => {}
-                CellOrientation::Inverted(det) => {
-                    return Err(MeshError::InvertedCell { cell: c, det })
-                }
-                CellOrientation::Degenerate(det) => {
-                    return Err(MeshError::DegenerateCell { cell: c, det })
-                }
+                CellOrientation::Inverted(det) => return Err(MeshError::InvertedCell { cell: c, det }),
+                CellOrientation::Degenerate(det) => return Err(MeshError::DegenerateCell { cell: c, det }),
             }
         }
         Ok(mesh)
@@ -133,10 +129,7 @@ impl<const D: usize> Mesh<D> {
     /// Like [`Mesh::new`], but flips inverted cells (swapping their last two nodes) instead of
     /// failing. Degenerate cells are still an error. Returns the mesh and the number of flipped
     /// cells.
-    pub fn new_with_repair(
-        nodes: Vec<Point<D>>,
-        cells: Vec<usize>,
-    ) -> Result<(Self, usize), MeshError> {
+    pub fn new_with_repair(nodes: Vec<Point<D>>, cells: Vec<usize>) -> Result<(Self, usize), MeshError> {
         let mut mesh = Self::unchecked(nodes, cells)?;
         let flipped = mesh.repair_orientation()?;
         Ok((mesh, flipped))
@@ -151,10 +144,7 @@ impl<const D: usize> Mesh<D> {
         }
         let per = D + 1;
         if cells.len() % per != 0 {
-            return Err(MeshError::RaggedCells {
-                len: cells.len(),
-                per_cell: per,
-            });
+            return Err(MeshError::RaggedCells { len: cells.len(), per_cell: per });
         }
         if cells.is_empty() {
             return Err(MeshError::Empty);
@@ -162,22 +152,14 @@ impl<const D: usize> Mesh<D> {
         for (cell, c) in cells.chunks_exact(per).enumerate() {
             for (i, &node) in c.iter().enumerate() {
                 if node >= nodes.len() {
-                    return Err(MeshError::NodeOutOfRange {
-                        cell,
-                        node,
-                        n_nodes: nodes.len(),
-                    });
+                    return Err(MeshError::NodeOutOfRange { cell, node, n_nodes: nodes.len() });
                 }
                 if c[..i].contains(&node) {
                     return Err(MeshError::RepeatedNode { cell, node });
                 }
             }
         }
-        Ok(Self {
-            nodes,
-            cells,
-            parts: Vec::new(),
-        })
+        Ok(Self { nodes, cells, parts: Vec::new() })
     }
 
     /// Classifies the orientation of cell `c` by its relative determinant `det / h^D`
@@ -220,9 +202,7 @@ impl<const D: usize> Mesh<D> {
                     self.cells.swap(c * per + D - 1, c * per + D);
                     flipped += 1;
                 }
-                CellOrientation::Degenerate(det) => {
-                    return Err(MeshError::DegenerateCell { cell: c, det })
-                }
+                CellOrientation::Degenerate(det) => return Err(MeshError::DegenerateCell { cell: c, det }),
             }
         }
         Ok(flipped)
@@ -324,9 +304,7 @@ impl<const D: usize> Mesh<D> {
 
     fn edge_lengths(&self) -> impl Iterator<Item = Real> + '_ {
         self.cells().flat_map(move |c| {
-            (0..=D).flat_map(move |i| {
-                (0..i).map(move |j| (self.nodes[c[i]] - self.nodes[c[j]]).norm())
-            })
+            (0..=D).flat_map(move |i| (0..i).map(move |j| (self.nodes[c[i]] - self.nodes[c[j]]).norm()))
         })
     }
 
@@ -347,10 +325,7 @@ impl<const D: usize> Mesh<D> {
             for opp in 0..=D {
                 let mut key: Vec<usize> = (0..=D).filter(|&k| k != opp).map(|k| cell[k]).collect();
                 key.sort_unstable();
-                count
-                    .entry(key)
-                    .and_modify(|e| e.2 += 1)
-                    .or_insert((c, opp, 1));
+                count.entry(key).and_modify(|e| e.2 += 1).or_insert((c, opp, 1));
             }
         }
         let mut out: Vec<BoundaryFacet> = count
@@ -370,10 +345,7 @@ impl<const D: usize> Mesh<D> {
     /// [`Mesh::facet_normal`] points out of the cell.
     pub fn oriented_face(&self, c: usize, opposite: usize) -> Vec<usize> {
         let cell = self.cell(c);
-        let mut face: Vec<usize> = (0..=D)
-            .filter(|&k| k != opposite)
-            .map(|k| cell[k])
-            .collect();
+        let mut face: Vec<usize> = (0..=D).filter(|&k| k != opposite).map(|k| cell[k]).collect();
         let n = self.facet_normal(&face);
         let to_opp = self.nodes[cell[opposite]] - self.nodes[face[0]];
         if n.dot(&to_opp) > 0.0 {
@@ -471,12 +443,7 @@ impl<const D: usize> Mesh<D> {
             key.sort_unstable();
             match index.get(&key) {
                 Some(bf) if f.len() == D => selected.push(bf.clone()),
-                _ => {
-                    return Err(MeshError::NotABoundaryFacet {
-                        part: name.to_string(),
-                        facet: f.clone(),
-                    })
-                }
+                _ => return Err(MeshError::NotABoundaryFacet { part: name.to_string(), facet: f.clone() }),
             }
         }
         self.insert_part(name, kind, selected)
@@ -500,13 +467,7 @@ impl<const D: usize> Mesh<D> {
             facets.extend_from_slice(&f.nodes);
             cells.push(f.cell);
         }
-        self.parts.push(BoundaryPart {
-            name: name.to_string(),
-            kind,
-            facets,
-            cells,
-            dim: D,
-        });
+        self.parts.push(BoundaryPart { name: name.to_string(), kind, facets, cells, dim: D });
         Ok(self.parts.last().expect("just pushed"))
     }
 
@@ -517,10 +478,7 @@ impl<const D: usize> Mesh<D> {
     }
 
     fn part_index(&self, name: &str) -> Result<usize, MeshError> {
-        self.parts
-            .iter()
-            .position(|p| p.name == name)
-            .ok_or_else(|| MeshError::UnknownPart(name.to_string()))
+        self.parts.iter().position(|p| p.name == name).ok_or_else(|| MeshError::UnknownPart(name.to_string()))
     }
 
     /// Changes the kind of the part called `name` (generators create geometric parts as
@@ -556,10 +514,7 @@ impl<const D: usize> Mesh<D> {
     }
 
     /// Outward unit nodal normals of any set of outward-oriented facets.
-    pub fn nodal_normals_of<'a>(
-        &self,
-        facets: impl Iterator<Item = &'a [usize]>,
-    ) -> Vec<(usize, Vector<D>)> {
+    pub fn nodal_normals_of<'a>(&self, facets: impl Iterator<Item = &'a [usize]>) -> Vec<(usize, Vector<D>)> {
         let mut acc: HashMap<usize, Vector<D>> = HashMap::new();
         for f in facets {
             let n = self.facet_area_normal(f);

@@ -209,11 +209,7 @@ pub fn refine_marked<const D: usize>(
     let mut midpoint: HashMap<Edge, usize> = HashMap::with_capacity(marked_sorted.len());
     for &e in &marked_sorted {
         let (a, b) = (&nodes[e.0], &nodes[e.1]);
-        let p = if boundary_edges.contains(&e) {
-            proj.midpoint(a, b)
-        } else {
-            (a + b) * 0.5
-        };
+        let p = if boundary_edges.contains(&e) { proj.midpoint(a, b) } else { (a + b) * 0.5 };
         midpoint.insert(e, new_nodes.len());
         new_nodes.push(p);
     }
@@ -362,9 +358,8 @@ pub fn refine_toward<const D: usize>(
     let weights = sample_weights(D);
     let mut current = mesh.clone();
     for _ in 0..levels {
-        let marked: Vec<bool> = (0..current.n_cells())
-            .map(|c| cell_touches(&current, c, &weights, &region))
-            .collect();
+        let marked: Vec<bool> =
+            (0..current.n_cells()).map(|c| cell_touches(&current, c, &weights, &region)).collect();
         if !marked.iter().any(|&m| m) {
             break;
         }

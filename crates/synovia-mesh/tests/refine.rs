@@ -7,8 +7,7 @@ use std::collections::HashSet;
 use common::*;
 use synovia_mesh::generators::{box_mesh, disc, hemisphere, rectangle, Grading};
 use synovia_mesh::refine::{
-    refine_marked, refine_toward, refine_uniform, BoundaryProjection, SphereProjection,
-    StraightMidpoint,
+    refine_marked, refine_toward, refine_uniform, BoundaryProjection, SphereProjection, StraightMidpoint,
 };
 use synovia_mesh::{BoundaryKind, Mesh, MeshError, Point, Real};
 
@@ -20,30 +19,18 @@ fn on_rectangle_boundary(p: &Point<2>, x1: Real, y1: Real) -> bool {
 }
 
 fn on_unit_box_boundary(p: &Point<3>) -> bool {
-    p.iter()
-        .any(|&x| x.abs() < 1e-12 || (x - 1.0).abs() < 1e-12)
+    p.iter().any(|&x| x.abs() < 1e-12 || (x - 1.0).abs() < 1e-12)
 }
 
 /// Part names, kinds and measures of a mesh.
-fn part_summary<const D: usize>(
-    mesh: &Mesh<D>,
-) -> Result<Vec<(String, BoundaryKind, Real)>, MeshError> {
+fn part_summary<const D: usize>(mesh: &Mesh<D>) -> Result<Vec<(String, BoundaryKind, Real)>, MeshError> {
     mesh.boundary_parts()
         .iter()
-        .map(|p| {
-            Ok((
-                p.name().to_string(),
-                p.kind(),
-                part_measure(mesh, p.name())?,
-            ))
-        })
+        .map(|p| Ok((p.name().to_string(), p.kind(), part_measure(mesh, p.name())?)))
         .collect()
 }
 
-fn assert_parts_preserved<const D: usize>(
-    before: &Mesh<D>,
-    after: &Mesh<D>,
-) -> Result<(), MeshError> {
+fn assert_parts_preserved<const D: usize>(before: &Mesh<D>, after: &Mesh<D>) -> Result<(), MeshError> {
     let (b, a) = (part_summary(before)?, part_summary(after)?);
     assert_eq!(b.len(), a.len());
     for ((nb, kb, mb), (na, ka, ma)) in b.iter().zip(&a) {
@@ -57,16 +44,9 @@ fn assert_parts_preserved<const D: usize>(
         f.sort_unstable();
         f
     };
-    let in_parts: HashSet<Vec<usize>> = after
-        .boundary_parts()
-        .iter()
-        .flat_map(|p| p.facets().map(sorted))
-        .collect();
-    let boundary: HashSet<Vec<usize>> = after
-        .boundary_facets()
-        .iter()
-        .map(|f| sorted(&f.nodes))
-        .collect();
+    let in_parts: HashSet<Vec<usize>> =
+        after.boundary_parts().iter().flat_map(|p| p.facets().map(sorted)).collect();
+    let boundary: HashSet<Vec<usize>> = after.boundary_facets().iter().map(|f| sorted(&f.nodes)).collect();
     assert_eq!(in_parts, boundary);
     Ok(())
 }
@@ -80,11 +60,7 @@ fn refine_toward_2d_rectangle_is_conforming_graded_and_keeps_quality() -> Result
     let region = |x: &Point<2>| (x - target).norm() <= 0.15;
     let fine = refine_toward(&coarse, region, 6, &StraightMidpoint)?;
 
-    assert!(
-        fine.n_cells() > 4 * coarse.n_cells(),
-        "{} cells",
-        fine.n_cells()
-    );
+    assert!(fine.n_cells() > 4 * coarse.n_cells(), "{} cells", fine.n_cells());
     assert_conforming(&fine, |p| on_rectangle_boundary(p, 2.0, 1.0));
     assert!(rel(fine.measure(), 2.0) < 1e-12, "area {}", fine.measure());
     assert!(rel(boundary_measure(&fine), 6.0) < 1e-12);
@@ -93,18 +69,12 @@ fn refine_toward_2d_rectangle_is_conforming_graded_and_keeps_quality() -> Result
     // Cells in the region shrink by sqrt(2) per level (6 levels: h0 / 8); far cells keep h0.
     let near = max_h_where(&fine, |x| (x - target).norm() < 0.1);
     let far = min_h_where(&fine, |x| (x - target).norm() > 1.0);
-    assert!(
-        near <= h0 / 8.0 * (1.0 + 1e-12),
-        "near h {near}, coarse h {h0}"
-    );
+    assert!(near <= h0 / 8.0 * (1.0 + 1e-12), "near h {near}, coarse h {h0}");
     assert!(rel(far, h0) < 1e-12, "far h {far}, coarse h {h0}");
 
     // Longest-edge bisection keeps the shape: radius ratio bounded from below.
     let q = min_quality(&fine);
-    assert!(
-        q >= 0.75 * q0,
-        "min radius ratio {q} after refinement, {q0} before"
-    );
+    assert!(q >= 0.75 * q0, "min radius ratio {q} after refinement, {q0} before");
     Ok(())
 }
 
@@ -117,17 +87,9 @@ fn refine_toward_3d_box_is_conforming_graded_and_keeps_quality() -> Result<(), M
     let region = |x: &Point<3>| (x - target).norm() <= 0.15;
     let fine = refine_toward(&coarse, region, 3, &StraightMidpoint)?;
 
-    assert!(
-        fine.n_cells() > 3 * coarse.n_cells() / 2,
-        "{} cells",
-        fine.n_cells()
-    );
+    assert!(fine.n_cells() > 3 * coarse.n_cells() / 2, "{} cells", fine.n_cells());
     assert_conforming(&fine, on_unit_box_boundary);
-    assert!(
-        rel(fine.measure(), 1.0) < 1e-12,
-        "volume {}",
-        fine.measure()
-    );
+    assert!(rel(fine.measure(), 1.0) < 1e-12, "volume {}", fine.measure());
     assert!(rel(boundary_measure(&fine), 6.0) < 1e-12);
     assert_parts_preserved(&coarse, &fine)?;
 
@@ -137,10 +99,7 @@ fn refine_toward_3d_box_is_conforming_graded_and_keeps_quality() -> Result<(), M
     assert!(rel(far, h0) < 1e-12, "far h {far}, coarse h {h0}");
 
     let q = min_quality(&fine);
-    assert!(
-        q >= 0.75 * q0,
-        "min radius ratio {q} after refinement, {q0} before"
-    );
+    assert!(q >= 0.75 * q0, "min radius ratio {q} after refinement, {q0} before");
     Ok(())
 }
 
@@ -220,10 +179,7 @@ fn inverting_projection_is_reported_not_hidden() -> Result<(), MeshError> {
     let m = rectangle(1.0, 2.0, 1.0, 2.0, 2, 2, U, U)?;
     let out = refine_uniform(&m, 1, &Flip);
     assert!(
-        matches!(
-            out,
-            Err(MeshError::InvertedCell { .. }) | Err(MeshError::DegenerateCell { .. })
-        ),
+        matches!(out, Err(MeshError::InvertedCell { .. }) | Err(MeshError::DegenerateCell { .. })),
         "{out:?}"
     );
     Ok(())
@@ -251,10 +207,7 @@ fn overlapping_parts_are_all_carried_over() -> Result<(), MeshError> {
     let r = refine_toward(&m, |x| x[0] < 0.3 && x[1] < 0.3, 3, &StraightMidpoint)?;
     assert_parts_preserved(&m, &r)?;
     assert!(rel(part_measure(&r, "lower_half")?, 2.0) < 1e-12);
-    assert_eq!(
-        r.boundary_part("everything")?.n_facets(),
-        r.boundary_facets().len()
-    );
+    assert_eq!(r.boundary_part("everything")?.n_facets(), r.boundary_facets().len());
     assert_eq!(r.boundary_part("lower_half")?.kind(), BoundaryKind::Contact);
     // Parts stay outward oriented.
     for f in r.boundary_part("lower_half")?.facets() {
@@ -267,10 +220,7 @@ fn overlapping_parts_are_all_carried_over() -> Result<(), MeshError> {
 
 #[test]
 fn sphere_projection_validates_and_projects() -> Result<(), MeshError> {
-    assert!(matches!(
-        SphereProjection::new(Point::<2>::zeros(), 0.0),
-        Err(MeshError::InvalidParameter(_))
-    ));
+    assert!(matches!(SphereProjection::new(Point::<2>::zeros(), 0.0), Err(MeshError::InvalidParameter(_))));
     assert!(matches!(
         SphereProjection::new(Point::<3>::zeros(), Real::NAN),
         Err(MeshError::InvalidParameter(_))
@@ -295,15 +245,9 @@ fn sphere_projection_on_hemisphere_keeps_cap_round_and_top_flat() -> Result<(), 
     assert!(max_sphere_deviation(&fine, "cap", &c, r)? < 1e-12);
     let top = fine.boundary_part("top")?;
     assert!(top.nodes().iter().all(|&i| fine.node(i)[2] == c[2]));
-    assert_conforming(&fine, |p| {
-        p[2] == c[2] || ((p - c).norm() - r).abs() < 1e-12
-    });
+    assert_conforming(&fine, |p| p[2] == c[2] || ((p - c).norm() - r).abs() < 1e-12);
     let exact = 2.0 * std::f64::consts::PI * r.powi(3) / 3.0;
     assert!(rel(fine.measure(), exact) < 0.6 * rel(coarse.measure(), exact));
-    assert!(
-        min_quality(&fine) > 0.25,
-        "min radius ratio {}",
-        min_quality(&fine)
-    );
+    assert!(min_quality(&fine) > 0.25, "min radius ratio {}", min_quality(&fine));
     Ok(())
 }

@@ -35,11 +35,7 @@ pub fn assert_conforming<const D: usize>(mesh: &Mesh<D>, on_boundary: impl Fn(&P
         }
     }
     for c in 0..mesh.n_cells() {
-        assert_eq!(
-            mesh.cell_orientation(c),
-            CellOrientation::Positive,
-            "cell {c}"
-        );
+        assert_eq!(mesh.cell_orientation(c), CellOrientation::Positive, "cell {c}");
         assert!(mesh.cell_measure(c) > 0.0, "cell {c}");
     }
 }
@@ -52,17 +48,12 @@ pub fn part_measure<const D: usize>(mesh: &Mesh<D>, name: &str) -> Result<Real, 
 
 /// Total measure of all boundary facets.
 pub fn boundary_measure<const D: usize>(mesh: &Mesh<D>) -> Real {
-    mesh.boundary_facets()
-        .iter()
-        .map(|f| mesh.facet_measure(&f.nodes))
-        .sum()
+    mesh.boundary_facets().iter().map(|f| mesh.facet_measure(&f.nodes)).sum()
 }
 
 /// Smallest radius ratio of the mesh.
 pub fn min_quality<const D: usize>(mesh: &Mesh<D>) -> Real {
-    (0..mesh.n_cells())
-        .map(|c| mesh.radius_ratio(c))
-        .fold(Real::INFINITY, Real::min)
+    (0..mesh.n_cells()).map(|c| mesh.radius_ratio(c)).fold(Real::INFINITY, Real::min)
 }
 
 /// Longest edge of a cell.
