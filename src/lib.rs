@@ -10,6 +10,9 @@
 //! | [`material`] (`synovia-material`) | constitutive laws `C⁽⁰⁾`, `C⁽¹⁾` (isotropic, transversely isotropic, anisotropic, Kelvin–Voigt) |
 //! | [`fem`] (`synovia-fem`) | P1 elements, constraints, assembly, sparse Cholesky, post-processing |
 //! | [`io`] (`synovia-io`) | VTU/PVD output for ParaView |
+//! | [`contact_ops`] (`synovia-contact`) | contact pairs, `B_hn`/`B_Ht`, the contact problem, `ContactSolver`, KKT checker |
+//! | [`pdas`] (`synovia-pdas`) | semismooth Newton / PDAS and AU-PDAS |
+//! | [`uzawa`] (`synovia-uzawa`) | Uzawa with MPRGP, and the dual QP on the interface |
 //!
 //! See `docs/architecture.md` for the crate graph and the path of data from mesh to solution,
 //! and the specification `spec/model.md` for the equations.
@@ -33,12 +36,18 @@
 //! ```
 #![warn(missing_docs)]
 
+pub use synovia_contact as contact_ops;
 pub use synovia_fem as fem;
 pub use synovia_io as io;
 pub use synovia_material as material;
 pub use synovia_mesh as mesh;
+pub use synovia_pdas as pdas;
+pub use synovia_uzawa as uzawa;
 
+pub mod contact;
+pub mod hertz;
 pub mod output;
+pub mod solvers;
 pub mod verification;
 
 /// The types most programs need.

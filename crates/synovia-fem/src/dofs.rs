@@ -476,20 +476,28 @@ impl<const D: usize> NodeGroup<D> {
         for (_, a) in self.dependent.iter_mut() {
             a.resize(k, 0.0);
         }
-        // null-space basis
+        // null-space basis: repeatedly take the coordinate axis with the largest component
+        // orthogonal to the constrained directions and the basis so far
         let mut basis: Vec<Vector<D>> = Vec::new();
-        for e in 0..D {
-            let mut v = Vector::<D>::zeros();
-            v[e] = 1.0;
-            for (q, _) in &self.ortho {
-                v -= q * q.dot(&v);
+        while basis.len() + k < D {
+            let mut best: Option<(Vector<D>, Real)> = None;
+            for e in 0..D {
+                let mut v = Vector::<D>::zeros();
+                v[e] = 1.0;
+                for (q, _) in &self.ortho {
+                    v -= q * q.dot(&v);
+                }
+                for b in &basis {
+                    v -= b * b.dot(&v);
+                }
+                let len = v.norm();
+                if best.as_ref().is_none_or(|(_, l)| len > *l) {
+                    best = Some((v, len));
+                }
             }
-            for b in &basis {
-                v -= b * b.dot(&v);
-            }
-            let len = v.norm();
-            if len > 1e-6 && basis.len() + k < D {
-                basis.push(v / len);
+            match best {
+                Some((v, len)) if len > 1e-8 => basis.push(v / len),
+                _ => break,
             }
         }
         self.n_dofs = basis.len();

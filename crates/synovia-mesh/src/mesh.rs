@@ -317,6 +317,34 @@ impl<const D: usize> Mesh<D> {
         Ok(())
     }
 
+    /// The mirror image of the mesh in the plane `x_axis = plane` (e.g. the upper of two
+    /// contacting cylinders from the lower one). Cells are re-oriented and boundary parts kept
+    /// (with their outward orientation).
+    pub fn reflected(&self, axis: usize, plane: Real) -> Result<Self, MeshError> {
+        if axis >= D || !plane.is_finite() {
+            return Err(MeshError::InvalidParameter(format!("reflection axis {axis} / plane {plane}")));
+        }
+        let nodes: Vec<Point<D>> = self
+            .nodes
+            .iter()
+            .map(|p| {
+                let mut q = *p;
+                q[axis] = 2.0 * plane - q[axis];
+                q
+            })
+            .collect();
+        let mut cells = self.cells.clone();
+        for c in cells.chunks_exact_mut(D + 1) {
+            c.swap(D - 1, D);
+        }
+        let parts = self
+            .parts
+            .iter()
+            .map(|p| (p.name.clone(), p.kind, p.facets().map(|f| f.to_vec()).collect()))
+            .collect();
+        Self::from_parts(nodes, cells, parts)
+    }
+
     /// All boundary facets: faces of exactly one cell, oriented outward.
     pub fn boundary_facets(&self) -> Vec<BoundaryFacet> {
         let mut count: HashMap<Vec<usize>, (usize, usize, u32)> = HashMap::new();

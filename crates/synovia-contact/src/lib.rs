@@ -1,0 +1,32 @@
+//! # synovia-contact
+//!
+//! Unilateral contact with Coulomb friction frozen to Tresca friction at each time level
+//! (spec §3–§5): the discrete operators `B_hn` (normal, one row per contact node) and `B_Ht`
+//! (tangential, per friction cell), the lumped weights `κ`, the gaps `d` and the slip bounds
+//! `g_c`; the algebraic [`ContactProblem`] of spec §5
+//!
+//! ```text
+//! A U + B_hnᵀ diag(κ) Λ_n + B_Htᵀ Λ_t − F = 0
+//! Λ_n − (Λ_n + ρ (B_hn U − d))⁺          = 0
+//! Λ_t − π(Λ_t + ρ B_Ht (U − U_prev))      = 0
+//! ```
+//!
+//! its condensation on the contact interface ([`Interface`], spec §6.4), the
+//! [`ContactSolver`] trait implemented by `synovia-pdas` and `synovia-uzawa`, and the KKT checker
+//! [`check_kkt`].
+#![warn(missing_docs)]
+
+pub mod error;
+pub mod kkt;
+pub mod nested;
+pub mod operators;
+pub mod problem;
+pub mod rows;
+pub mod solver;
+pub mod testing;
+
+pub use error::{ContactError, IterationResidual};
+pub use kkt::{check_kkt, KktReport};
+pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
+pub use rows::SparseRows;
+pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};

@@ -1,0 +1,597 @@
+//! Contact pairs and the discrete contact operators of spec §5.
+//!
+//! A [`ContactPair`] joins the contact part of a body `k` either to the contact part of another
+//! body `l` with nodes at matching positions (node-to-node, the conforming case of the report),
+//! or to a rigid obstacle described by a signed-distance function (the foundation case). For
+//! every contact node `s_r` of body `k` [`ContactGeometry`] stores
+//!
+//! * the normal `n_r` (the outward nodal normal `n^k` of body `k`, spec §1, or a fixed
+//!   direction), and an orthonormal tangent basis,
+//! * the lumped weight `κ_r = ∫_{Γ_c} φ_r ds` (row sums of the boundary mass of part `k`),
+//! * the initial gap `d_r = (x_l − x_k) · n_r` (node-to-node) or `d_r = φ(x_k)` (obstacle).
+//!
+//! From these, [`ContactGeometry::normal_constraints`] builds `B_hn` in the reduced unknowns of a
+//! [`DofMap`] (`(B_hn U)_r = [U_n](s_r) = n_r · (u^k(s_r) − u^l(s_r))`), and
+//! [`ContactGeometry::friction_constraints`] builds `B_Ht` on the dual cells of the contact nodes:
+//! `(B_Ht U)_r = g_{c,r} κ_r T_rᵀ [U_t](s_r)`, the cell integral `∫_{cell r} g_c [U_t] ds` with the
+//! nodal (lumped) rule, `T_r` the tangent basis (one vector in 2D, two in 3D), for the cells with
+//! `g_{c,r} > 0` only (spec §5: `λ_t` vanishes outside `supp g_c`).
+//!
+//! In 3D the report puts `λ_t` on the triangles `Δ_H` of a separate contact triangulation of
+//! size `H`; with `H = h` one 2-vector per contact triangle gives about twice as many
+//! tangential constraints as tangential unknowns, which violates the inf–sup condition. synovia
+//! uses the dual (median) cells of the contact nodes as the triangulation `Δ_H` in 2D and 3D,
+//! which keeps `B_Ht` of full rank and the semismooth Newton systems well posed.
+
+use std::fmt;
+use std::sync::Arc;
+
+use synovia_fem::{BodyId, DofMap, Model};
+use synovia_mesh::matching::match_nodes;
+use synovia_mesh::math::{Point, Real, Vector};
+
+use crate::error::ContactError;
+use crate::problem::{FrictionConstraints, NormalConstraints};
+use crate::rows::SparseRows;
+
+/// A rigid obstacle given by a signed distance `φ` (positive in the free space outside the
+/// obstacle, negative inside) and its gradient.
+pub trait SignedDistance<const D: usize>: Send + Sync + fmt::Debug {
+    /// `φ(x)`.
+    fn distance(&self, x: &Point<D>) -> Real;
+    /// `∇φ(x)`: the unit normal of the obstacle surface pointing into the free space.
+    fn gradient(&self, x: &Point<D>) -> Vector<D>;
+}
+
+/// The half-space `{(x − p) · n < 0}` is the obstacle; `n` points into the free space.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneObstacle<const D: usize> {
+    /// A point of the plane.
+    pub point: Point<D>,
+    /// Unit normal pointing out of the obstacle.
+    pub normal: Vector<D>,
+}
+
+impl<const D: usize> PlaneObstacle<D> {
+    /// A plane through `point` with normal `normal` (normalised; error if zero).
+    pub fn new(point: Point<D>, normal: Vector<D>) -> Result<Self, ContactError> {
+        let len = normal.norm();
+        if !(len.is_finite() && len > 0.0) || point.iter().any(|x| !x.is_finite()) {
+            return Err(ContactError::InvalidParameter(
+                "plane obstacle needs a finite point and a non-zero normal".into(),
+            ));
+        }
+        Ok(Self { point, normal: normal / len })
+    }
+}
+
+impl<const D: usize> SignedDistance<D> for PlaneObstacle<D> {
+    fn distance(&self, x: &Point<D>) -> Real {
+        (x - self.point).dot(&self.normal)
+    }
+    fn gradient(&self, _x: &Point<D>) -> Vector<D> {
+        self.normal
+    }
+}
+
+/// A rigid ball (circle in 2D) `|x − c| ≤ R`, or with `cavity = true` the outside of it (a
+/// spherical socket whose inside is free).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SphereObstacle<const D: usize> {
+    /// Centre.
+    pub center: Point<D>,
+    /// Radius `R > 0`.
+    pub radius: Real,
+    /// `true`: the body moves inside the sphere (socket); `false`: outside (ball).
+    pub cavity: bool,
+}
+
+impl<const D: usize> SignedDistance<D> for SphereObstacle<D> {
+    fn distance(&self, x: &Point<D>) -> Real {
+        let r = (x - self.center).norm();
+        if self.cavity {
+            self.radius - r
+        } else {
+            r - self.radius
+        }
+    }
+    fn gradient(&self, x: &Point<D>) -> Vector<D> {
+        let v = x - self.center;
+        let r = v.norm();
+        let g = if r > 0.0 { v / r } else { Vector::<D>::zeros() };
+        if self.cavity {
+            -g
+        } else {
+            g
+        }
+    }
+}
+
+/// A rigid infinite cylinder in 3D `dist(x, axis) ≤ R` (or its outside with `cavity`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CylinderObstacle {
+    /// A point of the axis.
+    pub point: Point<3>,
+    /// Unit axis direction.
+    pub axis: Vector<3>,
+    /// Radius.
+    pub radius: Real,
+    /// `true`: the free space is inside the cylinder.
+    pub cavity: bool,
+}
+
+impl SignedDistance<3> for CylinderObstacle {
+    fn distance(&self, x: &Point<3>) -> Real {
+        let v = x - self.point;
+        let r = (v - self.axis * v.dot(&self.axis)).norm();
+        if self.cavity {
+            self.radius - r
+        } else {
+            r - self.radius
+        }
+    }
+    fn gradient(&self, x: &Point<3>) -> Vector<3> {
+        let v = x - self.point;
+        let radial = v - self.axis * v.dot(&self.axis);
+        let r = radial.norm();
+        let g = if r > 0.0 { radial / r } else { Vector::<3>::zeros() };
+        if self.cavity {
+            -g
+        } else {
+            g
+        }
+    }
+}
+
+/// A user-defined obstacle from a closure returning `(φ(x), ∇φ(x))`.
+pub struct FnObstacle<const D: usize> {
+    f: DistanceFn<D>,
+}
+
+/// A closure `x ↦ (φ(x), ∇φ(x))`.
+pub type DistanceFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> (Real, Vector<D>) + Send + Sync>;
+
+impl<const D: usize> FnObstacle<D> {
+    /// Wraps `f(x) = (φ(x), ∇φ(x))`.
+    pub fn new(f: impl Fn(&Point<D>) -> (Real, Vector<D>) + Send + Sync + 'static) -> Self {
+        Self { f: Arc::new(f) }
+    }
+}
+
+impl<const D: usize> fmt::Debug for FnObstacle<D> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("FnObstacle")
+    }
+}
+
+impl<const D: usize> SignedDistance<D> for FnObstacle<D> {
+    fn distance(&self, x: &Point<D>) -> Real {
+        (self.f)(x).0
+    }
+    fn gradient(&self, x: &Point<D>) -> Vector<D> {
+        (self.f)(x).1
+    }
+}
+
+/// Which normal a node-to-node pair uses.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum NormalChoice<const D: usize> {
+    /// The outward nodal normal `n^k` of body `k` (spec §1; default).
+    BodyK,
+    /// A fixed unit direction from body `k` toward body `l` for every node.
+    Fixed(Vector<D>),
+}
+
+/// What the contact part of body `k` touches.
+#[derive(Debug, Clone)]
+pub enum Partner<const D: usize> {
+    /// The contact part `part` of body `body`, with nodes at matching positions.
+    Body {
+        /// The other body `l`.
+        body: BodyId,
+        /// Its contact part.
+        part: String,
+        /// Pairing direction: nodes are paired when their positions agree after projecting out
+        /// this direction (default: the mean outward normal of part `k`).
+        direction: Option<Vector<D>>,
+        /// Pairing tolerance (absolute; default `1e-6 ×` the shortest facet edge of part `k`).
+        tolerance: Option<Real>,
+        /// Normal used for the pairs.
+        normal: NormalChoice<D>,
+    },
+    /// A rigid obstacle.
+    Rigid(Arc<dyn SignedDistance<D>>),
+}
+
+/// A contact pair `Γ_c^{kl}` (spec §1, §3).
+#[derive(Debug, Clone)]
+pub struct ContactPair<const D: usize> {
+    /// Name for reports and errors.
+    pub name: String,
+    /// Body `k` (whose outward normal is `n`).
+    pub body: BodyId,
+    /// Its contact part.
+    pub part: String,
+    /// The partner.
+    pub partner: Partner<D>,
+    /// Coulomb coefficient `F_c ≥ 0` (0: frictionless).
+    pub friction: Real,
+}
+
+impl<const D: usize> ContactPair<D> {
+    /// Body–body node-to-node pair with default pairing direction, tolerance and normal.
+    pub fn node_to_node(name: &str, body_k: BodyId, part_k: &str, body_l: BodyId, part_l: &str) -> Self {
+        Self {
+            name: name.to_string(),
+            body: body_k,
+            part: part_k.to_string(),
+            partner: Partner::Body {
+                body: body_l,
+                part: part_l.to_string(),
+                direction: None,
+                tolerance: None,
+                normal: NormalChoice::BodyK,
+            },
+            friction: 0.0,
+        }
+    }
+    /// Body–rigid-obstacle pair.
+    pub fn rigid(name: &str, body: BodyId, part: &str, obstacle: Arc<dyn SignedDistance<D>>) -> Self {
+        Self {
+            name: name.to_string(),
+            body,
+            part: part.to_string(),
+            partner: Partner::Rigid(obstacle),
+            friction: 0.0,
+        }
+    }
+    /// Sets the Coulomb coefficient.
+    #[must_use]
+    pub fn with_friction(mut self, coefficient: Real) -> Self {
+        self.friction = coefficient;
+        self
+    }
+    /// Uses a fixed normal (and pairing direction) for a node-to-node pair.
+    #[must_use]
+    pub fn with_fixed_normal(mut self, direction: Vector<D>) -> Self {
+        if let Partner::Body { normal, direction: dir, .. } = &mut self.partner {
+            *normal = NormalChoice::Fixed(direction);
+            *dir = Some(direction);
+        }
+        self
+    }
+}
+
+/// One contact node `s_r`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactNode<const D: usize> {
+    /// Index of the pair it belongs to.
+    pub pair: usize,
+    /// Body `k` and node.
+    pub node: (BodyId, usize),
+    /// Partner node on body `l` (node-to-node), or `None` (rigid obstacle).
+    pub partner: Option<(BodyId, usize)>,
+    /// Position of the node of body `k`.
+    pub position: Point<D>,
+    /// Unit normal `n_r`.
+    pub normal: Vector<D>,
+    /// Orthonormal tangents (`D − 1` used).
+    pub tangents: [Vector<D>; 2],
+    /// Lumped weight `κ_r`.
+    pub weight: Real,
+    /// Initial gap `d_r`.
+    pub gap: Real,
+    /// Coulomb coefficient of the pair.
+    pub friction: Real,
+}
+
+/// The geometry of all contact pairs of a model: the contact nodes with normals, weights, gaps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactGeometry<const D: usize> {
+    /// Pair names, with the range of their nodes in `nodes`.
+    pub pairs: Vec<(String, std::ops::Range<usize>)>,
+    /// All contact nodes, pair by pair.
+    pub nodes: Vec<ContactNode<D>>,
+    /// Neighbours of each contact node (nodes sharing a contact facet of body `k`), for nested
+    /// iteration ([`crate::nested`]).
+    pub adjacency: Vec<Vec<usize>>,
+}
+
+/// The friction operator for given slip bounds: constraints plus the contact node of each cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrictionOperator {
+    /// `B_Ht` rows and shift.
+    pub constraints: FrictionConstraints,
+    /// `cell_node[c]` = index (into [`ContactGeometry::nodes`]) of the node of friction cell `c`.
+    pub cell_node: Vec<usize>,
+    /// `g_c` of each cell.
+    pub slip_bound: Vec<Real>,
+}
+
+fn tangent_basis<const D: usize>(n: &Vector<D>) -> [Vector<D>; 2] {
+    let mut t = [Vector::<D>::zeros(); 2];
+    if D == 2 {
+        t[0][0] = -n[1];
+        t[0][1] = n[0];
+    } else if D == 3 {
+        // axis least aligned with n
+        let k = (0..3).min_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs())).unwrap_or(0);
+        let mut e = Vector::<D>::zeros();
+        e[k] = 1.0;
+        let t1 = e - n * n.dot(&e);
+        let t1 = t1 / t1.norm();
+        let t2 = Vector::<D>::from_fn(|i, _| {
+            let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+            n[a] * t1[b] - n[b] * t1[a]
+        });
+        t[0] = t1;
+        t[1] = t2;
+    }
+    t
+}
+
+impl<const D: usize> ContactGeometry<D> {
+    /// Builds the contact nodes of every pair.
+    pub fn new(model: &Model<D>, pairs: &[ContactPair<D>]) -> Result<Self, ContactError> {
+        let mut nodes = Vec::new();
+        let mut ranges = Vec::new();
+        let mut adjacency: Vec<Vec<usize>> = Vec::new();
+        for (pi, pair) in pairs.iter().enumerate() {
+            let invalid = |reason: String| ContactError::InvalidPair { pair: pair.name.clone(), reason };
+            if !(pair.friction.is_finite() && pair.friction >= 0.0) {
+                return Err(invalid(format!(
+                    "friction coefficient {} must be finite and ≥ 0",
+                    pair.friction
+                )));
+            }
+            let body = model.body(pair.body)?;
+            let part = body.mesh.boundary_part(&pair.part)?;
+            let start = nodes.len();
+            // lumped weights and nodal normals of part k
+            let mut weight = std::collections::HashMap::new();
+            let mut min_edge = Real::INFINITY;
+            for f in part.facets() {
+                let m = body.mesh.facet_measure(f) / D as Real;
+                for (a, &i) in f.iter().enumerate() {
+                    *weight.entry(i).or_insert(0.0) += m;
+                    for &j in &f[..a] {
+                        min_edge = min_edge.min((body.mesh.node(i) - body.mesh.node(j)).norm());
+                    }
+                }
+            }
+            let normals = body.mesh.nodal_normals(&pair.part)?;
+            match &pair.partner {
+                Partner::Rigid(obstacle) => {
+                    for (i, nk) in normals {
+                        let x = *body.mesh.node(i);
+                        let phi = obstacle.distance(&x);
+                        let grad = obstacle.gradient(&x);
+                        let gl = grad.norm();
+                        if !(phi.is_finite() && gl.is_finite() && gl > 0.0) {
+                            return Err(invalid(format!(
+                                "obstacle distance or gradient not finite/zero at node {i}"
+                            )));
+                        }
+                        let n = -grad / gl;
+                        if n.dot(&nk) <= 0.0 {
+                            return Err(invalid(format!(
+                                "at node {i} the obstacle faces away from the body (outward normal · obstacle normal = {:.3} ≤ 0)",
+                                n.dot(&nk)
+                            )));
+                        }
+                        nodes.push(ContactNode {
+                            pair: pi,
+                            node: (pair.body, i),
+                            partner: None,
+                            position: x,
+                            normal: n,
+                            tangents: tangent_basis(&n),
+                            weight: weight.get(&i).copied().unwrap_or(0.0),
+                            gap: phi,
+                            friction: pair.friction,
+                        });
+                    }
+                }
+                Partner::Body { body: bl, part: pl, direction, tolerance, normal } => {
+                    let other = model.body(*bl)?;
+                    let lpart = other.mesh.boundary_part(pl)?;
+                    let lnodes = lpart.nodes();
+                    let mean_n: Vector<D> = normals.iter().fold(Vector::<D>::zeros(), |a, (_, n)| a + n);
+                    let e = direction.unwrap_or(mean_n);
+                    let el = e.norm();
+                    if !(el.is_finite() && el > 0.0) {
+                        return Err(invalid("pairing direction is zero".into()));
+                    }
+                    let e = e / el;
+                    let proj = |x: &Point<D>| x - e * x.dot(&e);
+                    let knodes: Vec<usize> = normals.iter().map(|(i, _)| *i).collect();
+                    let xk: Vec<Point<D>> = knodes.iter().map(|&i| proj(body.mesh.node(i))).collect();
+                    let xl: Vec<Point<D>> = lnodes.iter().map(|&i| proj(other.mesh.node(i))).collect();
+                    let tol = tolerance.unwrap_or(1e-6 * min_edge);
+                    let pairs_found = match match_nodes(&xk, &xl, tol) {
+                        Ok(p) => p,
+                        Err(u) => {
+                            if !u.first.is_empty() {
+                                return Err(ContactError::UnmatchedNodes {
+                                    pair: pair.name.clone(),
+                                    body: body.name.clone(),
+                                    count: u.first.len(),
+                                    nodes: u.first.iter().take(10).map(|&i| knodes[i]).collect(),
+                                });
+                            }
+                            // extra nodes on body l are allowed: redo the matching on the matched subset
+                            let used: std::collections::HashSet<usize> = u.second.iter().copied().collect();
+                            let keep: Vec<usize> = (0..lnodes.len()).filter(|j| !used.contains(j)).collect();
+                            let xl2: Vec<Point<D>> = keep.iter().map(|&j| xl[j]).collect();
+                            match_nodes(&xk, &xl2, tol)
+                                .map_err(|_| invalid("node pairing is ambiguous".into()))?
+                                .into_iter()
+                                .map(|(a, b)| (a, keep[b]))
+                                .collect()
+                        }
+                    };
+                    for (a, b) in pairs_found {
+                        let (i, j) = (knodes[a], lnodes[b]);
+                        let n = match normal {
+                            NormalChoice::BodyK => normals[a].1,
+                            NormalChoice::Fixed(v) => {
+                                let l = v.norm();
+                                if !(l.is_finite() && l > 0.0) {
+                                    return Err(invalid("fixed normal is zero".into()));
+                                }
+                                v / l
+                            }
+                        };
+                        let xk = *body.mesh.node(i);
+                        let xlj = *other.mesh.node(j);
+                        nodes.push(ContactNode {
+                            pair: pi,
+                            node: (pair.body, i),
+                            partner: Some((*bl, j)),
+                            position: xk,
+                            normal: n,
+                            tangents: tangent_basis(&n),
+                            weight: weight.get(&i).copied().unwrap_or(0.0),
+                            gap: (xlj - xk).dot(&n),
+                            friction: pair.friction,
+                        });
+                    }
+                }
+            }
+            if nodes.len() == start {
+                return Err(invalid("the contact part has no nodes".into()));
+            }
+            // adjacency of the new rows through the facets of part k
+            let row_of: std::collections::HashMap<usize, usize> =
+                (start..nodes.len()).map(|r| (nodes[r].node.1, r)).collect();
+            adjacency.resize(nodes.len(), Vec::new());
+            for f in part.facets() {
+                for &a in f {
+                    for &b in f {
+                        if let (Some(&ra), Some(&rb)) = (row_of.get(&a), row_of.get(&b)) {
+                            if ra != rb {
+                                adjacency[ra].push(rb);
+                            }
+                        }
+                    }
+                }
+            }
+            ranges.push((pair.name.clone(), start..nodes.len()));
+        }
+        for a in adjacency.iter_mut() {
+            a.sort_unstable();
+            a.dedup();
+        }
+        Ok(Self { pairs: ranges, nodes, adjacency })
+    }
+
+    /// Number of contact nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    /// `true` if there are no contact nodes.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// `(u^k − u^l)` of node `r` as reduced-row entries of `v · (u^k − u^l)` (plus the lift part).
+    fn relative_row(
+        &self,
+        dofs: &DofMap<D>,
+        lifts: &[Vector<D>],
+        r: usize,
+        v: &Vector<D>,
+    ) -> (Vec<(usize, Real)>, Real) {
+        let node = &self.nodes[r];
+        let mut entries = Vec::with_capacity(2 * D);
+        let gk = dofs.group_of(node.node.0, node.node.1);
+        let g = &dofs.groups()[gk];
+        for k in 0..g.n_dofs {
+            entries.push((g.first_dof + k, g.basis[k].dot(v)));
+        }
+        let mut lift = lifts[gk].dot(v);
+        if let Some((bl, j)) = node.partner {
+            let gl = dofs.group_of(bl, j);
+            let g = &dofs.groups()[gl];
+            for k in 0..g.n_dofs {
+                entries.push((g.first_dof + k, -g.basis[k].dot(v)));
+            }
+            lift -= lifts[gl].dot(v);
+        }
+        (entries, lift)
+    }
+
+    /// `B_hn`, `κ` and the reduced gaps `d − [u_p]_n` for the lifts `u_p` of prescribed
+    /// displacements at the current time.
+    pub fn normal_constraints(&self, dofs: &DofMap<D>, lifts: &[Vector<D>]) -> NormalConstraints {
+        let mut rows = SparseRows::new(dofs.n_dofs());
+        let mut weights = Vec::with_capacity(self.len());
+        let mut gap = Vec::with_capacity(self.len());
+        for r in 0..self.len() {
+            let n = self.nodes[r].normal;
+            let (entries, lift) = self.relative_row(dofs, lifts, r, &n);
+            rows.push_row(entries);
+            weights.push(self.nodes[r].weight);
+            gap.push(self.nodes[r].gap - lift);
+        }
+        NormalConstraints { rows, weights, gap }
+    }
+
+    /// Tresca slip bounds `g_{c,r} = F_c |Λ_n,r|` from nodal pressures (spec §3).
+    pub fn slip_bounds_from_pressure(&self, lambda_n: &[Real]) -> Vec<Real> {
+        self.nodes.iter().zip(lambda_n).map(|(n, l)| n.friction * l.abs()).collect()
+    }
+
+    /// `B_Ht` for the slip bounds `g_c` (one per contact node; cells with `g_c = 0` are left out),
+    /// with the shift `s = B_Ht (U_prev − u_p)` of incremental slip when the previous nodal
+    /// displacements `previous[body][node]` are given (spec §3: slip measured from the previous
+    /// time level).
+    pub fn friction_constraints(
+        &self,
+        dofs: &DofMap<D>,
+        lifts: &[Vector<D>],
+        slip_bound: &[Real],
+        previous: Option<&[Vec<Vector<D>>]>,
+    ) -> Result<FrictionOperator, ContactError> {
+        if slip_bound.len() != self.len() {
+            return Err(ContactError::InvalidParameter(format!(
+                "{} slip bounds for {} contact nodes",
+                slip_bound.len(),
+                self.len()
+            )));
+        }
+        let mut rows = SparseRows::new(dofs.n_dofs());
+        let mut shift = Vec::new();
+        let mut cell_node = Vec::new();
+        let mut bounds = Vec::new();
+        for (r, &g) in slip_bound.iter().enumerate() {
+            if !g.is_finite() || g < 0.0 {
+                return Err(ContactError::InvalidParameter(format!(
+                    "slip bound g_c = {g} at contact node {r}"
+                )));
+            }
+            if g == 0.0 {
+                continue;
+            }
+            let node = &self.nodes[r];
+            let scale = g * node.weight;
+            for t in node.tangents.iter().take(D - 1) {
+                let (entries, lift) = self.relative_row(dofs, lifts, r, t);
+                rows.push_row(entries.into_iter().map(|(c, v)| (c, scale * v)));
+                let prev = previous.map_or(0.0, |p| {
+                    let uk = p[node.node.0 .0][node.node.1];
+                    let ul = node.partner.map_or(Vector::<D>::zeros(), |(b, j)| p[b.0][j]);
+                    t.dot(&(uk - ul))
+                });
+                shift.push(scale * (prev - lift));
+            }
+            cell_node.push(r);
+            bounds.push(g);
+        }
+        Ok(FrictionOperator {
+            constraints: FrictionConstraints { rows, components: D - 1, shift },
+            cell_node,
+            slip_bound: bounds,
+        })
+    }
+}

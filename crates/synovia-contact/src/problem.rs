@@ -1,0 +1,313 @@
+//! The algebraic contact problem of spec §5 and its condensation on the contact interface
+//! (spec §6.4).
+//!
+//! ```text
+//! A U + B_hnᵀ diag(κ) Λ_n + B_Htᵀ Λ_t − F = 0
+//! Λ_n − (Λ_n + ρ (B_hn U − d))⁺          = 0
+//! Λ_t − π(Λ_t + ρ (B_Ht U − s))           = 0        (s = B_Ht U_prev: incremental slip)
+//! ```
+//!
+//! All solvers work with the *force multipliers* `ν = (κ Λ_n, Λ_t)` and the stacked operator
+//! `C = [B_hn; B_Ht]`: `U = A⁻¹ (F − Cᵀ ν)` and the interface values
+//! `y = C U = w − S ν` with `w = C A⁻¹ F` and the interface Schur complement
+//! `S = C A⁻¹ Cᵀ` (symmetric positive semi-definite). [`Interface`] evaluates `S` lazily: a
+//! column costs one solve with the factorisation of `A`, computed once and cached, so a solver
+//! pays only for the rows that ever become active.
+
+use std::time::Instant;
+
+use synovia_fem::{CholeskySolver, SymmetricMatrix};
+
+use crate::error::ContactError;
+use crate::rows::SparseRows;
+
+/// Normal contact constraints `[U_n](s_r) ≤ d_r`, one row per contact node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NormalConstraints {
+    /// `B_hn`: `(B_hn U)_r = [U_n](s_r)`.
+    pub rows: SparseRows,
+    /// Lumped weights `κ_r = ∫_{Γ_c} φ_r ds`.
+    pub weights: Vec<f64>,
+    /// Gaps `d_r` (in the reduced unknowns: the lift of prescribed displacements is already
+    /// subtracted).
+    pub gap: Vec<f64>,
+}
+
+/// Tangential (Tresca) constraints: one cell per row group of `components` rows (1 in 2D,
+/// 2 in 3D), `(B_Ht U)_r = g_{c,r} ∫_{cell r} [U_t] ds`, `‖Λ_t,r‖ ≤ 1`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrictionConstraints {
+    /// `B_Ht` (rows grouped by cell, `components` consecutive rows per cell).
+    pub rows: SparseRows,
+    /// Rows per cell: 1 (2D) or 2 (3D).
+    pub components: usize,
+    /// `s = B_Ht U_prev` (incremental slip; zero for slip measured from the reference state).
+    pub shift: Vec<f64>,
+}
+
+impl FrictionConstraints {
+    /// Number of cells.
+    pub fn n_cells(&self) -> usize {
+        self.rows.nrows() / self.components.max(1)
+    }
+}
+
+/// One contact problem of spec §5: `A`, its factorisation, `F`, and the contact operators.
+#[derive(Debug, Clone, Copy)]
+pub struct ContactProblem<'a> {
+    /// `A` (stiffness, or the time-step matrix), reduced unknowns.
+    pub matrix: &'a SymmetricMatrix,
+    /// A numeric factorisation of `matrix`.
+    pub factor: &'a CholeskySolver,
+    /// `F`.
+    pub load: &'a [f64],
+    /// Normal constraints.
+    pub normal: &'a NormalConstraints,
+    /// Friction constraints (`None`: frictionless).
+    pub friction: Option<&'a FrictionConstraints>,
+}
+
+impl<'a> ContactProblem<'a> {
+    /// Checks sizes and finiteness.
+    pub fn validate(&self) -> Result<(), ContactError> {
+        let n = self.matrix.n();
+        let bad = |m: String| Err(ContactError::InvalidParameter(m));
+        if self.factor.n() != n || self.load.len() != n {
+            return bad(format!("A is {n}×{n}, factor {} and load {}", self.factor.n(), self.load.len()));
+        }
+        let nc = &self.normal;
+        let m = nc.rows.nrows();
+        if nc.rows.ncols() != n || nc.weights.len() != m || nc.gap.len() != m {
+            return bad(format!(
+                "B_hn has {} rows × {} columns, κ {} and d {} entries (n = {n})",
+                m,
+                nc.rows.ncols(),
+                nc.weights.len(),
+                nc.gap.len()
+            ));
+        }
+        if let Some(i) = nc.weights.iter().position(|k| !(k.is_finite() && *k > 0.0)) {
+            return bad(format!("weight κ_{i} = {} must be positive", nc.weights[i]));
+        }
+        if let Some(i) = nc.gap.iter().position(|d| !d.is_finite()) {
+            return bad(format!("gap d_{i} is not finite"));
+        }
+        if self.load.iter().any(|f| !f.is_finite()) {
+            return bad("load vector is not finite".into());
+        }
+        if let Some(fr) = self.friction {
+            if !(fr.components == 1 || fr.components == 2)
+                || fr.rows.nrows() % fr.components != 0
+                || fr.shift.len() != fr.rows.nrows()
+                || fr.rows.ncols() != n
+            {
+                return bad(format!(
+                    "B_Ht has {} rows × {} columns with {} components per cell and {} shifts",
+                    fr.rows.nrows(),
+                    fr.rows.ncols(),
+                    fr.components,
+                    fr.shift.len()
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of normal rows `m_n`.
+    pub fn n_normal(&self) -> usize {
+        self.normal.rows.nrows()
+    }
+    /// Number of tangential rows (`m_t × components`).
+    pub fn n_tangential(&self) -> usize {
+        self.friction.map_or(0, |f| f.rows.nrows())
+    }
+    /// Rows per friction cell (1 in 2D, 2 in 3D; 1 if frictionless).
+    pub fn components(&self) -> usize {
+        self.friction.map_or(1, |f| f.components)
+    }
+    /// Total interface rows `m_n + m_t × components`.
+    pub fn n_rows(&self) -> usize {
+        self.n_normal() + self.n_tangential()
+    }
+
+    /// Row `r` of `C = [B_hn; B_Ht]`.
+    pub fn row(&self, r: usize) -> Box<dyn Iterator<Item = (usize, f64)> + '_> {
+        let m = self.n_normal();
+        if r < m {
+            Box::new(self.normal.rows.row(r))
+        } else {
+            match self.friction {
+                Some(f) => Box::new(f.rows.row(r - m)),
+                None => Box::new(std::iter::empty()),
+            }
+        }
+    }
+
+    /// `C x`.
+    pub fn apply(&self, x: &[f64]) -> Vec<f64> {
+        let mut y = self.normal.rows.mul(x);
+        if let Some(f) = self.friction {
+            y.extend(f.rows.mul(x));
+        }
+        y
+    }
+
+    /// `out += Cᵀ ν`.
+    pub fn apply_transpose_add(&self, nu: &[f64], out: &mut [f64]) {
+        let m = self.n_normal();
+        self.normal.rows.mul_transpose_add(&nu[..m], out);
+        if let Some(f) = self.friction {
+            f.rows.mul_transpose_add(&nu[m..], out);
+        }
+    }
+
+    /// The right-hand sides `g = (d, s)` of the interface conditions.
+    pub fn offsets(&self) -> Vec<f64> {
+        let mut g = self.normal.gap.clone();
+        if let Some(f) = self.friction {
+            g.extend_from_slice(&f.shift);
+        }
+        g
+    }
+
+    /// Complementarity parameters per interface row, from the scaling of `A`:
+    /// `ρ_r = scale · mean diag(A) / ‖C_r‖²` in force-multiplier units, which is the spec's
+    /// `ρ ≈ mean diag(A) / κ` for the normal rows. The solution does not depend on `ρ`.
+    pub fn default_rho(&self, scale: f64) -> Vec<f64> {
+        let diag = self.matrix.diagonal();
+        let mean = diag.iter().sum::<f64>() / diag.len().max(1) as f64;
+        (0..self.n_rows())
+            .map(|r| {
+                let nr: f64 = self.row(r).map(|(_, v)| v * v).sum();
+                if nr > 0.0 {
+                    scale * mean / nr
+                } else {
+                    scale * mean
+                }
+            })
+            .collect()
+    }
+
+    /// The multipliers of spec §5 from force multipliers: `Λ_n = ν_n / κ`, `Λ_t = ν_t`.
+    pub fn split_multipliers(&self, nu: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let m = self.n_normal();
+        let ln = nu[..m].iter().zip(&self.normal.weights).map(|(v, k)| v / k).collect();
+        (ln, nu[m..].to_vec())
+    }
+}
+
+/// Lazily evaluated interface Schur complement `S = C A⁻¹ Cᵀ` and the interface load
+/// `w = C A⁻¹ F` (spec §6.4).
+#[derive(Debug)]
+pub struct Interface<'a> {
+    problem: ContactProblem<'a>,
+    w: Vec<f64>,
+    columns: Vec<Option<Vec<f64>>>,
+    solves: usize,
+    solve_s: f64,
+}
+
+impl<'a> Interface<'a> {
+    /// Validates the problem and computes `w = C A⁻¹ F` (one solve).
+    pub fn new(problem: ContactProblem<'a>) -> Result<Self, ContactError> {
+        problem.validate()?;
+        let t0 = Instant::now();
+        let mut x = problem.load.to_vec();
+        problem.factor.solve_in_place(&mut x)?;
+        let w = problem.apply(&x);
+        let m = problem.n_rows();
+        Ok(Self { problem, w, columns: vec![None; m], solves: 1, solve_s: t0.elapsed().as_secs_f64() })
+    }
+
+    /// The problem.
+    pub fn problem(&self) -> &ContactProblem<'a> {
+        &self.problem
+    }
+    /// `w = C A⁻¹ F`.
+    pub fn w(&self) -> &[f64] {
+        &self.w
+    }
+    /// Number of interface rows.
+    pub fn n_rows(&self) -> usize {
+        self.columns.len()
+    }
+    /// Linear solves with `A` so far.
+    pub fn solves(&self) -> usize {
+        self.solves
+    }
+    /// Seconds spent in those solves (and the products with `C`).
+    pub fn solve_seconds(&self) -> f64 {
+        self.solve_s
+    }
+
+    /// Makes sure the columns `cols` of `S` are computed (batched solves, 32 right-hand sides
+    /// at a time).
+    pub fn ensure_columns(&mut self, cols: &[usize]) -> Result<(), ContactError> {
+        let missing: Vec<usize> = {
+            let mut v: Vec<usize> = cols.iter().copied().filter(|&j| self.columns[j].is_none()).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        };
+        if missing.is_empty() {
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        let n = self.problem.matrix.n();
+        for chunk in missing.chunks(32) {
+            let k = chunk.len();
+            let mut rhs = faer::Mat::<f64>::zeros(n, k);
+            for (c, &j) in chunk.iter().enumerate() {
+                for (i, v) in self.problem.row(j) {
+                    rhs[(i, c)] += v;
+                }
+            }
+            self.problem.factor.solve_many_in_place(rhs.as_mut())?;
+            self.solves += k;
+            for (c, &j) in chunk.iter().enumerate() {
+                let col: Vec<f64> = rhs.col(c).iter().copied().collect();
+                self.columns[j] = Some(self.problem.apply(&col));
+            }
+        }
+        self.solve_s += t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// Column `j` of `S` (must have been ensured).
+    pub fn column(&self, j: usize) -> Option<&[f64]> {
+        self.columns[j].as_deref()
+    }
+
+    /// `S ν`, computing the columns of the non-zero entries of `ν` if needed.
+    pub fn apply_s(&mut self, nu: &[f64]) -> Result<Vec<f64>, ContactError> {
+        let nz: Vec<usize> = (0..nu.len()).filter(|&j| nu[j] != 0.0).collect();
+        self.ensure_columns(&nz)?;
+        let mut out = vec![0.0; self.n_rows()];
+        for j in nz {
+            if let Some(col) = self.columns[j].as_deref() {
+                for (o, c) in out.iter_mut().zip(col) {
+                    *o += nu[j] * c;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Interface values `y = C U = w − S ν`.
+    pub fn interface_values(&mut self, nu: &[f64]) -> Result<Vec<f64>, ContactError> {
+        let s = self.apply_s(nu)?;
+        Ok(self.w.iter().zip(&s).map(|(w, s)| w - s).collect())
+    }
+
+    /// The displacement `U = A⁻¹ (F − Cᵀ ν)` (one solve).
+    pub fn displacement(&mut self, nu: &[f64]) -> Result<Vec<f64>, ContactError> {
+        let t0 = Instant::now();
+        let mut rhs = self.problem.load.to_vec();
+        let neg: Vec<f64> = nu.iter().map(|v| -v).collect();
+        self.problem.apply_transpose_add(&neg, &mut rhs);
+        self.problem.factor.solve_in_place(&mut rhs)?;
+        self.solves += 1;
+        self.solve_s += t0.elapsed().as_secs_f64();
+        Ok(rhs)
+    }
+}

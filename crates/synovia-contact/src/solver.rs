@@ -1,0 +1,75 @@
+//! The [`ContactSolver`] trait that every contact solver implements, its parameters and report.
+
+use crate::error::{ContactError, IterationResidual};
+use crate::problem::ContactProblem;
+
+/// Parameters shared by the contact solvers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactParams {
+    /// Stopping tolerance on the relative complementarity residuals (default `1e-10`).
+    pub tolerance: f64,
+    /// Maximum outer iterations (default `200`).
+    pub max_iterations: usize,
+    /// Scale of the complementarity parameter `ρ` relative to the automatic choice
+    /// `mean diag(A) / ‖C_r‖²` (default `1`). The solution does not depend on it.
+    pub rho_scale: f64,
+}
+
+impl Default for ContactParams {
+    fn default() -> Self {
+        Self { tolerance: 1e-10, max_iterations: 200, rho_scale: 1.0 }
+    }
+}
+
+/// What a solver did: iterations, residuals, set sizes, time.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SolverReport {
+    /// Solver name.
+    pub solver: String,
+    /// Outer iterations.
+    pub iterations: usize,
+    /// Inner iterations (projected-gradient steps, Uzawa inner solves), if any.
+    pub inner_iterations: usize,
+    /// Linear solves with the factorisation of `A`.
+    pub linear_solves: usize,
+    /// Residual history, one entry per outer iteration.
+    pub history: Vec<IterationResidual>,
+    /// Normal rows in contact (`Λ_n > 0` or active).
+    pub active: usize,
+    /// Friction cells sticking (`‖Λ_t‖ < 1`).
+    pub stick: usize,
+    /// Friction cells slipping (`‖Λ_t‖ = 1`).
+    pub slip: usize,
+    /// Wall time (s).
+    pub time_s: f64,
+}
+
+/// A solution of the contact problem of spec §5.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactSolution {
+    /// Displacement `U` (reduced unknowns).
+    pub u: Vec<f64>,
+    /// Normal multipliers `Λ_n` (contact pressure at the nodes), one per normal row.
+    pub lambda_n: Vec<f64>,
+    /// Tangential multipliers `Λ_t` (`components` per friction cell, `‖Λ_t‖ ≤ 1`); the
+    /// friction traction is `−g_c Λ_t`.
+    pub lambda_t: Vec<f64>,
+    /// What the solver did.
+    pub report: SolverReport,
+}
+
+/// A solver of the contact problem of spec §5 (frictionless or Tresca).
+///
+/// Implemented by the PDAS and AU-PDAS solvers (`synovia-pdas`) and the Uzawa solvers
+/// (`synovia-uzawa`). `warm_start` (a previous solution of a nearby problem with the same
+/// rows) seeds the multipliers and active sets.
+pub trait ContactSolver {
+    /// Short name for reports.
+    fn name(&self) -> &str;
+    /// Solves the problem. Errors carry the residual history when the iteration fails.
+    fn solve(
+        &self,
+        problem: &ContactProblem<'_>,
+        warm_start: Option<&ContactSolution>,
+    ) -> Result<ContactSolution, ContactError>;
+}

@@ -1,0 +1,135 @@
+//! Static contact problems of a [`Model`]: one elastic factorisation, the contact operators of
+//! every pair, and any [`ContactSolver`] (spec §4–§6).
+//!
+//! [`StaticContact`] factorises `A` once; each [`StaticContact::solve`] assembles the load and
+//! the lifts of prescribed displacements at the requested time, builds `B_hn` (and `B_Ht` for
+//! given slip bounds `g_c`), runs the solver, and maps the result back to nodal displacements
+//! per body and pressures per contact node.
+
+use synovia_contact::operators::{ContactGeometry, ContactPair};
+use synovia_contact::{
+    ContactError, ContactProblem, ContactSolution, ContactSolver, FrictionConstraints, KktReport,
+};
+use synovia_fem::{ElasticParams, ElasticSolver, Model};
+use synovia_mesh::math::{Real, Vector};
+
+/// A factorised model with its contact geometry.
+#[derive(Debug)]
+pub struct StaticContact<const D: usize> {
+    elastic: ElasticSolver<D>,
+    geometry: ContactGeometry<D>,
+    nested_min_rows: Option<usize>,
+}
+
+/// The result of one static contact solve.
+#[derive(Debug, Clone)]
+pub struct StaticContactResult<const D: usize> {
+    /// Nodal displacements per body.
+    pub displacement: Vec<Vec<Vector<D>>>,
+    /// The solver's solution (reduced `U`, `Λ_n` per contact node, `Λ_t` per friction cell).
+    pub solution: ContactSolution,
+    /// Contact node of each friction cell (index into the geometry's nodes).
+    pub cell_node: Vec<usize>,
+    /// `g_c` of each friction cell.
+    pub slip_bound: Vec<Real>,
+    /// The KKT residuals of the returned solution (spec §5).
+    pub kkt: KktReport,
+    /// Solver iterations spent on the coarse levels of the nested iteration (0 if none).
+    pub coarse_iterations: usize,
+}
+
+impl<const D: usize> StaticContact<D> {
+    /// Factorises the model's stiffness and builds the contact nodes of `pairs`.
+    pub fn new(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        params: ElasticParams,
+    ) -> Result<Self, ContactError> {
+        let elastic = ElasticSolver::new(model, params)?;
+        let geometry = ContactGeometry::new(model, pairs)?;
+        Ok(Self { elastic, geometry, nested_min_rows: Some(32) })
+    }
+
+    /// Nested iteration for cold starts ([`synovia_contact::nested`]): coarsen the contact rows
+    /// down to `min_rows` and use the coarse solutions as the warm start (default `Some(32)`);
+    /// `None` starts every solve from `Λ = 0`.
+    pub fn set_nested_iteration(&mut self, min_rows: Option<usize>) {
+        self.nested_min_rows = min_rows;
+    }
+
+    /// The elastic solver (dofs, stiffness, factorisation, timings).
+    pub fn elastic(&self) -> &ElasticSolver<D> {
+        &self.elastic
+    }
+    /// The contact nodes.
+    pub fn geometry(&self) -> &ContactGeometry<D> {
+        &self.geometry
+    }
+
+    /// Solves the contact problem at time `t` with slip bounds `slip_bound` (one per contact
+    /// node; `None` = frictionless) and slip measured from `previous` nodal displacements (if
+    /// given).
+    pub fn solve(
+        &self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        warm_start: Option<&ContactSolution>,
+    ) -> Result<StaticContactResult<D>, ContactError> {
+        let (load, lifts) = self.elastic.rhs(model, t)?;
+        let dofs = self.elastic.dofs();
+        let normal = self.geometry.normal_constraints(dofs, &lifts);
+        let friction_op = match slip_bound {
+            Some(g) => Some(self.geometry.friction_constraints(dofs, &lifts, g, previous)?),
+            None => None,
+        };
+        let friction: Option<&FrictionConstraints> =
+            friction_op.as_ref().map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0);
+        let problem = ContactProblem {
+            matrix: self.elastic.stiffness(),
+            factor: self.elastic.cholesky(),
+            load: &load,
+            normal: &normal,
+            friction,
+        };
+        let mut coarse_iterations = 0;
+        let nested = match (warm_start, self.nested_min_rows) {
+            (None, Some(min_rows)) => synovia_contact::nested::nested_warm_start(
+                &problem,
+                solver,
+                &self.geometry.adjacency,
+                min_rows,
+            )?,
+            _ => None,
+        };
+        if let Some((_, it)) = &nested {
+            coarse_iterations = *it;
+        }
+        let warm = warm_start.or(nested.as_ref().map(|(w, _)| w));
+        let solution = solver.solve(&problem, warm)?;
+        let kkt = synovia_contact::check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
+        let displacement = dofs.expand(&solution.u, &lifts)?;
+        let has_friction = friction.is_some();
+        let (cell_node, slip) = match friction_op {
+            Some(op) if has_friction => (op.cell_node, op.slip_bound),
+            _ => (Vec::new(), Vec::new()),
+        };
+        Ok(StaticContactResult {
+            displacement,
+            solution,
+            cell_node,
+            slip_bound: slip,
+            kkt,
+            coarse_iterations,
+        })
+    }
+}
+
+impl<const D: usize> StaticContactResult<D> {
+    /// Total normal contact force `Σ_r κ_r Λ_n,r` of the nodes in `range`.
+    pub fn normal_force(&self, geometry: &ContactGeometry<D>, range: std::ops::Range<usize>) -> Real {
+        range.map(|r| geometry.nodes[r].weight * self.solution.lambda_n[r]).sum()
+    }
+}

@@ -1,0 +1,526 @@
+//! Hertz and Cattaneo–Mindlin contact problems with closed-form references (spec §9), shared by
+//! the examples `hertz2d`, `hertz3d`, `cattaneo_mindlin` and the test suite.
+//!
+//! * 2D Hertz (plane strain): a half-disc of radius `R` pressed by a prescribed displacement of
+//!   its flat top onto a rigid flat (`E₂ = ∞`), or onto a second, mirrored half-disc of another
+//!   material. `1/E* = Σ (1 − ν_i²)/E_i`, `1/R* = Σ 1/R_i`, `a = sqrt(4 P R*/(π E*))`,
+//!   `p₀ = 2P/(π a)`, `p(x) = p₀ sqrt(1 − x²/a²)`, `P` the contact force per unit thickness.
+//! * 3D Hertz: a hemisphere on a rigid flat, `a = (3 P R*/(4 E*))^{1/3}`, `p₀ = 3P/(2π a²)`.
+//! * 2D Cattaneo–Mindlin: two identical half-discs (Dundurs `β = 0`), first pressed together
+//!   (frictionless), then sheared by a tangential displacement of the top with Tresca friction
+//!   `g_c = μ p` from the normal state and slip measured from it: stick zone
+//!   `|x| ≤ c = a sqrt(1 − Q/(μP))` and traction
+//!   `q(x) = μ p₀ sqrt(1 − x²/a²) − (c/a) μ p₀ sqrt(1 − x²/c²)` (second term for `|x| ≤ c` only).
+//!
+//! The contact half-width and peak pressure are measured by a least-squares fit of
+//! `p² = p₀² (1 − x²/a²)` to the nodal pressures of the inner 80 % of the contact zone, which
+//! is insensitive to the one-element uncertainty of the contact edge.
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use synovia_contact::operators::{ContactPair, PlaneObstacle};
+use synovia_contact::{ContactError, ContactSolver};
+use synovia_fem::{ElasticParams, ElasticSolver, FemError, Model};
+use synovia_material::{isotropic, plane_strain};
+use synovia_mesh::generators::{half_disc_refined, hemisphere_refined};
+use synovia_mesh::math::{Point, Real, Vector};
+use synovia_mesh::BoundaryKind;
+
+use crate::contact::{StaticContact, StaticContactResult};
+
+/// Figures of one Hertz or Cattaneo–Mindlin run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactRun {
+    /// Problem name.
+    pub problem: String,
+    /// Refinement level.
+    pub level: usize,
+    /// Mesh size at the contact point.
+    pub h: Real,
+    /// Reduced unknowns.
+    pub dofs: usize,
+    /// Contact nodes (candidates).
+    pub contact_nodes: usize,
+    /// Nodes in contact (`Λ_n > 0`).
+    pub active_nodes: usize,
+    /// Solver name.
+    pub solver: String,
+    /// Solver iterations (outer) of the final solve.
+    pub iterations: usize,
+    /// Solver iterations on the coarse levels of the nested iteration (0 without it).
+    pub coarse_iterations: usize,
+    /// Contact solve time (s), excluding the factorisation of `A`.
+    pub solve_s: Real,
+    /// One plain elastic factorisation + solve of the same `A` (s), same run.
+    pub linear_solve_s: Real,
+    /// Contact force `P` (per unit thickness in 2D).
+    pub force: Real,
+    /// Analytic half-width / radius for `P`.
+    pub a_exact: Real,
+    /// Measured half-width / radius.
+    pub a: Real,
+    /// Analytic peak pressure.
+    pub p0_exact: Real,
+    /// Measured peak pressure.
+    pub p0: Real,
+    /// Relative L² error of the pressure profile against `p₀ sqrt(1 − x²/a²)` (exact `a`, `p₀`).
+    pub pressure_l2_err: Real,
+    /// Cattaneo–Mindlin only: `Q / (μ P)`.
+    pub q_ratio: Real,
+    /// Cattaneo–Mindlin only: measured stick half-width.
+    pub c: Real,
+    /// Cattaneo–Mindlin only: analytic stick half-width.
+    pub c_exact: Real,
+    /// Cattaneo–Mindlin only: relative L² error of the tangential traction.
+    pub traction_l2_err: Real,
+    /// Cattaneo–Mindlin only: `max (|q| − μ p)` over the contact nodes (≤ 0 up to round-off).
+    pub coulomb_excess: Real,
+    /// Largest KKT residual of the solution (spec §5).
+    pub kkt: Real,
+}
+
+impl ContactRun {
+    /// `|a − a_exact| / a_exact`.
+    pub fn a_rel_err(&self) -> Real {
+        (self.a - self.a_exact).abs() / self.a_exact
+    }
+    /// `|p₀ − p₀_exact| / p₀_exact`.
+    pub fn p0_rel_err(&self) -> Real {
+        (self.p0 - self.p0_exact).abs() / self.p0_exact
+    }
+    /// `|c − c_exact| / c_exact`.
+    pub fn c_rel_err(&self) -> Real {
+        (self.c - self.c_exact).abs() / self.c_exact
+    }
+    /// One JSON line with the key figures.
+    pub fn json(&self) -> String {
+        let mut s = format!(
+            "{{\"problem\":\"{}\",\"level\":{},\"h\":{:.4e},\"dofs\":{},\"contact_nodes\":{},\"active_nodes\":{},\"solver\":\"{}\",\"iterations\":{},\"coarse_iterations\":{},\"solve_s\":{:.4},\"linear_solve_s\":{:.4},\"force\":{:.6e},\"a\":{:.6e},\"a_exact\":{:.6e},\"a_rel_err\":{:.3e},\"p0\":{:.6e},\"p0_exact\":{:.6e},\"p0_rel_err\":{:.3e},\"pressure_l2_err\":{:.3e},\"kkt\":{:.2e}",
+            self.problem, self.level, self.h, self.dofs, self.contact_nodes, self.active_nodes, self.solver,
+            self.iterations, self.coarse_iterations, self.solve_s, self.linear_solve_s, self.force, self.a, self.a_exact, self.a_rel_err(),
+            self.p0, self.p0_exact, self.p0_rel_err(), self.pressure_l2_err, self.kkt
+        );
+        if self.c_exact > 0.0 {
+            s.push_str(&format!(
+                ",\"q_ratio\":{:.4},\"c\":{:.6e},\"c_exact\":{:.6e},\"c_rel_err\":{:.3e},\"traction_l2_err\":{:.3e},\"coulomb_excess\":{:.2e}",
+                self.q_ratio, self.c, self.c_exact, self.c_rel_err(), self.traction_l2_err, self.coulomb_excess
+            ));
+        }
+        s.push('}');
+        s
+    }
+}
+
+/// Least-squares fit of `p² = A − B r²` over the points with `r ≤ 0.8 r_max`:
+/// returns `(a, p₀) = (sqrt(A/B), sqrt(A))`.
+pub fn fit_elliptic(points: &[(Real, Real)]) -> (Real, Real) {
+    let rmax = points.iter().filter(|p| p.1 > 0.0).map(|p| p.0.abs()).fold(0.0, Real::max);
+    let sel: Vec<(Real, Real)> = points
+        .iter()
+        .filter(|p| p.1 > 0.0 && p.0.abs() <= 0.8 * rmax)
+        .map(|p| (p.0 * p.0, p.1 * p.1))
+        .collect();
+    let n = sel.len() as Real;
+    if sel.len() < 2 {
+        return (Real::NAN, Real::NAN);
+    }
+    let mx = sel.iter().map(|p| p.0).sum::<Real>() / n;
+    let my = sel.iter().map(|p| p.1).sum::<Real>() / n;
+    let sxy: Real = sel.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: Real = sel.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let slope = sxy / sxx; // −B
+    let intercept = my - slope * mx; // A
+    ((intercept / -slope).sqrt(), intercept.sqrt())
+}
+
+/// Parameters of the 2D Hertz / Cattaneo–Mindlin problems.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hertz2d {
+    /// Radius `R` of the half-disc(s).
+    pub radius: Real,
+    /// Young's modulus of the indenter (upper half-disc).
+    pub e1: Real,
+    /// Its Poisson ratio.
+    pub nu1: Real,
+    /// Young's modulus of the lower body (`None`: rigid flat).
+    pub e2: Option<Real>,
+    /// Its Poisson ratio.
+    pub nu2: Real,
+    /// Vertical push of the top.
+    pub push: Real,
+    /// Coarse cells along the radius.
+    pub n: usize,
+    /// Refinement levels toward the contact point.
+    pub levels: usize,
+    /// Radius of the refined zone (multiple of the expected `a`).
+    pub refine_radius: Real,
+    /// Warm-start cold solves by nested iteration on the contact rows (default `true`).
+    pub nested: bool,
+}
+
+impl Default for Hertz2d {
+    fn default() -> Self {
+        Self {
+            radius: 1.0,
+            e1: 1.0,
+            nu1: 0.3,
+            e2: None,
+            nu2: 0.3,
+            push: 0.01,
+            n: 8,
+            levels: 10,
+            refine_radius: 0.16,
+            nested: true,
+        }
+    }
+}
+
+fn fem(e: impl Into<FemError>) -> ContactError {
+    ContactError::Fem(e.into())
+}
+
+/// Builds the model of a 2D Hertz problem: the upper half-disc `"indenter"` (contact part
+/// `"contact"`: its arc below `y < 0.3 R`), and either a rigid flat `y = 0` or the mirrored
+/// lower half-disc `"base"`.
+pub fn hertz2d_model(p: &Hertz2d) -> Result<(Model<2>, Vec<ContactPair<2>>), ContactError> {
+    let r = p.radius;
+    let centre = Point::<2>::new(0.0, r);
+    let mut upper =
+        half_disc_refined(centre, r, p.n, Point::<2>::new(0.0, 0.0), p.refine_radius * r, p.levels)?;
+    upper.set_part_kind("top", BoundaryKind::Prescribed)?;
+    let sel = move |x: &Point<2>, n: &Vector<2>| x[1] < 0.3 * r && n[1] < 0.0;
+    let mut model = Model::<2>::new();
+    let mut pairs = Vec::new();
+    let lower = match p.e2 {
+        Some(_) => {
+            let mut lower = upper.reflected(1, 0.0)?;
+            lower.set_part_kind("top", BoundaryKind::Clamped)?;
+            lower.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| {
+                x[1] > -0.3 * r && n[1] > 0.0
+            })?;
+            Some(lower)
+        }
+        None => None,
+    };
+    upper.add_boundary_part("contact", BoundaryKind::Contact, sel)?;
+    let push = p.push;
+    let up =
+        model.add_body("indenter", upper, Arc::new(plane_strain(p.e1, p.nu1).map_err(fem)?)).map_err(fem)?;
+    // the top moves down by `push` and sideways by t (the time is the tangential displacement)
+    model.prescribe(up, "top", move |_, t| Vector::<2>::new(t, -push)).map_err(fem)?;
+    match (lower, p.e2) {
+        (Some(lower), Some(e2)) => {
+            let lo = model
+                .add_body("base", lower, Arc::new(plane_strain(e2, p.nu2).map_err(fem)?))
+                .map_err(fem)?;
+            pairs.push(
+                ContactPair::node_to_node("indenter-base", up, "contact", lo, "contact")
+                    .with_fixed_normal(Vector::<2>::new(0.0, -1.0)),
+            );
+        }
+        _ => {
+            let flat = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0))?;
+            pairs.push(ContactPair::rigid("indenter-flat", up, "contact", Arc::new(flat)));
+        }
+    }
+    Ok((model, pairs))
+}
+
+fn linear_solve_time<const D: usize>(model: &Model<D>) -> Result<Real, ContactError> {
+    let t0 = Instant::now();
+    let mut s = ElasticSolver::new(model, ElasticParams::default())?;
+    s.solve(model, 0.0)?;
+    Ok(t0.elapsed().as_secs_f64())
+}
+
+fn contact_h<const D: usize>(model: &Model<D>) -> Real {
+    let mesh = &model.bodies()[0].mesh;
+    let mut h = Real::INFINITY;
+    if let Ok(part) = mesh.boundary_part("contact") {
+        for f in part.facets() {
+            h = h.min(mesh.facet_measure(f).powf(1.0 / (D as Real - 1.0)));
+        }
+    }
+    h
+}
+
+fn pressure_l2<const D: usize>(
+    nodes: &[synovia_contact::operators::ContactNode<D>],
+    res: &StaticContactResult<D>,
+    a: Real,
+    p0: Real,
+    radial: impl Fn(&Point<D>) -> Real,
+) -> Real {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (node, &l) in nodes.iter().zip(&res.solution.lambda_n) {
+        let r = radial(&node.position);
+        let s = 1.0 - (r / a).powi(2);
+        let ex = if s > 0.0 { p0 * s.sqrt() } else { 0.0 };
+        num += node.weight * (l - ex).powi(2);
+        den += node.weight * ex * ex;
+    }
+    (num / den).sqrt()
+}
+
+/// Solves a 2D Hertz problem with `solver` and measures `a`, `p₀` and the pressure profile.
+pub fn hertz2d(p: &Hertz2d, solver: &dyn ContactSolver) -> Result<ContactRun, ContactError> {
+    let (model, pairs) = hertz2d_model(p)?;
+    let linear_solve_s = linear_solve_time(&model)?;
+    let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+    sc.set_nested_iteration(p.nested.then_some(32));
+    let t0 = Instant::now();
+    let res = sc.solve(&model, 0.0, solver, None, None, None)?;
+    let solve_s = t0.elapsed().as_secs_f64();
+    let geo = sc.geometry();
+    let force = res.normal_force(geo, 0..geo.len());
+    let inv_e = (1.0 - p.nu1 * p.nu1) / p.e1 + p.e2.map_or(0.0, |e2| (1.0 - p.nu2 * p.nu2) / e2);
+    let e_star = 1.0 / inv_e;
+    let r_star = if p.e2.is_some() { p.radius / 2.0 } else { p.radius };
+    let a_exact = (4.0 * force * r_star / (std::f64::consts::PI * e_star)).sqrt();
+    let p0_exact = 2.0 * force / (std::f64::consts::PI * a_exact);
+    let pts: Vec<(Real, Real)> =
+        geo.nodes.iter().zip(&res.solution.lambda_n).map(|(n, l)| (n.position[0], *l)).collect();
+    let (a, p0) = fit_elliptic(&pts);
+    let l2 = pressure_l2(&geo.nodes, &res, a_exact, p0_exact, |x| x[0]);
+    Ok(ContactRun {
+        problem: if p.e2.is_some() { "hertz2d_cylinders".into() } else { "hertz2d_rigid".into() },
+        level: p.levels,
+        h: contact_h(&model),
+        dofs: sc.elastic().info().n_dofs,
+        contact_nodes: geo.len(),
+        active_nodes: res.solution.lambda_n.iter().filter(|&&l| l > 0.0).count(),
+        solver: solver.name().to_string(),
+        iterations: res.solution.report.iterations,
+        coarse_iterations: res.coarse_iterations,
+        solve_s,
+        linear_solve_s,
+        force,
+        a_exact,
+        a,
+        p0_exact,
+        p0,
+        pressure_l2_err: l2,
+        q_ratio: 0.0,
+        c: 0.0,
+        c_exact: 0.0,
+        traction_l2_err: 0.0,
+        coulomb_excess: 0.0,
+        kkt: res.kkt.max(),
+    })
+}
+
+/// Parameters of the 3D Hertz problem (hemisphere on a rigid flat).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hertz3d {
+    /// Radius.
+    pub radius: Real,
+    /// Young's modulus.
+    pub e: Real,
+    /// Poisson ratio.
+    pub nu: Real,
+    /// Vertical push of the top.
+    pub push: Real,
+    /// Coarse cells along the radius.
+    pub n: usize,
+    /// Refinement levels toward the pole.
+    pub levels: usize,
+    /// Radius of the refined zone.
+    pub refine_radius: Real,
+    /// Warm-start by nested iteration on the contact rows (default `true`).
+    pub nested: bool,
+}
+
+impl Default for Hertz3d {
+    fn default() -> Self {
+        Self { radius: 1.0, e: 1.0, nu: 0.3, push: 0.01, n: 4, levels: 12, refine_radius: 0.15, nested: true }
+    }
+}
+
+/// Solves the 3D Hertz problem with `solver`.
+pub fn hertz3d(p: &Hertz3d, solver: &dyn ContactSolver) -> Result<ContactRun, ContactError> {
+    let r = p.radius;
+    let mut mesh = hemisphere_refined(
+        Point::<3>::new(0.0, 0.0, r),
+        r,
+        p.n,
+        Point::<3>::zeros(),
+        p.refine_radius * r,
+        p.levels,
+    )?;
+    mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
+    mesh.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
+    let mut model = Model::<3>::new();
+    let b = model.add_body("hemisphere", mesh, Arc::new(isotropic(p.e, p.nu).map_err(fem)?)).map_err(fem)?;
+    let push = p.push;
+    model.prescribe(b, "top", move |_, _| Vector::<3>::new(0.0, 0.0, -push)).map_err(fem)?;
+    let flat = PlaneObstacle::new(Point::<3>::zeros(), Vector::<3>::new(0.0, 0.0, 1.0))?;
+    let pairs = vec![ContactPair::rigid("hemisphere-flat", b, "contact", Arc::new(flat))];
+    let linear_solve_s = linear_solve_time(&model)?;
+    let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+    sc.set_nested_iteration(p.nested.then_some(32));
+    let t0 = Instant::now();
+    let res = sc.solve(&model, 0.0, solver, None, None, None)?;
+    let solve_s = t0.elapsed().as_secs_f64();
+    let geo = sc.geometry();
+    let force = res.normal_force(geo, 0..geo.len());
+    let e_star = p.e / (1.0 - p.nu * p.nu);
+    let a_exact = (3.0 * force * r / (4.0 * e_star)).cbrt();
+    let p0_exact = 3.0 * force / (2.0 * std::f64::consts::PI * a_exact * a_exact);
+    let radial = |x: &Point<3>| (x[0] * x[0] + x[1] * x[1]).sqrt();
+    let pts: Vec<(Real, Real)> =
+        geo.nodes.iter().zip(&res.solution.lambda_n).map(|(n, l)| (radial(&n.position), *l)).collect();
+    let (a, p0) = fit_elliptic(&pts);
+    let l2 = pressure_l2(&geo.nodes, &res, a_exact, p0_exact, radial);
+    Ok(ContactRun {
+        problem: "hertz3d_rigid".into(),
+        level: p.levels,
+        h: contact_h(&model),
+        dofs: sc.elastic().info().n_dofs,
+        contact_nodes: geo.len(),
+        active_nodes: res.solution.lambda_n.iter().filter(|&&l| l > 0.0).count(),
+        solver: solver.name().to_string(),
+        iterations: res.solution.report.iterations,
+        coarse_iterations: res.coarse_iterations,
+        solve_s,
+        linear_solve_s,
+        force,
+        a_exact,
+        a,
+        p0_exact,
+        p0,
+        pressure_l2_err: l2,
+        q_ratio: 0.0,
+        c: 0.0,
+        c_exact: 0.0,
+        traction_l2_err: 0.0,
+        coulomb_excess: 0.0,
+        kkt: res.kkt.max(),
+    })
+}
+
+/// Solves the 2D Cattaneo–Mindlin problem: two identical half-discs (parameters `p` with
+/// `e2 = Some(e1)` enforced), friction coefficient `mu`, tangential load tuned (secant on the
+/// top's tangential displacement) to `Q / (μ P) = q_ratio` within 0.5 %.
+pub fn cattaneo_mindlin_2d(
+    p: &Hertz2d,
+    mu: Real,
+    q_ratio: Real,
+    solver: &dyn ContactSolver,
+) -> Result<ContactRun, ContactError> {
+    if !(mu > 0.0 && q_ratio > 0.0 && q_ratio < 1.0) {
+        return Err(ContactError::InvalidParameter(format!(
+            "need μ > 0 and 0 < Q/(μP) < 1, got {mu}, {q_ratio}"
+        )));
+    }
+    let p = Hertz2d { e2: Some(p.e1), nu2: p.nu1, ..*p };
+    let (model, mut pairs) = hertz2d_model(&p)?;
+    pairs[0].friction = mu;
+    let linear_solve_s = linear_solve_time(&model)?;
+    let sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+    let geo = sc.geometry();
+    let t0 = Instant::now();
+    // ## normal step (frictionless), then Tresca with g_c = μ p
+    let normal = sc.solve(&model, 0.0, solver, None, None, None)?;
+    let force = normal.normal_force(geo, 0..geo.len());
+    let gc = geo.slip_bounds_from_pressure(&normal.solution.lambda_n);
+    let tangential_force = |res: &StaticContactResult<2>| -> Real {
+        res.cell_node
+            .iter()
+            .zip(&res.slip_bound)
+            .zip(&res.solution.lambda_t)
+            .map(|((&r, g), l)| g * geo.nodes[r].weight * l)
+            .sum::<Real>()
+            .abs()
+    };
+    let mut iterations = normal.solution.report.iterations;
+    let coarse_iterations = normal.coarse_iterations;
+    let mut solve = |shift: Real| -> Result<(StaticContactResult<2>, Real), ContactError> {
+        let res = sc.solve(&model, shift, solver, Some(&gc), Some(&normal.displacement), None)?;
+        iterations += res.solution.report.iterations;
+        let q = tangential_force(&res) / (mu * force);
+        Ok((res, q))
+    };
+    // secant on the shift
+    let mut s0 = 1e-4 * p.radius;
+    let (mut r0, mut q0) = solve(s0)?;
+    let mut s1 = s0 * q_ratio / q0.max(1e-12);
+    let (mut r1, mut q1) = solve(s1)?;
+    for _ in 0..20 {
+        if (q1 - q_ratio).abs() < 5e-3 * q_ratio {
+            break;
+        }
+        let s2 = s1 + (q_ratio - q1) * (s1 - s0) / (q1 - q0);
+        s0 = s1;
+        q0 = q1;
+        r0 = r1;
+        s1 = s2;
+        let (r2, q2) = solve(s1)?;
+        r1 = r2;
+        q1 = q2;
+    }
+    drop(r0);
+    let res = r1;
+    let solve_s = t0.elapsed().as_secs_f64();
+    let e_star = 1.0 / (2.0 * (1.0 - p.nu1 * p.nu1) / p.e1);
+    let r_star = p.radius / 2.0;
+    let a_exact = (4.0 * force * r_star / (std::f64::consts::PI * e_star)).sqrt();
+    let p0_exact = 2.0 * force / (std::f64::consts::PI * a_exact);
+    let c_exact = a_exact * (1.0 - q1).sqrt();
+    // stick zone and traction
+    let (mut stick_max, mut slip_min): (Real, Real) = (0.0, Real::INFINITY);
+    let (mut num, mut den, mut excess): (Real, Real, Real) = (0.0, 0.0, Real::NEG_INFINITY);
+    for ((&r, g), l) in res.cell_node.iter().zip(&res.slip_bound).zip(&res.solution.lambda_t) {
+        let x = geo.nodes[r].position[0].abs();
+        if l.abs() < 1.0 - 1e-6 {
+            stick_max = stick_max.max(x);
+        }
+        let q = g * l.abs();
+        let s1 = 1.0 - (x / a_exact).powi(2);
+        let s2 = 1.0 - (x / c_exact).powi(2);
+        let mut qe = if s1 > 0.0 { mu * p0_exact * s1.sqrt() } else { 0.0 };
+        if s2 > 0.0 {
+            qe -= c_exact / a_exact * mu * p0_exact * s2.sqrt();
+        }
+        let w = geo.nodes[r].weight;
+        num += w * (q - qe).powi(2);
+        den += w * qe * qe;
+        excess = excess.max(q - mu * res.solution.lambda_n[r].abs());
+    }
+    for ((&r, _), l) in res.cell_node.iter().zip(&res.slip_bound).zip(&res.solution.lambda_t) {
+        let x = geo.nodes[r].position[0].abs();
+        if l.abs() >= 1.0 - 1e-6 && x > stick_max {
+            slip_min = slip_min.min(x);
+        }
+    }
+    let c = if slip_min.is_finite() { 0.5 * (stick_max + slip_min) } else { stick_max };
+    let pts: Vec<(Real, Real)> =
+        geo.nodes.iter().zip(&res.solution.lambda_n).map(|(n, l)| (n.position[0], *l)).collect();
+    let (a, p0) = fit_elliptic(&pts);
+    let l2 = pressure_l2(&geo.nodes, &res, a_exact, p0_exact, |x| x[0]);
+    Ok(ContactRun {
+        problem: "cattaneo_mindlin_2d".into(),
+        level: p.levels,
+        h: contact_h(&model),
+        dofs: sc.elastic().info().n_dofs,
+        contact_nodes: geo.len(),
+        active_nodes: res.solution.lambda_n.iter().filter(|&&l| l > 0.0).count(),
+        solver: solver.name().to_string(),
+        iterations,
+        coarse_iterations,
+        solve_s,
+        linear_solve_s,
+        force,
+        a_exact,
+        a,
+        p0_exact,
+        p0,
+        pressure_l2_err: l2,
+        q_ratio: q1,
+        c,
+        c_exact,
+        traction_l2_err: (num / den).sqrt(),
+        coulomb_excess: excess,
+        kkt: res.kkt.max().max(normal.kkt.max()),
+    })
+}
