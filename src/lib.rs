@@ -44,7 +44,10 @@ pub use synovia_mesh as mesh;
 pub use synovia_pdas as pdas;
 pub use synovia_uzawa as uzawa;
 
-pub mod contact;
+/// Static contact problems of a model (re-exported from `synovia-contact`).
+pub mod contact {
+    pub use synovia_contact::static_contact::*;
+}
 pub mod hertz;
 pub mod output;
 pub mod solvers;

@@ -17,16 +17,20 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod friction;
 pub mod kkt;
 pub mod nested;
 pub mod operators;
 pub mod problem;
 pub mod rows;
 pub mod solver;
+pub mod static_contact;
 pub mod testing;
 
 pub use error::{ContactError, IterationResidual};
+pub use friction::{ConstantFriction, ExponentialFriction, FrictionLaw};
 pub use kkt::{check_kkt, KktReport};
 pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
 pub use rows::SparseRows;
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};
+pub use static_contact::{StaticContact, StaticContactResult};

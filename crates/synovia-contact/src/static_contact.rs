@@ -6,12 +6,14 @@
 //! given slip bounds `g_c`), runs the solver, and maps the result back to nodal displacements
 //! per body and pressures per contact node.
 
-use synovia_contact::operators::{ContactGeometry, ContactPair};
-use synovia_contact::{
-    ContactError, ContactProblem, ContactSolution, ContactSolver, FrictionConstraints, KktReport,
-};
 use synovia_fem::{ElasticParams, ElasticSolver, Model};
 use synovia_mesh::math::{Real, Vector};
+
+use crate::error::ContactError;
+use crate::kkt::{check_kkt, KktReport};
+use crate::operators::{ContactGeometry, ContactPair};
+use crate::problem::{ContactProblem, FrictionConstraints};
+use crate::solver::{ContactSolution, ContactSolver};
 
 /// A factorised model with its contact geometry.
 #[derive(Debug)]
@@ -50,7 +52,7 @@ impl<const D: usize> StaticContact<D> {
         Ok(Self { elastic, geometry, nested_min_rows: Some(32) })
     }
 
-    /// Nested iteration for cold starts ([`synovia_contact::nested`]): coarsen the contact rows
+    /// Nested iteration for cold starts ([`crate::nested`]): coarsen the contact rows
     /// down to `min_rows` and use the coarse solutions as the warm start (default `Some(32)`);
     /// `None` starts every solve from `Λ = 0`.
     pub fn set_nested_iteration(&mut self, min_rows: Option<usize>) {
@@ -96,7 +98,7 @@ impl<const D: usize> StaticContact<D> {
         };
         let mut coarse_iterations = 0;
         let nested = match (warm_start, self.nested_min_rows) {
-            (None, Some(min_rows)) => synovia_contact::nested::nested_warm_start(
+            (None, Some(min_rows)) => crate::nested::nested_warm_start(
                 &problem,
                 solver,
                 &self.geometry.adjacency,
@@ -109,7 +111,7 @@ impl<const D: usize> StaticContact<D> {
         }
         let warm = warm_start.or(nested.as_ref().map(|(w, _)| w));
         let solution = solver.solve(&problem, warm)?;
-        let kkt = synovia_contact::check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
+        let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
         let displacement = dofs.expand(&solution.u, &lifts)?;
         let has_friction = friction.is_some();
         let (cell_node, slip) = match friction_op {
