@@ -17,7 +17,7 @@
 //!
 //! Run: `cargo run --release --example hertz2d [pdas|au-pdas|uzawa-mprgp|dual-mprgp]`
 
-use synovia::hertz::{hertz2d, ContactRun, Hertz2d};
+use synovia::hertz::{hertz2d, hertz2d_write, ContactRun, Hertz2d};
 
 fn table(title: &str, runs: &[ContactRun]) {
     println!("\n{title}");
@@ -62,10 +62,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let solver = synovia::solvers::by_name(&name)?;
 
     // ## Step 1: half-disc on a rigid flat, four refinements
+    std::fs::create_dir_all("out/hertz2d")?;
+    let vtu = std::path::Path::new("out/hertz2d/hertz2d_rigid.vtu");
     let mut rigid = Vec::new();
     for levels in [8, 10, 12, 14] {
-        rigid.push(hertz2d(&Hertz2d { levels, ..Default::default() }, solver.as_ref())?);
+        // the finest run also writes its contact state (pressure, active set) for ParaView
+        let out = (levels == 14).then_some(vtu);
+        rigid.push(hertz2d_write(&Hertz2d { levels, ..Default::default() }, solver.as_ref(), out)?);
     }
+    println!("wrote {} (colour by contact_pressure / contact_active)", vtu.display());
     table("cylinder on a rigid flat (E = 1, ν = 0.3, R = 1)", &rigid);
     let mut cold = Vec::new();
     for levels in [8, 10, 12, 14] {

@@ -265,6 +265,16 @@ fn pressure_l2<const D: usize>(
 
 /// Solves a 2D Hertz problem with `solver` and measures `a`, `p₀` and the pressure profile.
 pub fn hertz2d(p: &Hertz2d, solver: &dyn ContactSolver) -> Result<ContactRun, ContactError> {
+    hertz2d_write(p, solver, None)
+}
+
+/// [`hertz2d`], also writing the contact state to `vtu` (displacement, pressure, active set)
+/// when given.
+pub fn hertz2d_write(
+    p: &Hertz2d,
+    solver: &dyn ContactSolver,
+    vtu: Option<&std::path::Path>,
+) -> Result<ContactRun, ContactError> {
     let (model, pairs) = hertz2d_model(p)?;
     let linear_solve_s = linear_solve_time(&model)?;
     let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
@@ -273,6 +283,11 @@ pub fn hertz2d(p: &Hertz2d, solver: &dyn ContactSolver) -> Result<ContactRun, Co
     let res = sc.solve(&model, 0.0, solver, None, None, None)?;
     let solve_s = t0.elapsed().as_secs_f64();
     let geo = sc.geometry();
+    if let Some(path) = vtu {
+        crate::output::contact_vtu(&model, geo, &res, synovia_io::Encoding::Base64)
+            .and_then(|w| w.write(path))
+            .map_err(|e| ContactError::InvalidParameter(format!("writing {}: {e}", path.display())))?;
+    }
     let force = res.normal_force(geo, 0..geo.len());
     let inv_e = (1.0 - p.nu1 * p.nu1) / p.e1 + p.e2.map_or(0.0, |e2| (1.0 - p.nu2 * p.nu2) / e2);
     let e_star = 1.0 / inv_e;

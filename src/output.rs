@@ -41,3 +41,59 @@ pub fn elastic_vtu<const D: usize>(
     }
     Ok(w)
 }
+
+/// A [`VtuWriter`] with every body of `model` and the contact state of `result`: point fields
+/// `displacement`, `contact_pressure` (`Λ_n` at the contact nodes of body `k`, 0 elsewhere),
+/// `contact_active` (1 where `Λ_n > 0`), `friction_traction` (the tangential traction
+/// `−g_c Λ_t T` at the nodes of friction cells) and `stick` (1 sticking, −1 slipping, 0 none).
+pub fn contact_vtu<const D: usize>(
+    model: &Model<D>,
+    geometry: &synovia_contact::operators::ContactGeometry<D>,
+    result: &synovia_contact::StaticContactResult<D>,
+    encoding: Encoding,
+) -> Result<VtuWriter, IoError> {
+    use synovia_mesh::math::Vector;
+    let nb = model.bodies().len();
+    let mut pressure: Vec<Vec<f64>> = model.bodies().iter().map(|b| vec![0.0; b.mesh.n_nodes()]).collect();
+    let mut active = pressure.clone();
+    let mut stick = pressure.clone();
+    let mut traction: Vec<Vec<Vector<D>>> =
+        model.bodies().iter().map(|b| vec![Vector::<D>::zeros(); b.mesh.n_nodes()]).collect();
+    for (r, node) in geometry.nodes.iter().enumerate() {
+        let (b, i) = (node.node.0 .0, node.node.1);
+        if b < nb {
+            let l = result.solution.lambda_n.get(r).copied().unwrap_or(0.0);
+            pressure[b][i] = l;
+            active[b][i] = if l > 0.0 { 1.0 } else { 0.0 };
+        }
+    }
+    let comps = D - 1;
+    for (c, (&r, &g)) in result.cell_node.iter().zip(&result.slip_bound).enumerate() {
+        let node = &geometry.nodes[r];
+        let (b, i) = (node.node.0 .0, node.node.1);
+        let l = &result.solution.lambda_t[c * comps..(c + 1) * comps];
+        let mut t = Vector::<D>::zeros();
+        for (k, lk) in l.iter().enumerate() {
+            t -= node.tangents[k] * (g * lk);
+        }
+        if b < nb {
+            traction[b][i] = t;
+            let ln = l.iter().map(|v| v * v).sum::<f64>().sqrt();
+            stick[b][i] = if ln < 1.0 - 1e-6 { 1.0 } else { -1.0 };
+        }
+    }
+    let mut w = VtuWriter::new(encoding);
+    for (bi, body) in model.bodies().iter().enumerate() {
+        w.add_piece(
+            &body.mesh,
+            vec![
+                Field::point_vectors("displacement", &result.displacement[bi]),
+                Field::point_scalars("contact_pressure", pressure[bi].clone()),
+                Field::point_scalars("contact_active", active[bi].clone()),
+                Field::point_vectors("friction_traction", &traction[bi]),
+                Field::point_scalars("stick", stick[bi].clone()),
+            ],
+        )?;
+    }
+    Ok(w)
+}

@@ -294,3 +294,29 @@ fn the_solvers_agree_in_3d_with_friction() {
         assert!(du < 1e-6 && dn < 1e-6 && dt < 1e-6, "{name}: {du:e} {dn:e} {dt:e}");
     }
 }
+
+#[test]
+fn contact_state_is_written_for_paraview_and_reads_back() {
+    let p = Hertz2d { levels: 6, ..Default::default() };
+    let (model, pairs) = hertz2d_model(&p).expect("model");
+    let sc = StaticContact::new(&model, &pairs, Default::default()).expect("factorise");
+    let solver = by_name("pdas").expect("solver");
+    let res = sc.solve(&model, 0.0, solver.as_ref(), None, None, None).expect("solve");
+    let dir = std::env::temp_dir().join(format!("synovia-contact-vtu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("hertz.vtu");
+    synovia::output::contact_vtu(&model, sc.geometry(), &res, synovia::io::Encoding::Ascii)
+        .expect("writer")
+        .write(&path)
+        .expect("write");
+    let data = synovia::io::read_vtu(&path).expect("read");
+    let pressure = data.pieces[0].point_field("contact_pressure").expect("field");
+    let mut n_active = 0;
+    for (r, node) in sc.geometry().nodes.iter().enumerate() {
+        assert_eq!(pressure.values[node.node.1], res.solution.lambda_n[r]);
+        n_active += usize::from(res.solution.lambda_n[r] > 0.0);
+    }
+    let active = data.pieces[0].point_field("contact_active").expect("field");
+    assert_eq!(active.values.iter().filter(|&&v| v == 1.0).count(), n_active);
+    std::fs::remove_dir_all(&dir).ok();
+}

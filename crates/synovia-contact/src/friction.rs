@@ -44,7 +44,11 @@ mod tests {
 
     #[test]
     fn exponential_law_goes_from_static_to_kinetic() {
-        let law = ExponentialFriction { static_coefficient: 0.3, kinetic_coefficient: 0.1, characteristic_speed: 0.01 };
+        let law = ExponentialFriction {
+            static_coefficient: 0.3,
+            kinetic_coefficient: 0.1,
+            characteristic_speed: 0.01,
+        };
         assert!((law.coefficient(0.0) - 0.3).abs() < 1e-15);
         assert!((law.coefficient(1.0) - 0.1).abs() < 1e-12);
         let mid = law.coefficient(0.01);

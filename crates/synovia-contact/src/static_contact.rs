@@ -98,12 +98,9 @@ impl<const D: usize> StaticContact<D> {
         };
         let mut coarse_iterations = 0;
         let nested = match (warm_start, self.nested_min_rows) {
-            (None, Some(min_rows)) => crate::nested::nested_warm_start(
-                &problem,
-                solver,
-                &self.geometry.adjacency,
-                min_rows,
-            )?,
+            (None, Some(min_rows)) => {
+                crate::nested::nested_warm_start(&problem, solver, &self.geometry.adjacency, min_rows)?
+            }
             _ => None,
         };
         if let Some((_, it)) = &nested {

@@ -56,7 +56,10 @@ pub struct StepRecord {
 }
 
 /// Computes the pair records of a contact solution.
-pub fn pair_records<const D: usize>(geometry: &ContactGeometry<D>, result: &StaticContactResult<D>) -> Vec<PairRecord> {
+pub fn pair_records<const D: usize>(
+    geometry: &ContactGeometry<D>,
+    result: &StaticContactResult<D>,
+) -> Vec<PairRecord> {
     let sol = &result.solution;
     let comps = D - 1;
     let mut out: Vec<PairRecord> = geometry
