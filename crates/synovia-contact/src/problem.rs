@@ -253,21 +253,26 @@ impl<'a> Interface<'a> {
             return Ok(());
         }
         let t0 = Instant::now();
-        let n = self.problem.matrix.n();
-        for chunk in missing.chunks(32) {
-            let k = chunk.len();
-            let mut rhs = faer::Mat::<f64>::zeros(n, k);
-            for (c, &j) in chunk.iter().enumerate() {
-                for (i, v) in self.problem.row(j) {
-                    rhs[(i, c)] += v;
-                }
-            }
-            self.problem.factor.solve_many_in_place(rhs.as_mut())?;
-            self.solves += k;
-            for (c, &j) in chunk.iter().enumerate() {
-                let col: Vec<f64> = rhs.col(c).iter().copied().collect();
-                self.columns[j] = Some(self.problem.apply(&col));
-            }
+        let problem = self.problem;
+        // Two worker threads on the two halves when there is enough work: triangular solves
+        // with many right-hand sides do not parallelise well inside faer (notes: faer-0.24.md),
+        // so the right-hand sides are split instead.
+        let computed: Vec<(usize, Vec<f64>)> = if missing.len() >= 64 {
+            let (a, b) = missing.split_at(missing.len() / 2);
+            let (ra, rb) = std::thread::scope(|scope| {
+                let ha = scope.spawn(|| schur_columns(&problem, a));
+                let rb = schur_columns(&problem, b);
+                (ha.join(), rb)
+            });
+            let mut ra = ra.map_err(|_| ContactError::InvalidParameter("a column worker panicked".into()))??;
+            ra.extend(rb?);
+            ra
+        } else {
+            schur_columns(&problem, &missing)?
+        };
+        self.solves += computed.len();
+        for (j, col) in computed {
+            self.columns[j] = Some(col);
         }
         self.solve_s += t0.elapsed().as_secs_f64();
         Ok(())
@@ -310,4 +315,25 @@ impl<'a> Interface<'a> {
         self.solve_s += t0.elapsed().as_secs_f64();
         Ok(rhs)
     }
+}
+
+/// Columns `j ∈ cols` of `S = C A⁻¹ Cᵀ`: batched solves, 32 right-hand sides at a time.
+fn schur_columns(problem: &ContactProblem<'_>, cols: &[usize]) -> Result<Vec<(usize, Vec<f64>)>, ContactError> {
+    let n = problem.matrix.n();
+    let mut out = Vec::with_capacity(cols.len());
+    for chunk in cols.chunks(32) {
+        let k = chunk.len();
+        let mut rhs = faer::Mat::<f64>::zeros(n, k);
+        for (c, &j) in chunk.iter().enumerate() {
+            for (i, v) in problem.row(j) {
+                rhs[(i, c)] += v;
+            }
+        }
+        problem.factor.solve_many_in_place(rhs.as_mut())?;
+        for (c, &j) in chunk.iter().enumerate() {
+            let col: Vec<f64> = rhs.col(c).iter().copied().collect();
+            out.push((j, problem.apply(&col)));
+        }
+    }
+    Ok(out)
 }
