@@ -294,14 +294,43 @@ pub fn hertz2d_write(
     let r_star = if p.e2.is_some() { p.radius / 2.0 } else { p.radius };
     let a_exact = (4.0 * force * r_star / (std::f64::consts::PI * e_star)).sqrt();
     let p0_exact = 2.0 * force / (std::f64::consts::PI * a_exact);
+    let name = if p.e2.is_some() { "hertz2d_cylinders" } else { "hertz2d_rigid" };
+    Ok(hertz_run(
+        name,
+        p.levels,
+        &model,
+        &sc,
+        &res,
+        solver,
+        (solve_s, linear_solve_s),
+        (force, a_exact, p0_exact),
+        |x| x[0],
+    ))
+}
+
+/// The figures of a Hertz-type run from a contact result: fits `a`, `p₀` along `radial` and
+/// measures the pressure profile against the analytic values for the computed force.
+#[allow(clippy::too_many_arguments)]
+fn hertz_run<const D: usize>(
+    problem: &str,
+    level: usize,
+    model: &Model<D>,
+    sc: &StaticContact<D>,
+    res: &StaticContactResult<D>,
+    solver: &dyn ContactSolver,
+    (solve_s, linear_solve_s): (Real, Real),
+    (force, a_exact, p0_exact): (Real, Real, Real),
+    radial: impl Fn(&Point<D>) -> Real,
+) -> ContactRun {
+    let geo = sc.geometry();
     let pts: Vec<(Real, Real)> =
-        geo.nodes.iter().zip(&res.solution.lambda_n).map(|(n, l)| (n.position[0], *l)).collect();
+        geo.nodes.iter().zip(&res.solution.lambda_n).map(|(n, l)| (radial(&n.position), *l)).collect();
     let (a, p0) = fit_elliptic(&pts);
-    let l2 = pressure_l2(&geo.nodes, &res, a_exact, p0_exact, |x| x[0]);
-    Ok(ContactRun {
-        problem: if p.e2.is_some() { "hertz2d_cylinders".into() } else { "hertz2d_rigid".into() },
-        level: p.levels,
-        h: contact_h(&model),
+    let l2 = pressure_l2(&geo.nodes, res, a_exact, p0_exact, &radial);
+    ContactRun {
+        problem: problem.to_string(),
+        level,
+        h: contact_h(model),
         dofs: sc.elastic().info().n_dofs,
         contact_nodes: geo.len(),
         active_nodes: res.solution.lambda_n.iter().filter(|&&l| l > 0.0).count(),
@@ -322,7 +351,7 @@ pub fn hertz2d_write(
         traction_l2_err: 0.0,
         coulomb_excess: 0.0,
         kkt: res.kkt.max(),
-    })
+    }
 }
 
 /// Parameters of the 3D Hertz problem (hemisphere on a rigid flat).
@@ -383,35 +412,17 @@ pub fn hertz3d(p: &Hertz3d, solver: &dyn ContactSolver) -> Result<ContactRun, Co
     let a_exact = (3.0 * force * r / (4.0 * e_star)).cbrt();
     let p0_exact = 3.0 * force / (2.0 * std::f64::consts::PI * a_exact * a_exact);
     let radial = |x: &Point<3>| (x[0] * x[0] + x[1] * x[1]).sqrt();
-    let pts: Vec<(Real, Real)> =
-        geo.nodes.iter().zip(&res.solution.lambda_n).map(|(n, l)| (radial(&n.position), *l)).collect();
-    let (a, p0) = fit_elliptic(&pts);
-    let l2 = pressure_l2(&geo.nodes, &res, a_exact, p0_exact, radial);
-    Ok(ContactRun {
-        problem: "hertz3d_rigid".into(),
-        level: p.levels,
-        h: contact_h(&model),
-        dofs: sc.elastic().info().n_dofs,
-        contact_nodes: geo.len(),
-        active_nodes: res.solution.lambda_n.iter().filter(|&&l| l > 0.0).count(),
-        solver: solver.name().to_string(),
-        iterations: res.solution.report.iterations,
-        coarse_iterations: res.coarse_iterations,
-        solve_s,
-        linear_solve_s,
-        force,
-        a_exact,
-        a,
-        p0_exact,
-        p0,
-        pressure_l2_err: l2,
-        q_ratio: 0.0,
-        c: 0.0,
-        c_exact: 0.0,
-        traction_l2_err: 0.0,
-        coulomb_excess: 0.0,
-        kkt: res.kkt.max(),
-    })
+    Ok(hertz_run(
+        "hertz3d_rigid",
+        p.levels,
+        &model,
+        &sc,
+        &res,
+        solver,
+        (solve_s, linear_solve_s),
+        (force, a_exact, p0_exact),
+        radial,
+    ))
 }
 
 /// Solves the 2D Cattaneo–Mindlin problem: two identical half-discs (parameters `p` with
@@ -509,33 +520,24 @@ pub fn cattaneo_mindlin_2d(
         }
     }
     let c = if slip_min.is_finite() { 0.5 * (stick_max + slip_min) } else { stick_max };
-    let pts: Vec<(Real, Real)> =
-        geo.nodes.iter().zip(&res.solution.lambda_n).map(|(n, l)| (n.position[0], *l)).collect();
-    let (a, p0) = fit_elliptic(&pts);
-    let l2 = pressure_l2(&geo.nodes, &res, a_exact, p0_exact, |x| x[0]);
-    Ok(ContactRun {
-        problem: "cattaneo_mindlin_2d".into(),
-        level: p.levels,
-        h: contact_h(&model),
-        dofs: sc.elastic().info().n_dofs,
-        contact_nodes: geo.len(),
-        active_nodes: res.solution.lambda_n.iter().filter(|&&l| l > 0.0).count(),
-        solver: solver.name().to_string(),
-        iterations,
-        coarse_iterations,
-        solve_s,
-        linear_solve_s,
-        force,
-        a_exact,
-        a,
-        p0_exact,
-        p0,
-        pressure_l2_err: l2,
-        q_ratio: q1,
-        c,
-        c_exact,
-        traction_l2_err: (num / den).sqrt(),
-        coulomb_excess: excess,
-        kkt: res.kkt.max().max(normal.kkt.max()),
-    })
+    let mut run = hertz_run(
+        "cattaneo_mindlin_2d",
+        p.levels,
+        &model,
+        &sc,
+        &res,
+        solver,
+        (solve_s, linear_solve_s),
+        (force, a_exact, p0_exact),
+        |x| x[0],
+    );
+    run.iterations = iterations;
+    run.coarse_iterations = coarse_iterations;
+    run.q_ratio = q1;
+    run.c = c;
+    run.c_exact = c_exact;
+    run.traction_l2_err = (num / den).sqrt();
+    run.coulomb_excess = excess;
+    run.kkt = res.kkt.max().max(normal.kkt.max());
+    Ok(run)
 }

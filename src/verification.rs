@@ -152,12 +152,12 @@ pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> 
             .map_err(mesh_error("iso"))?;
         let r = rectangle(0.5, 1.0, 0.0, 1.0, half, n, Grading::Uniform, Grading::Uniform)
             .map_err(mesh_error("aniso"))?;
-        (cast_mesh::<2, D>(l)?, cast_mesh::<2, D>(r)?)
+        (l.recast::<D>().map_err(mesh_error("iso"))?, r.recast::<D>().map_err(mesh_error("aniso"))?)
     } else {
         let g = [Grading::Uniform; 3];
         let l = box_mesh([0.0, 0.0, 0.0], [0.5, 1.0, 1.0], [half, n, n], g).map_err(mesh_error("iso"))?;
         let r = box_mesh([0.5, 0.0, 0.0], [1.0, 1.0, 1.0], [half, n, n], g).map_err(mesh_error("aniso"))?;
-        (cast_mesh::<3, D>(l)?, cast_mesh::<3, D>(r)?)
+        (l.recast::<D>().map_err(mesh_error("iso"))?, r.recast::<D>().map_err(mesh_error("aniso"))?)
     };
     let sides: Vec<&str> =
         if D == 2 { vec!["bottom", "top"] } else { vec!["bottom", "top", "front", "back"] };
@@ -249,21 +249,6 @@ pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> 
         l2_error: (e_l2 / n_l2).sqrt(),
         solve_s,
     })
-}
-
-/// Re-types a mesh of dimension `A` as dimension `B` when `A == B` (the generators are
-/// dimension-specific, the study is generic).
-fn cast_mesh<const A: usize, const B: usize>(m: Mesh<A>) -> Result<Mesh<B>, FemError> {
-    if A != B {
-        return Err(FemError::InvalidParameter(format!("dimension {A} is not {B}")));
-    }
-    let nodes: Vec<Point<B>> = m.nodes().iter().map(|p| Point::<B>::from_fn(|i, _| p[i])).collect();
-    let parts = m
-        .boundary_parts()
-        .iter()
-        .map(|p| (p.name().to_string(), p.kind(), p.facets().map(|f| f.to_vec()).collect()))
-        .collect();
-    Mesh::<B>::from_parts(nodes, m.cells_flat().to_vec(), parts).map_err(mesh_error("cast"))
 }
 
 /// Keeps the material trait in scope for downstream docs.

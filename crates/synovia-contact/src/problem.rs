@@ -264,7 +264,8 @@ impl<'a> Interface<'a> {
                 let rb = schur_columns(&problem, b);
                 (ha.join(), rb)
             });
-            let mut ra = ra.map_err(|_| ContactError::InvalidParameter("a column worker panicked".into()))??;
+            let mut ra =
+                ra.map_err(|_| ContactError::InvalidParameter("a column worker panicked".into()))??;
             ra.extend(rb?);
             ra
         } else {
@@ -318,7 +319,10 @@ impl<'a> Interface<'a> {
 }
 
 /// Columns `j ∈ cols` of `S = C A⁻¹ Cᵀ`: batched solves, 32 right-hand sides at a time.
-fn schur_columns(problem: &ContactProblem<'_>, cols: &[usize]) -> Result<Vec<(usize, Vec<f64>)>, ContactError> {
+fn schur_columns(
+    problem: &ContactProblem<'_>,
+    cols: &[usize],
+) -> Result<Vec<(usize, Vec<f64>)>, ContactError> {
     let n = problem.matrix.n();
     let mut out = Vec::with_capacity(cols.len());
     for chunk in cols.chunks(32) {

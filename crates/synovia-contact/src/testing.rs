@@ -75,41 +75,25 @@ impl BlockOnFoundation {
         let mut model = Model::<D>::new();
         let top = "top";
         let bottom = "bottom";
-        if D == 2 {
-            let mut mesh = rectangle(0.0, 1.0, 0.0, 0.5, n, n / 2, Grading::Uniform, Grading::Uniform)?;
-            mesh.set_part_kind(top, BoundaryKind::Prescribed)?;
-            mesh.set_part_kind(bottom, BoundaryKind::Contact)?;
-            let mesh = cast::<2, D>(mesh)?;
-            let b = model.add_body("block", mesh, Arc::new(cast_material::<D>(true)?))?;
-            model.prescribe(b, top, move |_, _| {
-                Vector::<D>::from_fn(|i, _| {
-                    if i == 0 {
-                        shift
-                    } else if i == D - 1 {
-                        -push
-                    } else {
-                        0.0
-                    }
-                })
-            })?;
+        let mut mesh = if D == 2 {
+            rectangle(0.0, 1.0, 0.0, 0.5, n, n / 2, Grading::Uniform, Grading::Uniform)?.recast::<D>()?
         } else {
-            let mut mesh = box_mesh([0.0; 3], [1.0, 1.0, 0.5], [n, n, n / 2], [Grading::Uniform; 3])?;
-            mesh.set_part_kind(top, BoundaryKind::Prescribed)?;
-            mesh.set_part_kind(bottom, BoundaryKind::Contact)?;
-            let mesh = cast::<3, D>(mesh)?;
-            let b = model.add_body("block", mesh, Arc::new(cast_material::<D>(false)?))?;
-            model.prescribe(b, top, move |_, _| {
-                Vector::<D>::from_fn(|i, _| {
-                    if i == 0 {
-                        shift
-                    } else if i == D - 1 {
-                        -push
-                    } else {
-                        0.0
-                    }
-                })
-            })?;
-        }
+            box_mesh([0.0; 3], [1.0, 1.0, 0.5], [n, n, n / 2], [Grading::Uniform; 3])?.recast::<D>()?
+        };
+        mesh.set_part_kind(top, BoundaryKind::Prescribed)?;
+        mesh.set_part_kind(bottom, BoundaryKind::Contact)?;
+        let b = model.add_body("block", mesh, Arc::new(block_material::<D>()?))?;
+        model.prescribe(b, top, move |_, _| {
+            Vector::<D>::from_fn(|i, _| {
+                if i == 0 {
+                    shift
+                } else if i == D - 1 {
+                    -push
+                } else {
+                    0.0
+                }
+            })
+        })?;
         let mut solver = ElasticSolver::new(&model, ElasticParams::default())?;
         let (load, lifts) = solver.rhs(&model, 0.0)?;
         let _ = solver.solve(&model, 0.0)?;
@@ -162,23 +146,9 @@ impl BlockOnFoundation {
     }
 }
 
-fn cast<const A: usize, const B: usize>(
-    m: synovia_mesh::Mesh<A>,
-) -> Result<synovia_mesh::Mesh<B>, ContactError> {
-    if A != B {
-        return Err(ContactError::InvalidParameter(format!("dimension {A} is not {B}")));
-    }
-    let nodes: Vec<Point<B>> = m.nodes().iter().map(|p| Point::<B>::from_fn(|i, _| p[i])).collect();
-    let parts = m
-        .boundary_parts()
-        .iter()
-        .map(|p| (p.name().to_string(), p.kind(), p.facets().map(|f| f.to_vec()).collect()))
-        .collect();
-    Ok(synovia_mesh::Mesh::<B>::from_parts(nodes, m.cells_flat().to_vec(), parts)?)
-}
-
-fn cast_material<const D: usize>(plane: bool) -> Result<synovia_material::LinearElastic<D>, ContactError> {
-    let c = if plane {
+/// E = 1, ν = 0.3: plane strain in 2D, isotropic in 3D.
+fn block_material<const D: usize>() -> Result<synovia_material::LinearElastic<D>, ContactError> {
+    let c = if D == 2 {
         plane_strain(1.0, 0.3).map(|m| m.stiffness().clone())
     } else {
         isotropic(1.0, 0.3).map(|m| m.stiffness().clone())

@@ -106,6 +106,46 @@ pub enum IoError {
     /// A piece read back does not form a valid [`synovia_mesh::Mesh`].
     #[error("piece does not form a valid mesh: {0}")]
     Mesh(#[from] MeshError),
+    /// A Gmsh `.msh` file uses a format version this crate cannot read.
+    #[error(
+        "`{}`: unsupported Gmsh MSH format version {version}; synovia reads MSH 4.1 and 2.2 \
+         (ASCII or binary): re-export with `gmsh -format msh41` (or `msh22`)",
+        path.display()
+    )]
+    MshVersion {
+        /// The file (or `<bytes>` for in-memory input).
+        path: PathBuf,
+        /// The version as written in the file's `$MeshFormat` section.
+        version: String,
+    },
+    /// A Gmsh physical group that synovia maps (a body or a boundary part) contains an element
+    /// type other than the P1 simplex of its dimension.
+    #[error(
+        "unsupported element type {element_type} ({description}) in physical group `{group}`; \
+         synovia uses P1 simplices"
+    )]
+    UnsupportedElement {
+        /// The Gmsh element type number (e.g. 9 for the 6-node triangle).
+        element_type: i32,
+        /// Human-readable description of the type (e.g. `6-node triangle`).
+        description: String,
+        /// Name of the physical group.
+        group: String,
+    },
+    /// A Gmsh mesh cannot be turned into synovia bodies: no physical group of the requested
+    /// dimension, a boundary group on no body's boundary, a 2D mesh outside the plane `z = 0`,
+    /// duplicate body names.
+    #[error("Gmsh mesh cannot be mapped to synovia bodies: {0}")]
+    GmshMapping(String),
+    /// The cells (or boundary facets) of a Gmsh physical group do not form a valid
+    /// [`synovia_mesh::Mesh`] (e.g. a degenerate cell).
+    #[error("Gmsh body `{body}` does not form a valid mesh: {source}")]
+    GmshBody {
+        /// Name of the body (its physical group).
+        body: String,
+        /// The mesh error.
+        source: MeshError,
+    },
 }
 
 impl IoError {

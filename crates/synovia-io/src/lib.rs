@@ -1,8 +1,8 @@
 //! # synovia-io
 //!
 //! Output of synovia results for [ParaView](https://www.paraview.org) (and any VTK-based
-//! tool) in the VTK XML formats, and a reader of the same files for round-trip tests and
-//! verification.
+//! tool) in the VTK XML formats, a reader of the same files for round-trip tests and
+//! verification, and a reader of Gmsh meshes.
 //!
 //! * [`VtuWriter`] / [`write_vtu`]: one `.vtu` file (VTK XML `UnstructuredGrid`) holding one
 //!   `<Piece>` per body, with point and cell [`Field`]s.
@@ -10,6 +10,10 @@
 //! * [`TimeSeriesWriter`]: writes `DIR/NAME_0000.vtu`, `DIR/NAME_0001.vtu`, … and rewrites
 //!   `DIR/NAME.pvd` after every step, so an interrupted run still leaves a readable series.
 //! * [`read_vtu`], [`parse_vtu`], [`read_pvd`]: read back exactly what the writers write.
+//! * [`gmsh`]: input of [Gmsh](https://gmsh.info) `.msh` meshes (MSH 4.1 and 2.2, ASCII or
+//!   binary): [`read_msh`] parses a file, [`GmshMesh::bodies`] turns its physical groups into
+//!   one synovia [`Mesh`](synovia_mesh::Mesh) per body with named boundary parts (see the
+//!   [`gmsh`] module for the mapping and the part-kind naming convention).
 //!
 //! Every problem is an [`IoError`]; nothing here panics on user input. Fields with NaN or
 //! infinite values are rejected ([`IoError::NonFinite`], naming the field and the index)
@@ -115,6 +119,7 @@
 
 pub mod error;
 pub mod field;
+pub mod gmsh;
 pub mod pvd;
 pub mod read;
 mod util;
@@ -122,6 +127,10 @@ pub mod vtu;
 
 pub use error::IoError;
 pub use field::{Field, FieldLocation};
+pub use gmsh::{
+    default_boundary_kind, parse_msh, read_msh, read_msh_bodies, ElementBlock, GmshMesh, MshVersion,
+    PhysicalGroup, PhysicalName,
+};
 pub use pvd::{read_pvd, PvdEntry, PvdWriter, TimeSeriesWriter};
 pub use read::{parse_vtu, read_vtu, VtuData, VtuPiece};
 pub use vtu::{write_vtu, Encoding, VtuWriter, BODY_FIELD, VTK_TETRA, VTK_TRIANGLE};

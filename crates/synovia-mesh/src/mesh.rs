@@ -317,6 +317,21 @@ impl<const D: usize> Mesh<D> {
         Ok(())
     }
 
+    /// The same mesh typed with the dimension parameter `B`, which must equal `D` (lets
+    /// dimension-generic code use the dimension-specific generators). Errors otherwise.
+    pub fn recast<const B: usize>(&self) -> Result<Mesh<B>, MeshError> {
+        if B != D {
+            return Err(MeshError::InvalidParameter(format!("cannot recast a {D}D mesh as {B}D")));
+        }
+        let nodes: Vec<Point<B>> = self.nodes.iter().map(|p| Point::<B>::from_fn(|i, _| p[i])).collect();
+        let parts = self
+            .parts
+            .iter()
+            .map(|p| (p.name.clone(), p.kind, p.facets().map(|f| f.to_vec()).collect()))
+            .collect();
+        Mesh::<B>::from_parts(nodes, self.cells.clone(), parts)
+    }
+
     /// The mirror image of the mesh in the plane `x_axis = plane` (e.g. the upper of two
     /// contacting cylinders from the lower one). Cells are re-oriented and boundary parts kept
     /// (with their outward orientation).

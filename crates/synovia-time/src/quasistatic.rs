@@ -1,1 +1,614 @@
-//! (in progress)
+//! Quasi-static time stepping (spec §7, Part I of the report): inertia is neglected and every
+//! time level `t_i` is a static contact problem with Tresca friction whose slip bound is frozen
+//! from the previous level (spec §3).
+//!
+//! # The scheme
+//!
+//! For the times `t_0 < t_1 < … < t_m` ([`QuasiStaticStepper::run`]):
+//!
+//! * **Step 0** (the initial state `u₀`, spec §7): the frictionless contact problem at `t_0`
+//!   (loads `F(t_0)`, `P(t_0)`, prescribed `u₂(t_0)`). With
+//!   [`QuasiStaticParams::initial_friction`] it is followed by a Tresca solve at `t_0` with
+//!   `g_c = F_c |λ_n|` of that frictionless pre-solve and slip measured from the reference
+//!   (undeformed) state, i.e. friction acting while the initial load is applied in one step.
+//! * **Step i ≥ 1**: the Tresca problem of spec §5 at `t_i`,
+//!
+//!   ```text
+//!   A U + B_hnᵀ diag(κ) Λ_n + B_Htᵀ Λ_t − F(t_i) = 0
+//!   Λ_n − (Λ_n + ρ (B_hn U − d(t_i)))⁺         = 0
+//!   Λ_t − π(Λ_t + ρ B_Ht (U − U(t_{i−1})))     = 0
+//!   ```
+//!
+//!   with `B_Ht` built on the cells of `supp g_c`, `g_c,r = F_c |Λ_n,r(t_{i−1})|`
+//!   ([`ContactGeometry::slip_bounds_from_pressure`] of the previous level, spec §3, `r = 1`),
+//!   and slip measured from the previous level `U(t_{i−1})` (incremental slip, spec §3; with
+//!   [`QuasiStaticParams::incremental_slip`] `= false` the report's total-displacement form
+//!   `Λ_t − π(Λ_t + ρ B_Ht U)` is used instead, slip measured from the reference state).
+//!   The solve is warm-started from the previous level: `U` and `Λ_n` (the normal rows are the
+//!   same at every level) are copied, and `Λ_t` is mapped cell by cell through the contact
+//!   node of each cell ([`StaticContactResult::cell_node`]), since the friction cells
+//!   `supp g_c` change from level to level; new cells start from `Λ_t = 0`.
+//! * **Coulomb fixed point** ([`QuasiStaticParams::coulomb_fixed_point`], spec §3): the level
+//!   is re-solved with `g_c^{k+1} = F_c |Λ_n^k|` from the current iterate until
+//!   `max_r |g^{k+1}_r − g^k_r| / max_r |g^{k+1}_r| ≤ fixed_point_tolerance`; the accepted
+//!   solution is the last one (computed with `g^k`). After `max_fixed_point` solves without
+//!   convergence the run stops with [`TimeError::FixedPoint`].
+//!
+//! The factorisation of `A` is done once, in [`QuasiStaticStepper::new`], and reused at every
+//! level and fixed-point iteration (spec §7).
+//!
+//! # Per-step figures ([`StepRecord`])
+//!
+//! * pair resultants, areas, pressures, stick/slip areas: [`pair_records`];
+//! * friction dissipation of step `i`: the discrete friction functional of the slip increment,
+//!   `D_i = Σ_c g_c κ_c ‖T_cᵀ([u](s_c, t_i) − [u](s_c, t_{i−1}))‖` over the friction cells `c`
+//!   of the step (`T_c` the tangent basis, `[u] = u^k − u^l` or `u^k` for a rigid obstacle);
+//!   this is `Σ_c ‖(B_Ht (U_i − U_{i−1}))_c‖ = Λ_t · B_Ht ΔU`, the work of the friction
+//!   forces on the slip increment, ≥ 0. It is always measured on the increment (also with
+//!   total-displacement slip), and for step 0 from the reference state;
+//! * strain energy: the full `½ ∫ C e(u) : e(u) dx` summed over the bodies
+//!   ([`synovia_fem::post::body_fields`]), including the part due to the lifts of prescribed
+//!   displacements (the reduced `½ Ũᵀ K̃ Ũ` would miss it);
+//! * iterations: contact solver iterations (plus nested-iteration coarse iterations) summed
+//!   over the pre-solve and the Coulomb fixed-point iterations; the wall time of the step.
+//!
+//! # Output
+//!
+//! [`QuasiStaticOutput`] writes a ParaView time series (`DIR/NAME.pvd` + one `.vtu` per step,
+//! one piece per body with the displacement, contact pressure, friction traction, stick flag
+//! and von Mises stress) and the records as CSV ([`crate::results::write_csv`]).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use synovia_contact::operators::{ContactGeometry, ContactPair};
+use synovia_contact::{ContactSolution, ContactSolver, SolverReport, StaticContact, StaticContactResult};
+use synovia_fem::post::body_fields;
+use synovia_fem::{ElasticParams, Model};
+use synovia_io::{Encoding, Field, TimeSeriesWriter, VtuWriter};
+use synovia_mesh::math::{Real, Vector};
+
+use crate::error::TimeError;
+use crate::results::{pair_records, write_csv, StepRecord};
+
+/// Parameters of the quasi-static stepper.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuasiStaticParams {
+    /// Re-solve each level with `g_c = F_c |Λ_n|` of the current iterate until `g_c` stops
+    /// changing (true Coulomb friction, spec §3). Default `false` (Tresca with `g_c` frozen
+    /// from the previous level).
+    pub coulomb_fixed_point: bool,
+    /// Maximum contact solves per level in the Coulomb fixed point (default 50, ≥ 1).
+    pub max_fixed_point: usize,
+    /// Stopping tolerance of the fixed point on the relative change
+    /// `max |Δg_c| / max |g_c|` (default `1e-8`, > 0).
+    pub fixed_point_tolerance: Real,
+    /// Slip measured from the previous level (default `true`, spec §3); `false`: the report's
+    /// total-displacement form, slip measured from the reference state.
+    pub incremental_slip: bool,
+    /// Step 0 with friction: after the frictionless solve at `t_0`, solve the Tresca problem at
+    /// `t_0` with `g_c` from it (slip from the reference state). Default `false` (step 0 is
+    /// frictionless).
+    pub initial_friction: bool,
+}
+
+impl Default for QuasiStaticParams {
+    fn default() -> Self {
+        Self {
+            coulomb_fixed_point: false,
+            max_fixed_point: 50,
+            fixed_point_tolerance: 1e-8,
+            incremental_slip: true,
+            initial_friction: false,
+        }
+    }
+}
+
+impl QuasiStaticParams {
+    /// Checks the parameters.
+    ///
+    /// # Errors
+    /// [`TimeError::InvalidParameter`] if `max_fixed_point = 0` or the tolerance is not finite
+    /// and positive.
+    pub fn validate(&self) -> Result<(), TimeError> {
+        if self.max_fixed_point == 0 {
+            return Err(TimeError::InvalidParameter("max_fixed_point must be ≥ 1".into()));
+        }
+        if !(self.fixed_point_tolerance.is_finite() && self.fixed_point_tolerance > 0.0) {
+            return Err(TimeError::InvalidParameter(format!(
+                "fixed_point_tolerance must be finite and > 0, got {}",
+                self.fixed_point_tolerance
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The quasi-static stepper of spec §7: owns a [`StaticContact`] (one factorisation of `A`,
+/// reused at every level) and solves one Tresca contact problem per time level with `g_c`
+/// frozen from the previous level (see the [module documentation](self)).
+#[derive(Debug)]
+pub struct QuasiStaticStepper<const D: usize> {
+    contact: StaticContact<D>,
+    params: QuasiStaticParams,
+    body_nodes: Vec<usize>,
+    last: Option<StaticContactResult<D>>,
+}
+
+impl<const D: usize> QuasiStaticStepper<D> {
+    /// Factorises `model` and builds the contact geometry of `pairs` (friction coefficients
+    /// `F_c` from [`ContactPair::friction`]).
+    ///
+    /// # Errors
+    /// [`TimeError::InvalidParameter`] for invalid `params`; [`TimeError::ContactSetup`] from
+    /// [`StaticContact::new`] (invalid pairs, semi-coercive model, …).
+    pub fn new(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        elastic: ElasticParams,
+        params: QuasiStaticParams,
+    ) -> Result<Self, TimeError> {
+        params.validate()?;
+        let contact = StaticContact::new(model, pairs, elastic)?;
+        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None })
+    }
+
+    /// Wraps an existing [`StaticContact`] of `model` (e.g. with nested iteration switched off).
+    ///
+    /// # Errors
+    /// [`TimeError::InvalidParameter`] for invalid `params`.
+    pub fn from_contact(
+        model: &Model<D>,
+        contact: StaticContact<D>,
+        params: QuasiStaticParams,
+    ) -> Result<Self, TimeError> {
+        params.validate()?;
+        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None })
+    }
+
+    /// The static contact problem (factorisation, geometry).
+    pub fn contact(&self) -> &StaticContact<D> {
+        &self.contact
+    }
+    /// Mutable access to the static contact problem (e.g. [`StaticContact::set_nested_iteration`]).
+    pub fn contact_mut(&mut self) -> &mut StaticContact<D> {
+        &mut self.contact
+    }
+    /// The contact nodes.
+    pub fn geometry(&self) -> &ContactGeometry<D> {
+        self.contact.geometry()
+    }
+    /// The parameters.
+    pub fn params(&self) -> &QuasiStaticParams {
+        &self.params
+    }
+    /// Changes the parameters.
+    ///
+    /// # Errors
+    /// [`TimeError::InvalidParameter`] for invalid `params` (the old ones are kept).
+    pub fn set_params(&mut self, params: QuasiStaticParams) -> Result<(), TimeError> {
+        params.validate()?;
+        self.params = params;
+        Ok(())
+    }
+    /// The contact solution of the last level of the last (complete) [`QuasiStaticStepper::run`].
+    pub fn last_result(&self) -> Option<&StaticContactResult<D>> {
+        self.last.as_ref()
+    }
+
+    /// Runs the levels `times` (finite, strictly increasing, at least one): step 0 is the
+    /// initial state at `times[0]`, step `i` the Tresca problem at `times[i]` with `g_c` and
+    /// the slip origin from step `i − 1` (see the [module documentation](self)).
+    ///
+    /// `observer` is called after every level with its record and contact solution (write
+    /// output, check KKT, collect figures…); an error from it stops the run and is returned.
+    ///
+    /// # Errors
+    /// [`TimeError::InvalidParameter`] for bad `times` or a `model` whose bodies differ from
+    /// the one the stepper was built with; [`TimeError::Contact`] (with the step and time) when
+    /// a contact solve fails; [`TimeError::FixedPoint`] when the Coulomb fixed point does not
+    /// converge; [`TimeError::Fem`] from the post-processing; whatever `observer` returns.
+    pub fn run(
+        &mut self,
+        model: &Model<D>,
+        times: &[Real],
+        solver: &dyn ContactSolver,
+        mut observer: impl FnMut(&StepRecord, &StaticContactResult<D>) -> Result<(), TimeError>,
+    ) -> Result<Vec<StepRecord>, TimeError> {
+        self.check_model(model)?;
+        check_times(times)?;
+        let mut records: Vec<StepRecord> = Vec::with_capacity(times.len());
+        let mut cumulative = 0.0;
+        let mut previous: Option<StaticContactResult<D>> = None;
+        for (step, &t) in times.iter().enumerate() {
+            let start = Instant::now();
+            let (result, iterations) = match &previous {
+                None => self.initial(model, t, solver)?,
+                Some(prev) => {
+                    let g = self.contact.geometry().slip_bounds_from_pressure(&prev.solution.lambda_n);
+                    let origin = self.params.incremental_slip.then_some(prev.displacement.as_slice());
+                    self.tresca_level(model, step, t, solver, g, origin, Some(prev))?
+                }
+            };
+            let geometry = self.contact.geometry();
+            let dissipation = friction_dissipation(
+                geometry,
+                &result,
+                previous.as_ref().map(|p| p.displacement.as_slice()),
+            )?;
+            cumulative += dissipation;
+            let strain_energy =
+                body_fields(model, &result.displacement)?.iter().map(|f| f.strain_energy).sum();
+            let record = StepRecord {
+                step,
+                time: t,
+                pairs: pair_records(geometry, &result),
+                friction_dissipation: dissipation,
+                cumulative_friction_dissipation: cumulative,
+                kinetic_energy: 0.0,
+                strain_energy,
+                viscous_dissipation: 0.0,
+                iterations,
+                step_s: start.elapsed().as_secs_f64(),
+            };
+            observer(&record, &result)?;
+            records.push(record);
+            previous = Some(result);
+        }
+        self.last = previous;
+        Ok(records)
+    }
+
+    fn check_model(&self, model: &Model<D>) -> Result<(), TimeError> {
+        let nodes = body_nodes(model);
+        if nodes != self.body_nodes {
+            return Err(TimeError::InvalidParameter(format!(
+                "the model's bodies have {nodes:?} nodes, the stepper was built for {:?}",
+                self.body_nodes
+            )));
+        }
+        Ok(())
+    }
+
+    /// Step 0: frictionless solve at `t_0`, optionally followed by a Tresca solve with `g_c`
+    /// from it (slip from the reference state).
+    fn initial(
+        &self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+    ) -> Result<(StaticContactResult<D>, usize), TimeError> {
+        let pre = self
+            .contact
+            .solve(model, t, solver, None, None, None)
+            .map_err(|source| TimeError::Contact { step: 0, time: t, source })?;
+        let its = pre.solution.report.iterations + pre.coarse_iterations;
+        let has_friction = self.contact.geometry().nodes.iter().any(|n| n.friction > 0.0);
+        if !(self.params.initial_friction && has_friction) {
+            return Ok((pre, its));
+        }
+        let g = self.contact.geometry().slip_bounds_from_pressure(&pre.solution.lambda_n);
+        let (res, more) = self.tresca_level(model, 0, t, solver, g, None, Some(&pre))?;
+        Ok((res, its + more))
+    }
+
+    /// One Tresca level (with the optional Coulomb fixed point).
+    #[allow(clippy::too_many_arguments)]
+    fn tresca_level(
+        &self,
+        model: &Model<D>,
+        step: usize,
+        t: Real,
+        solver: &dyn ContactSolver,
+        slip_bound: Vec<Real>,
+        origin: Option<&[Vec<Vector<D>>]>,
+        warm_from: Option<&StaticContactResult<D>>,
+    ) -> Result<(StaticContactResult<D>, usize), TimeError> {
+        let geometry = self.contact.geometry();
+        let coulomb = self.params.coulomb_fixed_point;
+        let max = if coulomb { self.params.max_fixed_point } else { 1 };
+        let mut g = slip_bound;
+        let mut warm = warm_from.map(|w| warm_start(geometry, w, &g));
+        let mut iterations = 0;
+        let mut change = Real::INFINITY;
+        for _ in 0..max {
+            let res = self
+                .contact
+                .solve(model, t, solver, Some(&g), origin, warm.as_ref())
+                .map_err(|source| TimeError::Contact { step, time: t, source })?;
+            iterations += res.solution.report.iterations + res.coarse_iterations;
+            if !coulomb {
+                return Ok((res, iterations));
+            }
+            let g_new = geometry.slip_bounds_from_pressure(&res.solution.lambda_n);
+            change = relative_change(&g, &g_new);
+            if change <= self.params.fixed_point_tolerance {
+                return Ok((res, iterations));
+            }
+            warm = Some(warm_start(geometry, &res, &g_new));
+            g = g_new;
+        }
+        Err(TimeError::FixedPoint { step, iterations: max, change })
+    }
+}
+
+fn body_nodes<const D: usize>(model: &Model<D>) -> Vec<usize> {
+    model.bodies().iter().map(|b| b.mesh.n_nodes()).collect()
+}
+
+fn check_times(times: &[Real]) -> Result<(), TimeError> {
+    if times.is_empty() {
+        return Err(TimeError::InvalidParameter("no time levels".into()));
+    }
+    for (i, &t) in times.iter().enumerate() {
+        if !t.is_finite() {
+            return Err(TimeError::InvalidParameter(format!("time level {i} is {t}")));
+        }
+        if i > 0 && t <= times[i - 1] {
+            return Err(TimeError::InvalidParameter(format!(
+                "time levels must increase strictly: t_{i} = {t} ≤ t_{} = {}",
+                i - 1,
+                times[i - 1]
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// `max_r |b_r − a_r| / max_r |b_r|` (0 if both vanish).
+fn relative_change(a: &[Real], b: &[Real]) -> Real {
+    let diff = a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+    let scale = b.iter().fold(0.0_f64, |m, y| m.max(y.abs()));
+    if diff == 0.0 {
+        0.0
+    } else if scale > 0.0 {
+        diff / scale
+    } else {
+        Real::INFINITY
+    }
+}
+
+/// A warm start for the Tresca problem with slip bounds `g` from the solution `from` of
+/// another level: `U` and `Λ_n` copied; `Λ_t` of each new friction cell (the nodes with
+/// `g_r > 0`, in node order, as built by [`ContactGeometry::friction_constraints`]) copied from
+/// the cell of the same contact node in `from`, or 0 if that node had no cell there.
+pub fn warm_start<const D: usize>(
+    geometry: &ContactGeometry<D>,
+    from: &StaticContactResult<D>,
+    g: &[Real],
+) -> ContactSolution {
+    let comps = D.saturating_sub(1);
+    let mut cell_of = vec![None; geometry.len()];
+    for (c, &r) in from.cell_node.iter().enumerate() {
+        if let Some(slot) = cell_of.get_mut(r) {
+            *slot = Some(c);
+        }
+    }
+    let mut lambda_t = Vec::new();
+    for (r, &gr) in g.iter().enumerate() {
+        if gr > 0.0 {
+            let cell = cell_of.get(r).copied().flatten();
+            for k in 0..comps {
+                let v = cell.and_then(|c| from.solution.lambda_t.get(c * comps + k)).copied().unwrap_or(0.0);
+                lambda_t.push(v);
+            }
+        }
+    }
+    ContactSolution {
+        u: from.solution.u.clone(),
+        lambda_n: from.solution.lambda_n.clone(),
+        lambda_t,
+        report: SolverReport::default(),
+    }
+}
+
+/// `[u](s_r) = u^k(s_r) − u^l(s_r)` (or `u^k` for a rigid obstacle) of contact node `r`.
+fn relative_displacement<const D: usize>(
+    geometry: &ContactGeometry<D>,
+    r: usize,
+    displacement: &[Vec<Vector<D>>],
+) -> Option<Vector<D>> {
+    let node = geometry.nodes.get(r)?;
+    let uk = *displacement.get(node.node.0 .0)?.get(node.node.1)?;
+    let ul = match node.partner {
+        Some((b, j)) => *displacement.get(b.0)?.get(j)?,
+        None => Vector::<D>::zeros(),
+    };
+    Some(uk - ul)
+}
+
+/// The friction work of a step, `Σ_c g_c κ_c ‖T_cᵀ([u](s_c) − [u]_prev(s_c))‖` over the
+/// friction cells `c` of `result` (`g_c` = [`StaticContactResult::slip_bound`], `T_c` the
+/// tangent basis of the cell's contact node), with `[u]_prev` from the nodal displacements
+/// `previous` (`None`: the reference state, `[u]_prev = 0`). Equals `Λ_t · B_Ht ΔU ≥ 0` for a
+/// solution of the incremental Tresca problem.
+///
+/// # Errors
+/// [`TimeError::InvalidParameter`] if the displacements do not fit the geometry.
+pub fn friction_dissipation<const D: usize>(
+    geometry: &ContactGeometry<D>,
+    result: &StaticContactResult<D>,
+    previous: Option<&[Vec<Vector<D>>]>,
+) -> Result<Real, TimeError> {
+    let misfit = || TimeError::InvalidParameter("displacements do not fit the contact geometry".into());
+    let mut total = 0.0;
+    for (&r, &g) in result.cell_node.iter().zip(&result.slip_bound) {
+        let node = geometry.nodes.get(r).ok_or_else(misfit)?;
+        let mut du = relative_displacement(geometry, r, &result.displacement).ok_or_else(misfit)?;
+        if let Some(p) = previous {
+            du -= relative_displacement(geometry, r, p).ok_or_else(misfit)?;
+        }
+        let slip: Real = node.tangents.iter().take(D - 1).map(|t| t.dot(&du).powi(2)).sum::<Real>().sqrt();
+        total += g * node.weight * slip;
+    }
+    Ok(total)
+}
+
+/// Nodal contact fields of every body: `(pressure, friction traction, stick flag)` per node.
+///
+/// The pressure `Λ_n,r` is put on the contact node of body `k` and on its partner node of body
+/// `l`; the friction traction `−g_c Σ_j Λ_t,c,j T_c,j` acts on body `k` (and its opposite on
+/// body `l`); the stick flag is 1 at the nodes of sticking friction cells (`‖Λ_t‖ < 1 − 1e-6`)
+/// and 0 elsewhere.
+///
+/// # Errors
+/// [`TimeError::InvalidParameter`] if the result does not fit the geometry or the model.
+#[allow(clippy::type_complexity)]
+pub fn contact_fields<const D: usize>(
+    model: &Model<D>,
+    geometry: &ContactGeometry<D>,
+    result: &StaticContactResult<D>,
+) -> Result<(Vec<Vec<Real>>, Vec<Vec<Vector<D>>>, Vec<Vec<Real>>), TimeError> {
+    let misfit = || TimeError::InvalidParameter("contact result does not fit the model".into());
+    let n: Vec<usize> = model.bodies().iter().map(|b| b.mesh.n_nodes()).collect();
+    let mut pressure: Vec<Vec<Real>> = n.iter().map(|&k| vec![0.0; k]).collect();
+    let mut traction: Vec<Vec<Vector<D>>> = n.iter().map(|&k| vec![Vector::<D>::zeros(); k]).collect();
+    let mut stick: Vec<Vec<Real>> = n.iter().map(|&k| vec![0.0; k]).collect();
+    let set = |field: &mut Vec<Vec<Real>>, (b, i): (usize, usize), v: Real| -> Result<(), TimeError> {
+        *field.get_mut(b).and_then(|f| f.get_mut(i)).ok_or_else(misfit)? = v;
+        Ok(())
+    };
+    for (r, node) in geometry.nodes.iter().enumerate() {
+        let l = result.solution.lambda_n.get(r).copied().ok_or_else(misfit)?;
+        set(&mut pressure, (node.node.0 .0, node.node.1), l)?;
+        if let Some((b, j)) = node.partner {
+            set(&mut pressure, (b.0, j), l)?;
+        }
+    }
+    let comps = D - 1;
+    for (c, (&r, &g)) in result.cell_node.iter().zip(&result.slip_bound).enumerate() {
+        let node = geometry.nodes.get(r).ok_or_else(misfit)?;
+        let lt = result.solution.lambda_t.get(c * comps..(c + 1) * comps).ok_or_else(misfit)?;
+        let mut q = Vector::<D>::zeros();
+        for (t, l) in node.tangents.iter().zip(lt) {
+            q -= t * (g * l);
+        }
+        let norm = lt.iter().map(|v| v * v).sum::<Real>().sqrt();
+        let flag = if norm < 1.0 - 1e-6 { 1.0 } else { 0.0 };
+        let (b, i) = (node.node.0 .0, node.node.1);
+        *traction.get_mut(b).and_then(|f| f.get_mut(i)).ok_or_else(misfit)? = q;
+        set(&mut stick, (b, i), flag)?;
+        if let Some((bl, j)) = node.partner {
+            *traction.get_mut(bl.0).and_then(|f| f.get_mut(j)).ok_or_else(misfit)? = -q;
+            set(&mut stick, (bl.0, j), flag)?;
+        }
+    }
+    Ok((pressure, traction, stick))
+}
+
+/// Writer of quasi-static results: a ParaView time series `DIR/NAME.pvd` with one
+/// `DIR/NAME_NNNN.vtu` per step and the step records as `DIR/NAME.csv`.
+///
+/// Each `.vtu` holds one piece per body with the point fields `displacement`,
+/// `contact_pressure` (`Λ_n`, on both sides of a node-to-node pair), `friction_traction`
+/// (`−g_c Λ_t T` on body `k`, opposite on body `l`), `stick` (1 on sticking friction cells),
+/// `von_mises_nodal`, and the cell field `von_mises` ([`contact_fields`],
+/// [`synovia_fem::post::body_fields`]).
+///
+/// ```no_run
+/// # use synovia_time::quasistatic::*;
+/// # fn demo(model: &synovia_fem::Model<2>, mut stepper: QuasiStaticStepper<2>,
+/// #         solver: &dyn synovia_contact::ContactSolver) -> Result<(), synovia_time::TimeError> {
+/// let mut out = QuasiStaticOutput::new("out/run", "run", stepper.geometry())?;
+/// let records = stepper.run(model, &[0.0, 0.5, 1.0], solver, |rec, res| {
+///     out.write_step(model, rec, res).map(|_| ())
+/// })?;
+/// out.write_csv(&records)?;
+/// # Ok(()) }
+/// ```
+#[derive(Debug, Clone)]
+pub struct QuasiStaticOutput<const D: usize> {
+    dir: PathBuf,
+    name: String,
+    series: TimeSeriesWriter,
+    encoding: Encoding,
+    geometry: ContactGeometry<D>,
+}
+
+impl<const D: usize> QuasiStaticOutput<D> {
+    /// A series `name` in `dir` (created if missing), base64-encoded, for a stepper with the
+    /// contact `geometry` ([`QuasiStaticStepper::geometry`]; copied).
+    ///
+    /// # Errors
+    /// [`TimeError::Io`] for an invalid name or a directory that cannot be created.
+    pub fn new(
+        dir: impl Into<PathBuf>,
+        name: &str,
+        geometry: &ContactGeometry<D>,
+    ) -> Result<Self, TimeError> {
+        Self::with_encoding(dir, name, geometry, Encoding::Base64)
+    }
+
+    /// As [`QuasiStaticOutput::new`] with a chosen encoding.
+    ///
+    /// # Errors
+    /// As [`QuasiStaticOutput::new`].
+    pub fn with_encoding(
+        dir: impl Into<PathBuf>,
+        name: &str,
+        geometry: &ContactGeometry<D>,
+        encoding: Encoding,
+    ) -> Result<Self, TimeError> {
+        let dir = dir.into();
+        let series = TimeSeriesWriter::new(dir.clone(), name, encoding)?;
+        Ok(Self { dir, name: name.to_string(), series, encoding, geometry: geometry.clone() })
+    }
+
+    /// Writes the step of `record` (time `record.time`, which must exceed the previous step's)
+    /// with the fields of `result`; returns the `.vtu` path.
+    ///
+    /// # Errors
+    /// [`TimeError::Io`] on write failures or a non-increasing time; [`TimeError::Fem`] /
+    /// [`TimeError::InvalidParameter`] if `result` does not fit `model`.
+    pub fn write_step(
+        &mut self,
+        model: &Model<D>,
+        record: &StepRecord,
+        result: &StaticContactResult<D>,
+    ) -> Result<PathBuf, TimeError> {
+        let (pressure, traction, stick) = contact_fields(model, &self.geometry, result)?;
+        let fields = body_fields(model, &result.displacement)?;
+        let mut vtu = VtuWriter::new(self.encoding);
+        for (bi, body) in model.bodies().iter().enumerate() {
+            let (u, f) = match (result.displacement.get(bi), fields.get(bi)) {
+                (Some(u), Some(f)) => (u, f),
+                _ => return Err(TimeError::InvalidParameter("contact result does not fit the model".into())),
+            };
+            vtu.add_piece(
+                &body.mesh,
+                vec![
+                    Field::point_vectors("displacement", u),
+                    Field::point_scalars("contact_pressure", pressure[bi].clone()),
+                    Field::point_vectors("friction_traction", &traction[bi]),
+                    Field::point_scalars("stick", stick[bi].clone()),
+                    Field::point_scalars("von_mises_nodal", f.nodal_von_mises.clone()),
+                    Field::cell_scalars("von_mises", f.cell_von_mises.clone()),
+                ],
+            )?;
+        }
+        Ok(self.series.write_step(record.time, &vtu)?)
+    }
+
+    /// Writes `records` to `DIR/NAME.csv` ([`crate::results::write_csv`]); returns the path.
+    ///
+    /// # Errors
+    /// [`TimeError::Io`] on write failures.
+    pub fn write_csv(&self, records: &[StepRecord]) -> Result<PathBuf, TimeError> {
+        let path = self.csv_path();
+        write_csv(&path, records)?;
+        Ok(path)
+    }
+
+    /// `DIR/NAME.csv`.
+    pub fn csv_path(&self) -> PathBuf {
+        self.dir.join(format!("{}.csv", self.name))
+    }
+    /// `DIR/NAME.pvd`.
+    pub fn pvd_path(&self) -> &Path {
+        self.series.pvd_path()
+    }
+    /// Steps written so far.
+    pub fn n_steps(&self) -> usize {
+        self.series.n_steps()
+    }
+}

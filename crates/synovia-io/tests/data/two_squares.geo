@@ -1,0 +1,27 @@
+// Two unit squares stacked along y, sharing the curve y = 1 (a conforming interface):
+// bodies `lower` and `upper`, with boundary physical groups for the synovia-io Gmsh tests.
+lc = 0.25;
+Point(1) = {0, 0, 0, lc};
+Point(2) = {1, 0, 0, lc};
+Point(3) = {1, 1, 0, lc};
+Point(4) = {0, 1, 0, lc};
+Point(5) = {1, 2, 0, lc};
+Point(6) = {0, 2, 0, lc};
+Line(1) = {1, 2};
+Line(2) = {2, 3};
+Line(3) = {3, 4};
+Line(4) = {4, 1};
+Line(5) = {3, 5};
+Line(6) = {5, 6};
+Line(7) = {6, 4};
+Curve Loop(1) = {1, 2, 3, 4};
+Plane Surface(1) = {1};
+Curve Loop(2) = {5, 6, 7, -3};
+Plane Surface(2) = {2};
+Physical Surface("lower") = {1};
+Physical Surface("upper") = {2};
+Physical Curve("clamped_bottom") = {1};
+Physical Curve("contact_interface") = {3};
+Physical Curve("traction_top") = {6};
+Physical Curve("symmetry_left") = {4, 7};
+Physical Curve("free_right") = {2, 5};
