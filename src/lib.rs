@@ -13,6 +13,7 @@
 //! | [`contact_ops`] (`synovia-contact`) | contact pairs, `B_hn`/`B_Ht`, the contact problem, `ContactSolver`, KKT checker |
 //! | [`pdas`] (`synovia-pdas`) | semismooth Newton / PDAS and AU-PDAS |
 //! | [`uzawa`] (`synovia-uzawa`) | Uzawa with MPRGP, and the dual QP on the interface |
+//! | [`time`] (`synovia-time`) | load histories, rigid motions, quasi-static and dynamic time stepping |
 //!
 //! See `docs/architecture.md` for the crate graph and the path of data from mesh to solution,
 //! and the specification `spec/model.md` for the equations.
@@ -42,6 +43,7 @@ pub use synovia_io as io;
 pub use synovia_material as material;
 pub use synovia_mesh as mesh;
 pub use synovia_pdas as pdas;
+pub use synovia_time as time;
 pub use synovia_uzawa as uzawa;
 
 /// Static contact problems of a model (re-exported from `synovia-contact`).

@@ -279,7 +279,8 @@ fn element_info(t: i32) -> Option<ElementInfo> {
     const HEX: (usize, &str) = (3, "hexahedron");
     const PRI: (usize, &str) = (3, "prism");
     const PYR: (usize, &str) = (3, "pyramid");
-    let fixed = |(dim, shape): (usize, &'static str), n: usize| Some(ElementInfo { dim, shape, nodes: Some(n) });
+    let fixed =
+        |(dim, shape): (usize, &'static str), n: usize| Some(ElementInfo { dim, shape, nodes: Some(n) });
     let variable = |dim: usize, shape: &'static str| Some(ElementInfo { dim, shape, nodes: None });
     match t {
         1 => fixed(LIN, 2),
@@ -522,7 +523,10 @@ impl<'a> Reader<'a> {
         if line.first() == Some(&b'$') {
             return Err(at(
                 start,
-                format!("expected {what}, found `{}`: the section ends too early (is a count wrong?)", show(line)),
+                format!(
+                    "expected {what}, found `{}`: the section ends too early (is a count wrong?)",
+                    show(line)
+                ),
             ));
         }
         self.toks.clear();
@@ -537,7 +541,10 @@ impl<'a> Reader<'a> {
     fn end_record(&mut self) -> PResult<()> {
         if self.ascii_rec {
             if let Some(t) = self.toks.get(self.tok_i) {
-                return Err(at(self.rec_pos, format!("unexpected extra value `{}` at the end of the line", show(t))));
+                return Err(at(
+                    self.rec_pos,
+                    format!("unexpected extra value `{}` at the end of the line", show(t)),
+                ));
             }
         }
         self.ascii_rec = false;
@@ -610,7 +617,8 @@ impl<'a> Reader<'a> {
     fn int(&mut self, what: &str) -> PResult<i32> {
         if self.in_ascii() {
             let t = self.tok(what)?;
-            parse_token(t).ok_or_else(|| at(self.rec_pos, format!("bad {what} `{}`: expected an integer", show(t))))
+            parse_token(t)
+                .ok_or_else(|| at(self.rec_pos, format!("bad {what} `{}`: expected an integer", show(t))))
         } else {
             self.bin_i32(what)
         }
@@ -633,7 +641,8 @@ impl<'a> Reader<'a> {
     fn double(&mut self, what: &str) -> PResult<f64> {
         if self.in_ascii() {
             let t = self.tok(what)?;
-            parse_token(t).ok_or_else(|| at(self.rec_pos, format!("bad {what} `{}`: expected a number", show(t))))
+            parse_token(t)
+                .ok_or_else(|| at(self.rec_pos, format!("bad {what} `{}`: expected a number", show(t))))
         } else {
             self.bin_f64(what)
         }
@@ -660,10 +669,13 @@ impl<'a> Reader<'a> {
         let mut marker = b"$End".to_vec();
         marker.extend_from_slice(name);
         let mut from = self.pos;
-        while let Some(i) = self.data.get(from..).and_then(|r| r.windows(marker.len()).position(|w| w == marker)) {
+        while let Some(i) =
+            self.data.get(from..).and_then(|r| r.windows(marker.len()).position(|w| w == marker))
+        {
             let idx = from + i;
             let after = idx + marker.len();
-            let line_start = idx == self.pos || matches!(self.data.get(idx.wrapping_sub(1)), Some(b'\n' | b'\r'));
+            let line_start =
+                idx == self.pos || matches!(self.data.get(idx.wrapping_sub(1)), Some(b'\n' | b'\r'));
             let line_end = self.data.get(after).is_none_or(u8::is_ascii_whitespace);
             if line_start && line_end {
                 self.pos = idx;
@@ -672,10 +684,7 @@ impl<'a> Reader<'a> {
             }
             from = idx + 1;
         }
-        Err(at(
-            header,
-            format!("section `${}` is not closed by `$End{}`", show(name), show(name)),
-        ))
+        Err(at(header, format!("section `${}` is not closed by `$End{}`", show(name), show(name))))
     }
 }
 
@@ -867,7 +876,9 @@ impl Parser<'_> {
                     _ => {
                         return Err(at(
                             one_pos,
-                            format!("binary endianness check: expected the integer 1, found bytes {one:02x?}"),
+                            format!(
+                                "binary endianness check: expected the integer 1, found bytes {one:02x?}"
+                            ),
                         ))
                     }
                 };
@@ -916,7 +927,9 @@ impl Parser<'_> {
         r.record("the `$Entities` counts")?;
         let mut counts = [0u64; 4];
         for (d, c) in counts.iter_mut().enumerate() {
-            *c = r.size(["number of points", "number of curves", "number of surfaces", "number of volumes"][d])?;
+            *c = r.size(
+                ["number of points", "number of curves", "number of surfaces", "number of volumes"][d],
+            )?;
         }
         r.end_record()?;
         let mut map = HashMap::new();
@@ -969,6 +982,7 @@ impl Parser<'_> {
 
     fn nodes41(&mut self) -> PResult<()> {
         self.r.record("the `$Nodes` header `numEntityBlocks numNodes minNodeTag maxNodeTag`")?;
+        let header = self.r.rec_pos;
         let n_blocks = self.r.size("number of node blocks")?;
         let n_nodes = self.r.size("number of nodes")?;
         self.r.size("minimum node tag")?;
@@ -1015,7 +1029,7 @@ impl Parser<'_> {
         }
         if total != n_nodes {
             return Err(at(
-                self.r.pos,
+                header,
                 format!("the `$Nodes` header announces {n_nodes} nodes, but its blocks hold {total}"),
             ));
         }
@@ -1061,6 +1075,7 @@ impl Parser<'_> {
 
     fn elements41(&mut self) -> PResult<Vec<ElementBlock>> {
         self.r.record("the `$Elements` header `numEntityBlocks numElements minElementTag maxElementTag`")?;
+        let header = self.r.rec_pos;
         let n_blocks = self.r.size("number of element blocks")?;
         let n_elements = self.r.size("number of elements")?;
         self.r.size("minimum element tag")?;
@@ -1143,8 +1158,10 @@ impl Parser<'_> {
         }
         if total != n_elements {
             return Err(at(
-                self.r.pos,
-                format!("the `$Elements` header announces {n_elements} elements, but its blocks hold {total}"),
+                header,
+                format!(
+                    "the `$Elements` header announces {n_elements} elements, but its blocks hold {total}"
+                ),
             ));
         }
         self.r.expect_end("Elements")?;
@@ -1165,11 +1182,12 @@ impl Parser<'_> {
                 let element_type = self.r.int("element type")?;
                 let count = self.r.int("number of elements following")?;
                 let n_tags = self.r.int("number of tags")?;
-                let count = u64::try_from(count)
-                    .ok()
-                    .filter(|&c| c > 0 && c <= n - read)
-                    .ok_or_else(|| {
-                        at(pos, format!("bad element header: {count} elements announced, {} remain", n - read))
+                let count =
+                    u64::try_from(count).ok().filter(|&c| c > 0 && c <= n - read).ok_or_else(|| {
+                        at(
+                            pos,
+                            format!("bad element header: {count} elements announced, {} remain", n - read),
+                        )
                     })?;
                 let n_tags =
                     usize::try_from(n_tags).map_err(|_| at(pos, format!("bad number of tags {n_tags}")))?;
@@ -1187,7 +1205,8 @@ impl Parser<'_> {
                 for _ in 0..count {
                     let id_pos = self.r.pos;
                     let id = self.r.int("element id")?;
-                    let id = u64::try_from(id).map_err(|_| at(id_pos, format!("negative element id {id}")))?;
+                    let id =
+                        u64::try_from(id).map_err(|_| at(id_pos, format!("negative element id {id}")))?;
                     let mut physical = 0;
                     let mut entity = 0;
                     for t in 0..n_tags {
@@ -1379,14 +1398,18 @@ impl GmshMesh {
         for g in groups.iter().filter(|g| g.dim + 1 == D) {
             let facets = self.group_elements(g, facet_type, D)?; // D nodes per facet
             if facets.is_empty() {
-                return Err(IoError::GmshMapping(format!("boundary physical group `{}` has no elements", g.name)));
+                return Err(IoError::GmshMapping(format!(
+                    "boundary physical group `{}` has no elements",
+                    g.name
+                )));
             }
             let mut matched = false;
             for body in &mut bodies {
                 let local: Vec<Vec<usize>> = facets
                     .iter()
                     .filter_map(|(_, f)| {
-                        let lf: Vec<usize> = f.iter().map(|n| body.local.get(n).copied()).collect::<Option<_>>()?;
+                        let lf: Vec<usize> =
+                            f.iter().map(|n| body.local.get(n).copied()).collect::<Option<_>>()?;
                         let mut key = lf.clone();
                         key.sort_unstable();
                         body.boundary.contains(&key).then_some(lf)
@@ -1450,7 +1473,8 @@ impl GmshMesh {
         used.sort_unstable_by_key(|&i| (self.node_tags.get(i).copied().unwrap_or(u64::MAX), i));
         used.dedup();
         let local: HashMap<usize, usize> = used.iter().enumerate().map(|(l, &i)| (i, l)).collect();
-        let coords: Vec<[f64; 3]> = used.iter().map(|&i| self.nodes.get(i).copied().unwrap_or([0.0; 3])).collect();
+        let coords: Vec<[f64; 3]> =
+            used.iter().map(|&i| self.nodes.get(i).copied().unwrap_or([0.0; 3])).collect();
         if D == 2 {
             let scale = coords.iter().fold(0.0_f64, |m, p| m.max(p[0].abs()).max(p[1].abs()));
             if let Some((k, p)) = coords.iter().enumerate().find(|(_, p)| p[2].abs() > 1e-12 * scale) {
@@ -1462,8 +1486,10 @@ impl GmshMesh {
             }
         }
         let nodes: Vec<Point<D>> = coords.iter().map(|p| Point::<D>::from_fn(|k, _| p[k])).collect();
-        let flat: Vec<usize> =
-            cells.iter().flat_map(|(_, c)| c.iter().map(|n| local.get(n).copied().unwrap_or(usize::MAX))).collect();
+        let flat: Vec<usize> = cells
+            .iter()
+            .flat_map(|(_, c)| c.iter().map(|n| local.get(n).copied().unwrap_or(usize::MAX)))
+            .collect();
         let (mesh, _flipped) = Mesh::new_with_repair(nodes, flat)
             .map_err(|source| IoError::GmshBody { body: g.name.clone(), source })?;
         let boundary = mesh

@@ -12,9 +12,13 @@
 //! F̄ = Δt² F(t_{i+1}) + M_ρ (2U^i − U^{i−1}) + Δt M_α U^i + Δt A⁽¹⁾ U^i
 //! ```
 //!
-//! i.e. the time-discrete Kelvin–Voigt equation
-//! `ρ (U^{i+1} − 2U^i + U^{i−1})/Δt² + α (U^{i+1} − U^i)/Δt + A⁽⁰⁾U^{i+1}
-//!  + A⁽¹⁾(U^{i+1} − U^i)/Δt = F(t_{i+1}) − (contact and friction forces)` multiplied by `Δt²`.
+//! i.e. the time-discrete Kelvin–Voigt equation multiplied by `Δt²`:
+//!
+//! ```text
+//! M_ρ (U^{i+1} − 2U^i + U^{i−1})/Δt² + M_α (U^{i+1} − U^i)/Δt + A⁽⁰⁾ U^{i+1}
+//!     + A⁽¹⁾ (U^{i+1} − U^i)/Δt = F(t_{i+1}) − (contact and friction forces).
+//! ```
+//!
 //! `A` is symmetric positive definite even for bodies without any Dirichlet data (the mass
 //! term), so no coercivity check is needed; it is assembled on one sparsity pattern and
 //! factorised once (symbolic and numeric) for the whole run.
@@ -29,8 +33,8 @@
 //! (`j` is positively homogeneous), becomes `Δt² ∫ g_c |[v_t − U^i_t]| ds` in the step problem
 //! with the *physical* slip bound `g_c = F_c(|[u'_t]|) |λ_n|` (force per area). The spec's
 //! `j(v) = Δt ∫ g_c |[v_t − U^i_t]| ds` has one power of `Δt` too few for a `g_c` in force per
-//! area (check the units: every term of the step problem is `kg·m²`); synovia uses the slip bound `ḡ_c = Δt² g_c = F_c(|[u'_t]|^i) |Λ̄_n^i|` in the step
-//! problem, i.e. the Coulomb law with the scaled pressure of level `i`. The deceleration of a
+//! area (check the units: every term of the step problem is `kg·m²`); synovia uses the slip
+//! bound `ḡ_c = Δt² g_c = F_c(|[u'_t]|^i) |Λ̄_n^i|` in the step problem, i.e. the Coulomb law with the scaled pressure of level `i`. The deceleration of a
 //! sliding block (`μ g`, see the tests) confirms the scaling. The slip speed `|[u'_t]|^i` is
 //! `|[U^i_t] − [U^{i−1}_t]| / Δt` at each contact node and the law `F_c` is any
 //! [`FrictionLaw`] per pair ([`DynamicStepper::set_friction_law`]; default
@@ -86,7 +90,7 @@ use synovia_material::{voigt_len, KelvinVoigt, VoigtMatrix};
 use synovia_mesh::math::{Point, Real, Vector};
 
 use crate::error::TimeError;
-use crate::results::{pair_records, StepRecord};
+use crate::results::{pair_records, PairRecord, StepRecord};
 
 /// Largest element matrix size `(D(D+1))²` for `D ≤ 3`.
 const KE_MAX: usize = 144;
@@ -545,7 +549,8 @@ impl<const D: usize> DynamicStepper<D> {
                 0.5 * self.full_form(model, &self.disp, Kernel::Stiffness),
             )
         };
-        self.balance = EnergyBalance { kinetic, strain, exact: true, ..Default::default() };
+        let exact = all_zero(&self.lifts) && all_zero(&self.lifts_prev);
+        self.balance = EnergyBalance { kinetic, strain, exact, ..Default::default() };
         Ok(())
     }
 
@@ -865,12 +870,28 @@ impl<const D: usize> DynamicStepper<D> {
     }
 
     /// A record of the current level with its energies (kinetic energy of
-    /// `(U^i − U^{i−1})/Δt`, strain energy of `U^i`) and no contact figures: the row of
-    /// step 0 of a results table.
+    /// `(U^i − U^{i−1})/Δt`, strain energy of `U^i`) and zero contact figures (one
+    /// [`PairRecord`] per pair, so CSV columns line up): the row of step 0 of a results table.
     pub fn initial_record(&self) -> StepRecord {
+        let pairs = self
+            .geometry
+            .pairs
+            .iter()
+            .map(|(name, _)| PairRecord {
+                name: name.clone(),
+                force: [0.0; 3],
+                normal_force: 0.0,
+                tangential_force: 0.0,
+                contact_area: 0.0,
+                peak_pressure: 0.0,
+                stick_area: 0.0,
+                slip_area: 0.0,
+            })
+            .collect();
         StepRecord {
             step: self.step,
             time: self.time(),
+            pairs,
             kinetic_energy: self.balance.kinetic,
             strain_energy: self.balance.strain,
             cumulative_friction_dissipation: self.cumulative_friction,

