@@ -62,10 +62,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let sc = StaticContact::new(&model, &pairs, Default::default())?;
     let solver = synovia::solvers::by_name("pdas")?;
     let geo = sc.geometry();
-    let force = |t: f64| -> Result<(f64, synovia::contact::StaticContactResult<2>), Box<dyn std::error::Error>> {
-        let res = sc.solve(&model, t, solver.as_ref(), None, None, None)?;
-        Ok((res.normal_force(geo, 0..geo.len()), res))
-    };
+    let force =
+        |t: f64| -> Result<(f64, synovia::contact::StaticContactResult<2>), Box<dyn std::error::Error>> {
+            let res = sc.solve(&model, t, solver.as_ref(), None, None, None)?;
+            Ok((res.normal_force(geo, 0..geo.len()), res))
+        };
     let (mut t0_, mut t1) = (0.05, 0.2);
     let (mut f0, _) = force(t0_)?;
     let (mut f1, mut res) = force(t1)?;
@@ -84,7 +85,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         iterations += res.solution.report.iterations;
     }
     let rel = (f1 - p_target).abs() / p_target;
-    println!("base push {t1:.4} mm gives the contact force {f1:.4} N/mm (target {p_target}); KKT residual {:.1e}", res.kkt.max());
+    println!(
+        "base push {t1:.4} mm gives the contact force {f1:.4} N/mm (target {p_target}); KKT residual {:.1e}",
+        res.kkt.max()
+    );
     if rel > 1e-3 || !res.kkt.satisfied(1e-8) {
         return Err(format!("load not reached or KKT violated: force {f1}, KKT {:?}", res.kkt).into());
     }
@@ -103,7 +107,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // ## Step 6: write results
     let path = std::path::Path::new(&out).join("tibial_plateau.vtu");
     synovia::output::contact_vtu(&model, geo, &res, Encoding::Base64)?.write(&path)?;
-    println!("wrote {} (open in ParaView; colour by contact_pressure, Warp By Vector on displacement)", path.display());
+    println!(
+        "wrote {} (open in ParaView; colour by contact_pressure, Warp By Vector on displacement)",
+        path.display()
+    );
     let info = sc.elastic().info();
     let total = t0.elapsed().as_secs_f64();
     println!(

@@ -525,3 +525,48 @@ fn coulomb_fixed_point_uses_the_new_level() {
     }
     assert!(checked >= 5, "only {checked} fully slipping steps");
 }
+
+/// Initial data from a static contact problem (spec §7): a block pressed by its prescribed top
+/// onto a rigid flat is in static equilibrium; started from that state (`u₀` and the pressure
+/// from `StaticContact`, `u₁ = 0`) with constant data, the dynamic scheme stays at rest: with
+/// `U^i = U^{i−1} = u₀` the step equation reduces to the static one.
+#[test]
+fn initial_data_from_a_static_contact_problem_is_an_equilibrium() {
+    let mut mesh = rectangle(0.0, 1.0, 0.0, 0.5, 12, 6, Grading::Uniform, Grading::Uniform).unwrap();
+    mesh.set_part_kind("top", BoundaryKind::Prescribed).unwrap();
+    mesh.set_part_kind("bottom", BoundaryKind::Contact).unwrap();
+    let mut model = Model::<2>::new();
+    let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0, 0.3).unwrap())).unwrap();
+    model.prescribe(b, "top", |_, _| Vector::<2>::new(0.0, -0.01)).unwrap();
+    let curved = synovia_contact::operators::FnObstacle::new(|x: &Point<2>| {
+        // a shallow bump: φ = y + 0.05 (x − ½)²
+        let g = 0.1 * (x[0] - 0.5);
+        let n = (1.0 + g * g).sqrt();
+        ((x[1] + 0.05 * (x[0] - 0.5).powi(2)) / n, Vector::<2>::new(g / n, 1.0 / n))
+    });
+    let pairs = vec![ContactPair::rigid("floor", b, "bottom", Arc::new(curved))];
+    let sc = synovia_contact::StaticContact::new(&model, &pairs, Default::default()).unwrap();
+    let statics = sc.solve(&model, 0.0, &pdas(), None, None, None).unwrap();
+    assert!(statics.kkt.satisfied(1e-10));
+    let active = statics.solution.lambda_n.iter().filter(|&&l| l > 0.0).count();
+    assert!(active > 0 && active < statics.solution.lambda_n.len());
+
+    let mut stepper =
+        DynamicStepper::new(&model, &[DynamicBody::elastic(1.0)], &pairs, DynamicParams::new(1e-2)).unwrap();
+    stepper.set_initial_state(&model, Some(&statics.displacement), None).unwrap();
+    stepper.set_initial_pressure(&statics.solution.lambda_n).unwrap();
+    let scale = statics.displacement[0].iter().fold(0.0_f64, |m, u| m.max(u.norm()));
+    for _ in 0..5 {
+        stepper.step(&model, &pdas()).unwrap();
+        let drift = stepper.displacement()[0]
+            .iter()
+            .zip(&statics.displacement[0])
+            .fold(0.0_f64, |m, (a, b)| m.max((a - b).norm()));
+        assert!(drift < 1e-9 * scale, "the static state drifts by {drift:e}");
+        let p = stepper.pressure();
+        let pmax = statics.solution.lambda_n.iter().fold(0.0_f64, |m, &l| m.max(l));
+        for (a, b) in p.iter().zip(&statics.solution.lambda_n) {
+            assert!((a - b).abs() < 1e-8 * pmax, "pressure {a} vs static {b}");
+        }
+    }
+}
