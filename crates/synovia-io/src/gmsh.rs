@@ -1314,7 +1314,7 @@ struct Body<const D: usize> {
     /// Index in [`GmshMesh::nodes`] → local node index.
     local: HashMap<usize, usize>,
     /// Sorted local node lists of the boundary facets.
-    boundary: HashSet<Vec<usize>>,
+    boundary: HashSet<[usize; D]>,
 }
 
 impl GmshMesh {
@@ -1410,7 +1410,10 @@ impl GmshMesh {
                     .filter_map(|(_, f)| {
                         let lf: Vec<usize> =
                             f.iter().map(|n| body.local.get(n).copied()).collect::<Option<_>>()?;
-                        let mut key = lf.clone();
+                        let mut key = [0usize; D];
+                        for (k, &n) in key.iter_mut().zip(&lf) {
+                            *k = n;
+                        }
                         key.sort_unstable();
                         body.boundary.contains(&key).then_some(lf)
                     })
@@ -1492,15 +1495,25 @@ impl GmshMesh {
             .collect();
         let (mesh, _flipped) = Mesh::new_with_repair(nodes, flat)
             .map_err(|source| IoError::GmshBody { body: g.name.clone(), source })?;
-        let boundary = mesh
-            .boundary_facets()
-            .into_iter()
-            .map(|f| {
-                let mut key = f.nodes;
-                key.sort_unstable();
-                key
-            })
-            .collect();
+        let boundary = boundary_keys(&mesh);
         Ok(Body { name: g.name.clone(), mesh, local, boundary })
     }
+}
+
+/// Sorted node lists of the boundary facets of a mesh (faces of exactly one cell); the same set
+/// as [`Mesh::boundary_facets`], without the orientation work.
+fn boundary_keys<const D: usize>(mesh: &Mesh<D>) -> HashSet<[usize; D]> {
+    let mut count: HashMap<[usize; D], u32> = HashMap::with_capacity(mesh.n_cells() * (D + 1));
+    for cell in mesh.cells() {
+        for opposite in 0..cell.len() {
+            let mut key = [0usize; D];
+            let others = cell.iter().enumerate().filter(|&(i, _)| i != opposite).map(|(_, &n)| n);
+            for (k, n) in key.iter_mut().zip(others) {
+                *k = n;
+            }
+            key.sort_unstable();
+            *count.entry(key).or_insert(0) += 1;
+        }
+    }
+    count.into_iter().filter(|&(_, c)| c == 1).map(|(k, _)| k).collect()
 }

@@ -96,6 +96,18 @@ pub struct Mesh<const D: usize> {
     nodes: Vec<Point<D>>,
     cells: Vec<usize>,
     parts: Vec<BoundaryPart>,
+    facet_index: FacetIndex,
+}
+
+/// Lazily built index of the boundary facets by their sorted node lists (a cache: it takes no
+/// part in comparisons and is reset whenever cells change).
+#[derive(Debug, Clone, Default)]
+struct FacetIndex(std::sync::OnceLock<HashMap<Vec<usize>, BoundaryFacet>>);
+
+impl PartialEq for FacetIndex {
+    fn eq(&self, _other: &Self) -> bool {
+        true
+    }
 }
 
 /// Outcome of validating one cell's orientation.
@@ -159,7 +171,7 @@ impl<const D: usize> Mesh<D> {
                 }
             }
         }
-        Ok(Self { nodes, cells, parts: Vec::new() })
+        Ok(Self { nodes, cells, parts: Vec::new(), facet_index: FacetIndex::default() })
     }
 
     /// Classifies the orientation of cell `c` by its relative determinant `det / h^D`
@@ -200,6 +212,7 @@ impl<const D: usize> Mesh<D> {
                 CellOrientation::Inverted(_) => {
                     let per = D + 1;
                     self.cells.swap(c * per + D - 1, c * per + D);
+                    self.facet_index = FacetIndex::default();
                     flipped += 1;
                 }
                 CellOrientation::Degenerate(det) => return Err(MeshError::DegenerateCell { cell: c, det }),
@@ -314,6 +327,7 @@ impl<const D: usize> Mesh<D> {
         let new_nodes: Vec<Point<D>> = self.nodes.iter().map(f).collect();
         let candidate = Self::new(new_nodes, self.cells.clone())?;
         self.nodes = candidate.nodes;
+        self.facet_index = FacetIndex::default();
         Ok(())
     }
 
@@ -474,12 +488,16 @@ impl<const D: usize> Mesh<D> {
         kind: BoundaryKind,
         facets: &[Vec<usize>],
     ) -> Result<&BoundaryPart, MeshError> {
-        let mut index: HashMap<Vec<usize>, BoundaryFacet> = HashMap::new();
-        for f in self.boundary_facets() {
-            let mut key = f.nodes.clone();
-            key.sort_unstable();
-            index.insert(key, f);
-        }
+        let index = self.facet_index.0.get_or_init(|| {
+            self.boundary_facets()
+                .into_iter()
+                .map(|f| {
+                    let mut key = f.nodes.clone();
+                    key.sort_unstable();
+                    (key, f)
+                })
+                .collect()
+        });
         let mut selected = Vec::with_capacity(facets.len());
         for f in facets {
             let mut key = f.clone();
