@@ -127,6 +127,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     };
     print(&records[0], &stepper, &model);
+    // ParaView series (every 20th step): displacement, contact pressure, friction traction
+    let mut series =
+        synovia::time::quasistatic::QuasiStaticOutput::new(&out, "dynamic_drop", stepper.geometry())?;
     for _ in 0..steps {
         let rec = stepper.step(&model, &solver)?;
         let f = Vector::<2>::new(rec.pairs[0].force[0], rec.pairs[0].force[1]);
@@ -143,12 +146,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         if rec.step % 20 == 0 {
             print(&rec, &stepper, &model);
+            if let Some(state) = stepper.last_contact() {
+                series.write_step(&model, &rec, state)?;
+            }
         }
         records.push(rec);
     }
     let mismatch = (stepper.momentum() - p0 - impulse).norm() / (total_mass * v0.norm());
     let csv = Path::new(&out).join("dynamic_drop.csv");
     write_csv(&csv, &records)?;
+    println!("ParaView series: {}", series.pvd_path().display());
 
     // ## Step 4: cost of a step vs. a plain elastic factorisation + solve of the same mesh
     let mut clamped = mesh.clone();

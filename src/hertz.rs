@@ -23,7 +23,7 @@ use synovia_contact::operators::{ContactPair, PlaneObstacle};
 use synovia_contact::{ContactError, ContactSolver};
 use synovia_fem::{ElasticParams, ElasticSolver, FemError, Model};
 use synovia_material::{isotropic, plane_strain};
-use synovia_mesh::generators::{half_disc_refined, hemisphere_refined};
+use synovia_mesh::generators::{half_disc_refined, hemisphere_refined, nodes_1d, rectangle, Grading};
 use synovia_mesh::math::{Point, Real, Vector};
 use synovia_mesh::BoundaryKind;
 
@@ -539,5 +539,163 @@ pub fn cattaneo_mindlin_2d(
     run.traction_l2_err = (num / den).sqrt();
     run.coulomb_excess = excess;
     run.kkt = res.kkt.max().max(normal.kkt.max());
+    Ok(run)
+}
+
+/// Parameters of the 2D Hertz problem on non-matching meshes: the half-disc indenter of
+/// [`Hertz2d`] (radius `R`, refined toward its lowest point) pressed by a prescribed
+/// displacement of its flat top onto an elastic block `[−W, W] × [−H, 0]` clamped at its base,
+/// whose mesh is refined toward the contact point with [`Grading::Refined`] to another mesh
+/// size. The pair is node-to-segment ([`ContactPair::node_to_segment`]).
+///
+/// Reference: the Hertz line contact of a cylinder on a half-space, `1/E* = Σ (1 − ν_i²)/E_i`,
+/// `R* = R`; the block stands for the half-space when `H, W ≫ a`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HertzBlock2d {
+    /// Radius `R` of the indenter.
+    pub radius: Real,
+    /// Young's modulus of the indenter.
+    pub e1: Real,
+    /// Its Poisson ratio.
+    pub nu1: Real,
+    /// Young's modulus of the block.
+    pub e2: Real,
+    /// Its Poisson ratio.
+    pub nu2: Real,
+    /// Vertical push of the indenter's top.
+    pub push: Real,
+    /// Coarse cells of the indenter along its radius.
+    pub n: usize,
+    /// Refinement levels of the indenter toward its lowest point.
+    pub levels: usize,
+    /// Radius of the indenter's refined zone (multiple of `R`).
+    pub refine_radius: Real,
+    /// Half-width `W` of the block.
+    pub half_width: Real,
+    /// Depth `H` of the block.
+    pub depth: Real,
+    /// Block cell size in its fine window at the contact point.
+    pub block_h: Real,
+    /// Block cell size far from the contact.
+    pub block_h_far: Real,
+    /// Half-width of the block's fine window along x (its depth along y is half of it).
+    pub window: Real,
+    /// `true`: the indenter's nodes are the slave nodes (block = master); `false`: the block's.
+    pub slave_indenter: bool,
+    /// Warm-start by nested iteration on the contact rows (default `true`).
+    pub nested: bool,
+}
+
+impl Default for HertzBlock2d {
+    fn default() -> Self {
+        Self {
+            radius: 1.0,
+            e1: 1.0,
+            nu1: 0.3,
+            e2: 1.0,
+            nu2: 0.3,
+            push: 0.01,
+            n: 8,
+            levels: 10,
+            refine_radius: 0.16,
+            half_width: 1.0,
+            depth: 1.0,
+            block_h: 1.5e-3,
+            block_h_far: 0.1,
+            window: 0.12,
+            slave_indenter: true,
+            nested: true,
+        }
+    }
+}
+
+/// `[a, b]` graded by [`Grading::Refined`] with cells of about `h` in the window
+/// `|x − center| ≤ width/2` and `h_far` far from it: the grading and the number of cells
+/// (the smallest `n` whose finest cell is at most `1.02 h`).
+pub fn refined_axis(
+    a: Real,
+    b: Real,
+    center: Real,
+    width: Real,
+    h: Real,
+    h_far: Real,
+) -> Result<(Grading, usize), ContactError> {
+    let ratio = (h_far / h).max(1.0);
+    let g = Grading::Refined { center, width, ratio };
+    let mut n = ((b - a) / h_far).ceil().max(1.0) as usize;
+    loop {
+        let x = nodes_1d(a, b, n, g)?;
+        let hmin = x.windows(2).map(|w| w[1] - w[0]).fold(Real::INFINITY, Real::min);
+        if hmin <= 1.02 * h || n > 100_000 {
+            return Ok((g, n));
+        }
+        n = (n as Real * (hmin / h).clamp(1.01, 1.5)).ceil() as usize;
+    }
+}
+
+/// The model of [`HertzBlock2d`]: body 0 `"indenter"` (contact part `"contact"`, its arc below
+/// `y < 0.3 R`), body 1 `"block"` (contact part `"top"`), and the node-to-segment pair.
+pub fn hertz2d_block_model(p: &HertzBlock2d) -> Result<(Model<2>, Vec<ContactPair<2>>), ContactError> {
+    let r = p.radius;
+    let mut upper = half_disc_refined(
+        Point::<2>::new(0.0, r),
+        r,
+        p.n,
+        Point::<2>::new(0.0, 0.0),
+        p.refine_radius * r,
+        p.levels,
+    )?;
+    upper.set_part_kind("top", BoundaryKind::Prescribed)?;
+    upper.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[1] < 0.3 * r && n[1] < 0.0)?;
+    let (gx, nx) = refined_axis(-p.half_width, p.half_width, 0.0, 2.0 * p.window, p.block_h, p.block_h_far)?;
+    let (gy, ny) = refined_axis(-p.depth, 0.0, 0.0, p.window, p.block_h, p.block_h_far)?;
+    let mut block = rectangle(-p.half_width, p.half_width, -p.depth, 0.0, nx, ny, gx, gy)?;
+    block.set_part_kind("bottom", BoundaryKind::Clamped)?;
+    block.set_part_kind("top", BoundaryKind::Contact)?;
+    let mut model = Model::<2>::new();
+    let up =
+        model.add_body("indenter", upper, Arc::new(plane_strain(p.e1, p.nu1).map_err(fem)?)).map_err(fem)?;
+    let push = p.push;
+    model.prescribe(up, "top", move |_, t| Vector::<2>::new(t, -push)).map_err(fem)?;
+    let lo =
+        model.add_body("block", block, Arc::new(plane_strain(p.e2, p.nu2).map_err(fem)?)).map_err(fem)?;
+    let pair = if p.slave_indenter {
+        ContactPair::node_to_segment("indenter-block", up, "contact", lo, "top")
+    } else {
+        ContactPair::node_to_segment("block-indenter", lo, "top", up, "contact")
+    };
+    Ok((model, vec![pair]))
+}
+
+/// Solves [`HertzBlock2d`] with `solver` and measures `a`, `p₀` (fit of the slave nodal
+/// pressures) and the pressure profile against the Hertz line contact for the computed force.
+pub fn hertz2d_block(p: &HertzBlock2d, solver: &dyn ContactSolver) -> Result<ContactRun, ContactError> {
+    let (model, pairs) = hertz2d_block_model(p)?;
+    let linear_solve_s = linear_solve_time(&model)?;
+    let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+    sc.set_nested_iteration(p.nested.then_some(32));
+    let t0 = Instant::now();
+    let res = sc.solve(&model, 0.0, solver, None, None, None)?;
+    let solve_s = t0.elapsed().as_secs_f64();
+    let geo = sc.geometry();
+    let force = res.normal_force(geo, 0..geo.len());
+    let inv_e = (1.0 - p.nu1 * p.nu1) / p.e1 + (1.0 - p.nu2 * p.nu2) / p.e2;
+    let e_star = 1.0 / inv_e;
+    let a_exact = (4.0 * force * p.radius / (std::f64::consts::PI * e_star)).sqrt();
+    let p0_exact = 2.0 * force / (std::f64::consts::PI * a_exact);
+    let name = if p.slave_indenter { "hertz2d_block_slave_indenter" } else { "hertz2d_block_slave_block" };
+    let mut run = hertz_run(
+        name,
+        p.levels,
+        &model,
+        &sc,
+        &res,
+        solver,
+        (solve_s, linear_solve_s),
+        (force, a_exact, p0_exact),
+        |x| x[0],
+    );
+    // mesh size at the contact point of the slave side
+    run.h = if p.slave_indenter { contact_h(&model) } else { p.block_h };
     Ok(run)
 }

@@ -18,23 +18,41 @@
 //! See `docs/architecture.md` for the crate graph and the path of data from mesh to solution,
 //! and the specification `spec/model.md` for the equations.
 //!
+//! ## A complete small model
+//!
+//! A plane-strain block (2 × 1) rests on a rigid floor; its top is pushed down by 1 % of its
+//! height over two load steps, then sheared sideways with Coulomb friction `μ = 0.3`. The
+//! [`builder::JointModel`] holds the bodies, the boundary conditions by part name with their
+//! load histories, the contact pair and the solver, and runs the quasi-static analysis:
+//!
 //! ```
-//! use std::sync::Arc;
 //! use synovia::prelude::*;
 //!
-//! // A 2 × 1 block, clamped at the bottom, pulled up at the top by a traction of 0.01 E.
-//! let mut mesh = rectangle(0.0, 2.0, 0.0, 1.0, 8, 4, Grading::Uniform, Grading::Uniform)?;
-//! mesh.set_part_kind("bottom", BoundaryKind::Clamped)?;
-//! mesh.set_part_kind("top", BoundaryKind::Traction)?;
-//! let material = plane_strain(1.0e3, 0.3)?;
-//! let mut model = Model::<2>::new();
-//! let block = model.add_body("block", mesh, Arc::new(material))?;
-//! model.traction(block, "top", |_x, _n, _t| Vector::<2>::new(0.0, 10.0))?;
-//! let solution = solve_elastic(&model, 0.0)?;
-//! let top = solution.displacement[0].iter().map(|u| u[1]).fold(0.0, f64::max);
-//! assert!(top > 0.0);
+//! let mesh = rectangle(0.0, 2.0, 0.0, 1.0, 8, 4, Grading::Uniform, Grading::Uniform)?;
+//! let mut joint = JointModel::<2>::new();
+//! let block = joint.add_body("block", mesh, plane_strain(1.0e3, 0.3)?)?;
+//! // the top moves down by 0.01 (times 0 → 1), then sideways by 0.002 (times 1 → 2)
+//! let down = PiecewiseLinear::new(&[(0.0, 0.0), (1.0, 1.0)])?;
+//! let side = PiecewiseLinear::new(&[(1.0, 0.0), (2.0, 1.0)])?;
+//! joint.prescribe_field(block, "top", ComponentMask::ALL, move |_x, t| {
+//!     Vector::<2>::new(0.002 * side.value(t), -0.01 * down.value(t))
+//! })?;
+//! // the bottom touches the floor y = 0, with friction
+//! let floor = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0))?;
+//! joint.contact_rigid("floor", block, "bottom", floor, 0.3)?;
+//! joint.solver("pdas")?;
+//!
+//! let result = joint.run_quasistatic(&[0.5, 1.0, 1.5, 2.0])?;
+//! assert_eq!(result.records.len(), 4);
+//! let pushed = &result.records[1].pairs[0];
+//! assert!(pushed.normal_force > 0.0 && pushed.contact_area > 1.99);
+//! let sheared = &result.records[3].pairs[0];
+//! assert!(sheared.tangential_force <= 0.3 * sheared.normal_force * (1.0 + 1e-6));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+//!
+//! The same model can be written as a TOML scenario and run with the `synovia` command
+//! (crate `synovia-cli`, format in `docs/scenario.md`).
 #![warn(missing_docs)]
 
 pub use synovia_contact as contact_ops;
@@ -50,6 +68,7 @@ pub use synovia_uzawa as uzawa;
 pub mod contact {
     pub use synovia_contact::static_contact::*;
 }
+pub mod builder;
 pub mod hertz;
 pub mod output;
 pub mod solvers;
@@ -57,6 +76,9 @@ pub mod verification;
 
 /// The types most programs need.
 pub mod prelude {
+    pub use crate::builder::{Analysis, BodyMaterial, BodyRef, JointError, JointModel, RunResult, StepView};
+    pub use synovia_contact::operators::{CylinderObstacle, FnObstacle, PlaneObstacle, SphereObstacle};
+    pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction};
     pub use synovia_fem::{
         solve_elastic, BodyFields, BodyId, ComponentMask, ElasticParams, ElasticSolution, ElasticSolver,
         FemError, Model,
@@ -68,4 +90,6 @@ pub mod prelude {
     pub use synovia_mesh::generators::{box_mesh, rectangle, Grading};
     pub use synovia_mesh::math::{Point, Real, Vector};
     pub use synovia_mesh::{BoundaryKind, Mesh, MeshError};
+    pub use synovia_time::history::{Constant, LoadHistory, Periodic, PiecewiseLinear, RigidMotion};
+    pub use synovia_time::results::StepRecord;
 }

@@ -1,1 +1,30 @@
-//! tmp
+//! # synovia-cli
+//!
+//! The library behind the `synovia` command: the TOML scenario format ([`scenario`]), its
+//! translation into a [`JointModel`](synovia::builder::JointModel) ([`build`]), and running it
+//! with ParaView, CSV and JSON output ([`run`]). The format is documented with a complete
+//! example in `docs/scenario.md`.
+//!
+//! ```no_run
+//! use synovia_cli::{run, scenario::Scenario};
+//!
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! let sc = Scenario::from_file("examples/scenarios/hertz2d.toml")?;
+//! let report = run::run(&sc, Some("out/hertz2d".as_ref()), &mut |_| {})?;
+//! println!("{} steps, peak pressure {}", report.summary.steps.len(),
+//!          report.summary.steps[0].pairs[0].peak_pressure);
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! Errors in a scenario are [`ScenarioError`]s: they name the key path (e.g.
+//! `body[0].material.E`) and the line and column in the file, for syntax errors, unknown keys
+//! and wrong types (from toml's spans) as well as for semantic errors found while building the
+//! model (unknown body or part names, missing data, invalid materials or histories).
+#![warn(missing_docs)]
+
+pub mod build;
+pub mod run;
+pub mod scenario;
+
+pub use scenario::{Scenario, ScenarioError, Source};

@@ -1,1 +1,145 @@
-fn main() {}
+//! `synovia`: run joint-contact scenarios described in TOML files (`docs/scenario.md`).
+//!
+//! ```text
+//! synovia run SCENARIO.toml --out DIR    # solve; write DIR/NAME.pvd, NAME_*.vtu, NAME.csv, summary.json
+//! synovia check SCENARIO.toml            # read and build the model without solving
+//! ```
+//!
+//! Exit codes: 0 success, 1 the solve or the output failed, 2 a broken scenario (the message on
+//! stderr names the key and the line:column) or bad command-line arguments.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use synovia_cli::run::{self, Progress, RunError};
+use synovia_cli::Scenario;
+
+#[derive(Parser)]
+#[command(name = "synovia", version, about = "Finite-element contact mechanics of human joints")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve a scenario and write ParaView (PVD/VTU), CSV and summary.json results.
+    Run {
+        /// The scenario file (TOML, see docs/scenario.md).
+        scenario: PathBuf,
+        /// Output directory (default: `output.dir` of the scenario, or out/NAME).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        /// No progress bar and no closing report.
+        #[arg(long, short)]
+        quiet: bool,
+    },
+    /// Read a scenario and build its model (meshes, materials, conditions) without solving.
+    Check {
+        /// The scenario file.
+        scenario: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Check { scenario } => {
+            let checked = Scenario::from_file(&scenario).and_then(|sc| run::check(&sc));
+            match checked {
+                Ok(info) => {
+                    println!(
+                        "{}: {}D, {} steps ({})",
+                        scenario.display(),
+                        info.dimension,
+                        info.steps,
+                        info.analysis
+                    );
+                    for (name, nodes, cells) in &info.bodies {
+                        println!("  body {name}: {nodes} nodes, {cells} cells");
+                    }
+                    for p in &info.pairs {
+                        println!("  contact pair {p}");
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+            }
+        }
+        Command::Run { scenario, out, quiet } => {
+            let sc = match Scenario::from_file(&scenario) {
+                Ok(sc) => sc,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let target = if !quiet && std::io::stderr().is_terminal() {
+                ProgressDrawTarget::stderr()
+            } else {
+                ProgressDrawTarget::hidden()
+            };
+            let bar = ProgressBar::with_draw_target(None, target);
+            if let Ok(style) = ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} steps  {msg}",
+            ) {
+                bar.set_style(style);
+            }
+            let result = run::run(&sc, out.as_deref(), &mut |p| match p {
+                Progress::Start { steps } => bar.set_length(steps as u64),
+                Progress::Step { index, time } => {
+                    bar.set_position(index as u64 + 1);
+                    bar.set_message(format!("t = {time:.4e}"));
+                }
+            });
+            bar.finish_and_clear();
+            match result {
+                Ok(report) => {
+                    if !quiet {
+                        let s = &report.summary;
+                        let dir = report.out_dir.display();
+                        println!(
+                            "{}: {} analysis, {} steps, {} dofs, {} contact nodes, solver {}, {:.2} s",
+                            s.name,
+                            s.analysis,
+                            s.steps.len(),
+                            s.dofs,
+                            s.contact_nodes,
+                            s.solver,
+                            s.total_s
+                        );
+                        if let Some(last) = s.steps.last() {
+                            for p in &last.pairs {
+                                println!(
+                                    "  last step (t = {}): pair {}: normal force {:.5e}, contact area {:.5e}, peak pressure {:.5e}",
+                                    last.time, p.name, p.normal_force, p.contact_area, p.peak_pressure
+                                );
+                            }
+                        }
+                        println!("results in {dir}/:");
+                        if let Some(pvd) = &s.files.pvd {
+                            println!("  {pvd}  (ParaView: File > Open, Apply, colour by contact_pressure)");
+                        }
+                        println!("  {}  (one row per step)", s.files.csv);
+                        println!("  summary.json");
+                    }
+                    ExitCode::SUCCESS
+                }
+                Err(RunError::Scenario(e)) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+                Err(RunError::Failed(e)) => {
+                    eprintln!("error: {e:#}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+    }
+}

@@ -11,6 +11,11 @@
 //! Λ_t − π(Λ_t + ρ B_Ht (U − U_prev))      = 0
 //! ```
 //!
+//! Contact pairs are node-to-node (matching meshes), node-to-segment / node-to-facet
+//! (non-matching meshes, with the R*-tree contact search of [`search`]) or body-to-obstacle;
+//! the geometry can be rebuilt at every pose ([`operators::ContactGeometry::new_deformed`],
+//! [`StaticContact::update_geometry`]).
+//!
 //! its condensation on the contact interface ([`Interface`], spec §6.4), the
 //! [`ContactSolver`] trait implemented by `synovia-pdas` and `synovia-uzawa`, and the KKT checker
 //! [`check_kkt`].
@@ -23,6 +28,7 @@ pub mod nested;
 pub mod operators;
 pub mod problem;
 pub mod rows;
+pub mod search;
 pub mod solver;
 pub mod static_contact;
 pub mod testing;

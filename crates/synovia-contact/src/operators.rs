@@ -2,16 +2,22 @@
 //!
 //! A [`ContactPair`] joins the contact part of a body `k` either to the contact part of another
 //! body `l` with nodes at matching positions (node-to-node, the conforming case of the report),
-//! or to a rigid obstacle described by a signed-distance function (the foundation case). For
-//! every contact node `s_r` of body `k` [`ContactGeometry`] stores
+//! to the contact part of another body `l` with an arbitrary (non-matching) mesh
+//! (node-to-segment in 2D, node-to-facet in 3D: [`Partner::Segment`]), or to a rigid obstacle
+//! described by a signed-distance function (the foundation case). For every contact node `s_r`
+//! of body `k` [`ContactGeometry`] stores
 //!
 //! * the normal `n_r` (the outward nodal normal `n^k` of body `k`, spec §1, or a fixed
-//!   direction), and an orthonormal tangent basis,
+//!   direction; for node-to-segment the master facet's outward normal negated), and an
+//!   orthonormal tangent basis,
 //! * the lumped weight `κ_r = ∫_{Γ_c} φ_r ds` (row sums of the boundary mass of part `k`),
-//! * the initial gap `d_r = (x_l − x_k) · n_r` (node-to-node) or `d_r = φ(x_k)` (obstacle).
+//! * the initial gap `d_r = (x_l − x_k) · n_r` (node-to-node), `d_r = (Σ_j w_j x_{l,j} − x_k) · n_r`
+//!   (node-to-segment, `w_j` the weights of the projection of `x_k` on its master facet) or
+//!   `d_r = φ(x_k)` (obstacle).
 //!
 //! From these, [`ContactGeometry::normal_constraints`] builds `B_hn` in the reduced unknowns of a
-//! [`DofMap`] (`(B_hn U)_r = [U_n](s_r) = n_r · (u^k(s_r) − u^l(s_r))`), and
+//! [`DofMap`] (`(B_hn U)_r = [U_n](s_r) = n_r · (u^k(s_r) − u^l(s_r))`, with
+//! `u^l(s_r) = Σ_j w_j u^l_j` for node-to-segment), and
 //! [`ContactGeometry::friction_constraints`] builds `B_Ht` on the dual cells of the contact nodes:
 //! `(B_Ht U)_r = g_{c,r} κ_r T_rᵀ [U_t](s_r)`, the cell integral `∫_{cell r} g_c [U_t] ds` with the
 //! nodal (lumped) rule, `T_r` the tangent basis (one vector in 2D, two in 3D), for the cells with
@@ -22,6 +28,41 @@
 //! tangential constraints as tangential unknowns, which violates the inf–sup condition. synovia
 //! uses the dual (median) cells of the contact nodes as the triangulation `Δ_H` in 2D and 3D,
 //! which keeps `B_Ht` of full rank and the semismooth Newton systems well posed.
+//!
+//! # Non-matching meshes: node-to-segment / node-to-facet
+//!
+//! For a [`Partner::Segment`] pair, part `k` is the *slave* side and part `l` the *master*
+//! side. Every slave node `x_s` is projected onto the master facets with the R*-tree search of
+//! [`crate::search`] (closest facet containing the orthogonal projection; see there for the
+//! rule at convex master edges and at the rim of the master part). The pair uses
+//!
+//! * the normal `n = −n_l`, the master facet's outward unit normal negated (it points from `k`
+//!   into `l`, like `n^k` of a conforming pair). The master normal, not the slave nodal normal,
+//!   is used because then `d` is the exact distance of `x_s` to the master facet plane and a
+//!   flat master surface gives the exact normal whatever the slave mesh;
+//! * the master point `x_m = Σ_j w_j x_{l,j}` (barycentric weights on the facet's nodes,
+//!   [`ContactNode::master`]), `[u_n] = (u_k − Σ_j w_j u_{l,j}) · n`,
+//!   `d = (x_m − x_s) · n` (the signed distance, negative if `x_s` is inside body `l`);
+//! * the tangent basis of `n` and the weight `κ_s` from the slave facets (the multipliers live
+//!   on the slave side, spec §5).
+//!
+//! Slave nodes without a master facet — farther than the pair's search distance, facing no
+//! master facet, or beyond the rim of the master part — are left out of the pair; they can
+//! enter it when the geometry is rebuilt at a later pose. The operator is not exact for a
+//! uniform pressure on non-matching meshes (the slave nodal forces are passed to the master
+//! nodes by point interpolation, not by the mortar integral); see `docs/contact.md` for the
+//! measured error.
+//!
+//! # Rebuilding the geometry at a pose
+//!
+//! [`ContactGeometry::new_deformed`] builds the pairing, normals, tangents and weights in the
+//! configuration `x + u⁰` (a pose: rigid motion plus small elastic displacement), with
+//! small-deformation kinematics from there. The constraints keep acting on the *total*
+//! displacement `U` from the reference configuration, so the gap is returned in total form:
+//! the linearised condition `([U] − [u⁰]) · n ≤ d(x + u⁰)` is `[U] · n ≤ d(x + u⁰) + [u⁰] · n`,
+//! which for node-to-segment is `(Σ_j w_j X_{l,j} − X_s) · n` with the reference positions `X`
+//! and the weights and normal of the pose. Node-to-node pairs keep the pairing of the
+//! reference configuration (normals from the pose).
 
 use std::fmt;
 use std::sync::Arc;
@@ -33,6 +74,7 @@ use synovia_mesh::math::{Point, Real, Vector};
 use crate::error::ContactError;
 use crate::problem::{FrictionConstraints, NormalConstraints};
 use crate::rows::SparseRows;
+use crate::search::{area_normal, FacetSearch};
 
 /// A rigid obstacle given by a signed distance `φ` (positive in the free space outside the
 /// obstacle, negative inside) and its gradient.
@@ -201,6 +243,19 @@ pub enum Partner<const D: usize> {
     },
     /// A rigid obstacle.
     Rigid(Arc<dyn SignedDistance<D>>),
+    /// The contact part `part` of body `body` with any mesh: node-to-segment (2D) /
+    /// node-to-facet (3D). Body `k` is the slave side, body `l` the master side (see the
+    /// [module docs](self)).
+    Segment {
+        /// The other (master) body `l`.
+        body: BodyId,
+        /// Its contact part.
+        part: String,
+        /// Largest distance from a slave node to its master point; slave nodes farther away are
+        /// left out of the pair (`None`: every slave node is paired with its closest master
+        /// facet).
+        search_distance: Option<Real>,
+    },
 }
 
 /// A contact pair `Γ_c^{kl}` (spec §1, §3).
@@ -234,6 +289,26 @@ impl<const D: usize> ContactPair<D> {
             },
             friction: 0.0,
         }
+    }
+    /// Body–body pair on non-matching meshes: node-to-segment (2D) / node-to-facet (3D), with
+    /// the nodes of `part_k` of body `k` as slave nodes projected onto the facets of `part_l`
+    /// of body `l` (no search-distance limit; see [`ContactPair::with_search_distance`]).
+    pub fn node_to_segment(name: &str, body_k: BodyId, part_k: &str, body_l: BodyId, part_l: &str) -> Self {
+        Self {
+            name: name.to_string(),
+            body: body_k,
+            part: part_k.to_string(),
+            partner: Partner::Segment { body: body_l, part: part_l.to_string(), search_distance: None },
+            friction: 0.0,
+        }
+    }
+    /// Sets the search distance of a node-to-segment pair (no effect on other pairs).
+    #[must_use]
+    pub fn with_search_distance(mut self, distance: Real) -> Self {
+        if let Partner::Segment { search_distance, .. } = &mut self.partner {
+            *search_distance = Some(distance);
+        }
+        self
     }
     /// Body–rigid-obstacle pair.
     pub fn rigid(name: &str, body: BodyId, part: &str, obstacle: Arc<dyn SignedDistance<D>>) -> Self {
@@ -269,9 +344,12 @@ pub struct ContactNode<const D: usize> {
     pub pair: usize,
     /// Body `k` and node.
     pub node: (BodyId, usize),
-    /// Partner node on body `l` (node-to-node), or `None` (rigid obstacle).
+    /// Partner node on body `l` (node-to-node), or `None` (rigid obstacle, node-to-segment).
     pub partner: Option<(BodyId, usize)>,
-    /// Position of the node of body `k`.
+    /// Node-to-segment: the master nodes `(body l, node j, w_j)` of the master point
+    /// `Σ_j w_j x_{l,j}` (`w_j > 0`, `Σ_j w_j = 1`); empty for the other pair kinds.
+    pub master: Vec<(BodyId, usize, Real)>,
+    /// Position of the node of body `k` (in the configuration the geometry was built on).
     pub position: Point<D>,
     /// Unit normal `n_r`.
     pub normal: Vector<D>,
@@ -330,9 +408,93 @@ fn tangent_basis<const D: usize>(n: &Vector<D>) -> [Vector<D>; 2] {
     t
 }
 
+impl<const D: usize> ContactNode<D> {
+    /// The jump `[u](s_r) = u^k(s_r) − u^l(s_r)` of nodal displacements `displacement[body][node]`:
+    /// `u^l` is the partner node's (node-to-node), `Σ_j w_j u^l_j` (node-to-segment) or 0
+    /// (rigid obstacle). `None` if the displacements do not fit the node.
+    pub fn jump(&self, displacement: &[Vec<Vector<D>>]) -> Option<Vector<D>> {
+        let at = |b: BodyId, i: usize| displacement.get(b.0).and_then(|u| u.get(i)).copied();
+        let mut j = at(self.node.0, self.node.1)?;
+        if let Some((b, i)) = self.partner {
+            j -= at(b, i)?;
+        }
+        for &(b, i, w) in &self.master {
+            j -= at(b, i)? * w;
+        }
+        Some(j)
+    }
+}
+
+/// Nodal normals of `facets` from the positions `pos` (the rule of
+/// [`synovia_mesh::Mesh::nodal_normals_of`]), sorted by node.
+fn nodal_normals_at<'a, const D: usize>(
+    pos: &[Point<D>],
+    facets: impl Iterator<Item = &'a [usize]>,
+) -> Vec<(usize, Vector<D>)> {
+    let mut acc: std::collections::HashMap<usize, Vector<D>> = std::collections::HashMap::new();
+    for f in facets {
+        let n = area_normal(pos, f);
+        for &i in f {
+            *acc.entry(i).or_insert_with(Vector::<D>::zeros) += n;
+        }
+    }
+    let mut out: Vec<(usize, Vector<D>)> = acc
+        .into_iter()
+        .map(|(i, n)| {
+            let len = n.norm();
+            (i, if len > 0.0 { n / len } else { n })
+        })
+        .collect();
+    out.sort_by_key(|e| e.0);
+    out
+}
+
 impl<const D: usize> ContactGeometry<D> {
-    /// Builds the contact nodes of every pair.
+    /// Builds the contact nodes of every pair in the reference configuration.
     pub fn new(model: &Model<D>, pairs: &[ContactPair<D>]) -> Result<Self, ContactError> {
+        Self::build(model, pairs, None)
+    }
+
+    /// Builds the contact nodes of every pair in the configuration `x + u⁰`, `u⁰ =
+    /// displacement[body][node]` (a pose; see the [module docs](self)): pairing of
+    /// node-to-segment pairs, normals, tangents, weights and the evaluation point of rigid
+    /// obstacles are those of the pose, the gaps are in total form (the constraints act on the
+    /// displacement from the reference configuration). With `u⁰ = 0` it equals
+    /// [`ContactGeometry::new`].
+    pub fn new_deformed(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        displacement: &[Vec<Vector<D>>],
+    ) -> Result<Self, ContactError> {
+        let bodies = model.bodies();
+        let fits = displacement.len() == bodies.len()
+            && bodies.iter().zip(displacement).all(|(b, u)| {
+                u.len() == b.mesh.n_nodes() && u.iter().all(|v| v.iter().all(|c| c.is_finite()))
+            });
+        if !fits {
+            return Err(ContactError::InvalidParameter(
+                "the displacement of the pose does not fit the model (one finite vector per node of every body)"
+                    .into(),
+            ));
+        }
+        Self::build(model, pairs, Some(displacement))
+    }
+
+    fn build(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        displacement: Option<&[Vec<Vector<D>>]>,
+    ) -> Result<Self, ContactError> {
+        // positions of the configuration the geometry is built on
+        let posed: Vec<Vec<Point<D>>> = model
+            .bodies()
+            .iter()
+            .enumerate()
+            .map(|(b, body)| match displacement {
+                Some(u) => body.mesh.nodes().iter().zip(&u[b]).map(|(x, v)| x + v).collect(),
+                None => body.mesh.nodes().to_vec(),
+            })
+            .collect();
         let mut nodes = Vec::new();
         let mut ranges = Vec::new();
         let mut adjacency: Vec<Vec<usize>> = Vec::new();
@@ -346,12 +508,13 @@ impl<const D: usize> ContactGeometry<D> {
             }
             let body = model.body(pair.body)?;
             let part = body.mesh.boundary_part(&pair.part)?;
+            let pos_k = &posed[pair.body.0];
             let start = nodes.len();
             // lumped weights and nodal normals of part k
             let mut weight = std::collections::HashMap::new();
             let mut min_edge = Real::INFINITY;
             for f in part.facets() {
-                let m = body.mesh.facet_measure(f) / D as Real;
+                let m = area_normal(pos_k, f).norm() / D as Real;
                 for (a, &i) in f.iter().enumerate() {
                     *weight.entry(i).or_insert(0.0) += m;
                     for &j in &f[..a] {
@@ -359,11 +522,12 @@ impl<const D: usize> ContactGeometry<D> {
                     }
                 }
             }
-            let normals = body.mesh.nodal_normals(&pair.part)?;
+            let normals = nodal_normals_at(pos_k, part.facets());
+            let reference = |i: usize| *body.mesh.node(i);
             match &pair.partner {
                 Partner::Rigid(obstacle) => {
                     for (i, nk) in normals {
-                        let x = *body.mesh.node(i);
+                        let x = pos_k[i];
                         let phi = obstacle.distance(&x);
                         let grad = obstacle.gradient(&x);
                         let gl = grad.norm();
@@ -379,15 +543,21 @@ impl<const D: usize> ContactGeometry<D> {
                                 n.dot(&nk)
                             )));
                         }
+                        // total form: φ(x + u⁰) + u⁰ · n
+                        let gap = match displacement {
+                            Some(_) => phi + (x - reference(i)).dot(&n),
+                            None => phi,
+                        };
                         nodes.push(ContactNode {
                             pair: pi,
                             node: (pair.body, i),
                             partner: None,
+                            master: Vec::new(),
                             position: x,
                             normal: n,
                             tangents: tangent_basis(&n),
                             weight: weight.get(&i).copied().unwrap_or(0.0),
-                            gap: phi,
+                            gap,
                             friction: pair.friction,
                         });
                     }
@@ -396,7 +566,12 @@ impl<const D: usize> ContactGeometry<D> {
                     let other = model.body(*bl)?;
                     let lpart = other.mesh.boundary_part(pl)?;
                     let lnodes = lpart.nodes();
-                    let mean_n: Vector<D> = normals.iter().fold(Vector::<D>::zeros(), |a, (_, n)| a + n);
+                    // the pairing is made in the reference configuration
+                    let ref_normals = match displacement {
+                        Some(_) => body.mesh.nodal_normals(&pair.part)?,
+                        None => normals.clone(),
+                    };
+                    let mean_n: Vector<D> = ref_normals.iter().fold(Vector::<D>::zeros(), |a, (_, n)| a + n);
                     let e = direction.unwrap_or(mean_n);
                     let el = e.norm();
                     if !(el.is_finite() && el > 0.0) {
@@ -442,19 +617,66 @@ impl<const D: usize> ContactGeometry<D> {
                                 v / l
                             }
                         };
+                        // total form: reference positions
                         let xk = *body.mesh.node(i);
                         let xlj = *other.mesh.node(j);
                         nodes.push(ContactNode {
                             pair: pi,
                             node: (pair.body, i),
                             partner: Some((*bl, j)),
-                            position: xk,
+                            master: Vec::new(),
+                            position: pos_k[i],
                             normal: n,
                             tangents: tangent_basis(&n),
                             weight: weight.get(&i).copied().unwrap_or(0.0),
                             gap: (xlj - xk).dot(&n),
                             friction: pair.friction,
                         });
+                    }
+                }
+                Partner::Segment { body: bl, part: pl, search_distance } => {
+                    if *bl == pair.body {
+                        return Err(invalid(
+                            "self-contact (master body = slave body) is not supported".into(),
+                        ));
+                    }
+                    if let Some(s) = search_distance {
+                        if !(s.is_finite() && *s >= 0.0) {
+                            return Err(invalid(format!("search distance {s} must be finite and ≥ 0")));
+                        }
+                    }
+                    let other = model.body(*bl)?;
+                    let lpart = other.mesh.boundary_part(pl)?;
+                    let lfacets: Vec<Vec<usize>> = lpart.facets().map(<[usize]>::to_vec).collect();
+                    let search = FacetSearch::new(&posed[bl.0], &lfacets);
+                    for (i, nk) in normals {
+                        let Some(p) = search.project(&pos_k[i], Some(&nk), *search_distance) else {
+                            continue;
+                        };
+                        let n = -p.normal;
+                        // total form: reference positions with the weights of the pose
+                        let xm = p
+                            .weights
+                            .iter()
+                            .fold(Point::<D>::zeros(), |acc, &(j, w)| acc + other.mesh.node(j) * w);
+                        nodes.push(ContactNode {
+                            pair: pi,
+                            node: (pair.body, i),
+                            partner: None,
+                            master: p.weights.iter().map(|&(j, w)| (*bl, j, w)).collect(),
+                            position: pos_k[i],
+                            normal: n,
+                            tangents: tangent_basis(&n),
+                            weight: weight.get(&i).copied().unwrap_or(0.0),
+                            gap: (xm - reference(i)).dot(&n),
+                            friction: pair.friction,
+                        });
+                    }
+                    if nodes.len() == start {
+                        return Err(invalid(format!(
+                            "no node of part `{}` has a master facet of part `{pl}` (search distance {search_distance:?})",
+                            pair.part
+                        )));
                     }
                 }
             }
@@ -494,7 +716,8 @@ impl<const D: usize> ContactGeometry<D> {
         self.nodes.is_empty()
     }
 
-    /// `(u^k − u^l)` of node `r` as reduced-row entries of `v · (u^k − u^l)` (plus the lift part).
+    /// `(u^k − u^l)` of node `r` as reduced-row entries of `v · (u^k − u^l)` (plus the lift part);
+    /// `u^l = Σ_j w_j u^l_j` for node-to-segment.
     fn relative_row(
         &self,
         dofs: &DofMap<D>,
@@ -518,6 +741,14 @@ impl<const D: usize> ContactGeometry<D> {
             }
             lift -= lifts[gl].dot(v);
         }
+        for &(bl, j, w) in &node.master {
+            let gl = dofs.group_of(bl, j);
+            let g = &dofs.groups()[gl];
+            for k in 0..g.n_dofs {
+                entries.push((g.first_dof + k, -w * g.basis[k].dot(v)));
+            }
+            lift -= w * lifts[gl].dot(v);
+        }
         (entries, lift)
     }
 
@@ -535,6 +766,40 @@ impl<const D: usize> ContactGeometry<D> {
             gap.push(self.nodes[r].gap - lift);
         }
         NormalConstraints { rows, weights, gap }
+    }
+
+    /// `[u]·n_r − d_r` per contact node for nodal displacements `displacement[body][node]`
+    /// (total, from the reference configuration): the penetration where positive, minus the open
+    /// gap where negative. On a geometry rebuilt at the pose `u` itself
+    /// ([`ContactGeometry::new_deformed`]) this is the signed distance of the pose's slave nodes
+    /// to their master facets, negated.
+    pub fn penetration(&self, displacement: &[Vec<Vector<D>>]) -> Result<Vec<Real>, ContactError> {
+        self.nodes
+            .iter()
+            .map(|n| {
+                n.jump(displacement).map(|j| j.dot(&n.normal) - n.gap).ok_or_else(|| {
+                    ContactError::InvalidParameter("displacements do not fit the contact nodes".into())
+                })
+            })
+            .collect()
+    }
+
+    /// For each contact node of `self`, the index of the node of `from` with the same pair index
+    /// and body-`k` node (`None` if `from` has none): carries nodal contact data (e.g. `Λ_n`)
+    /// to a rebuilt geometry.
+    pub fn node_map(&self, from: &ContactGeometry<D>) -> Vec<Option<usize>> {
+        let index: std::collections::HashMap<(usize, BodyId, usize), usize> =
+            from.nodes.iter().enumerate().map(|(r, n)| ((n.pair, n.node.0, n.node.1), r)).collect();
+        self.nodes.iter().map(|n| index.get(&(n.pair, n.node.0, n.node.1)).copied()).collect()
+    }
+
+    /// Nodal values of `from` (one per node of `from`) carried to the nodes of `self` through
+    /// [`ContactGeometry::node_map`]; nodes new in `self` get 0.
+    pub fn transfer(&self, from: &ContactGeometry<D>, values: &[Real]) -> Vec<Real> {
+        self.node_map(from)
+            .into_iter()
+            .map(|r| r.and_then(|r| values.get(r)).copied().unwrap_or(0.0))
+            .collect()
     }
 
     /// Tresca slip bounds `g_{c,r} = F_c |Λ_n,r|` from nodal pressures (spec §3).
@@ -578,11 +843,14 @@ impl<const D: usize> ContactGeometry<D> {
             for t in node.tangents.iter().take(D - 1) {
                 let (entries, lift) = self.relative_row(dofs, lifts, r, t);
                 rows.push_row(entries.into_iter().map(|(c, v)| (c, scale * v)));
-                let prev = previous.map_or(0.0, |p| {
-                    let uk = p[node.node.0 .0][node.node.1];
-                    let ul = node.partner.map_or(Vector::<D>::zeros(), |(b, j)| p[b.0][j]);
-                    t.dot(&(uk - ul))
-                });
+                let prev = match previous {
+                    Some(p) => t.dot(&node.jump(p).ok_or_else(|| {
+                        ContactError::InvalidParameter(
+                            "previous displacements do not fit the contact nodes".into(),
+                        )
+                    })?),
+                    None => 0.0,
+                };
                 shift.push(scale * (prev - lift));
             }
             cell_node.push(r);

@@ -52,6 +52,20 @@ impl<const D: usize> StaticContact<D> {
         Ok(Self { elastic, geometry, nested_min_rows: Some(32) })
     }
 
+    /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
+    /// ([`ContactGeometry::new_deformed`]: re-pairing of node-to-segment pairs, normals and
+    /// weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
+    /// previous geometry, e.g. to carry contact data over with [`ContactGeometry::transfer`].
+    pub fn update_geometry(
+        &mut self,
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        displacement: &[Vec<Vector<D>>],
+    ) -> Result<ContactGeometry<D>, ContactError> {
+        let geometry = ContactGeometry::new_deformed(model, pairs, displacement)?;
+        Ok(std::mem::replace(&mut self.geometry, geometry))
+    }
+
     /// Nested iteration for cold starts ([`crate::nested`]): coarsen the contact rows
     /// down to `min_rows` and use the coarse solutions as the warm start (default `Some(32)`);
     /// `None` starts every solve from `Λ = 0`.

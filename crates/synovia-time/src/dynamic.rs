@@ -617,11 +617,8 @@ impl<const D: usize> DynamicStepper<D> {
             .nodes
             .iter()
             .map(|node| {
-                let (b, i) = node.node;
-                let mut v = new[b.0][i] - old[b.0][i];
-                if let Some((bl, j)) = node.partner {
-                    v -= new[bl.0][j] - old[bl.0][j];
-                }
+                let v = node.jump(new).unwrap_or_else(Vector::<D>::zeros)
+                    - node.jump(old).unwrap_or_else(Vector::<D>::zeros);
                 let vt = v - node.normal * node.normal.dot(&v);
                 vt.norm() / dt
             })

@@ -37,6 +37,19 @@
 //! The factorisation of `A` is done once, in [`QuasiStaticStepper::new`], and reused at every
 //! level and fixed-point iteration (spec §7).
 //!
+//! # Re-pairing at every level (sliding contact)
+//!
+//! With [`QuasiStaticStepper::set_repairing`] the contact geometry is rebuilt before every level
+//! `i ≥ 1` from the configuration `x + u(t_{i−1})` of the previous level
+//! ([`StaticContact::update_geometry`], [`ContactGeometry::new_deformed`]): node-to-segment
+//! pairs are re-projected onto the master facets, normals, tangents and weights are those of
+//! that configuration (small-deformation kinematics per pose). The contact state of level
+//! `i − 1` is carried to the new pairing node by node ([`transfer_result`]: `Λ_n` and the
+//! friction cells of the slave nodes that stay in their pair; new nodes start from 0), so
+//! `g_c = F_c |Λ_n(t_{i−1})|` and the warm start are defined on the new rows. Slip stays
+//! incremental: `B_Ht` of the new pairing applied to `U − U(t_{i−1})`, the relative tangential
+//! displacement of a slave node and the master point it is over now.
+//!
 //! # Per-step figures ([`StepRecord`])
 //!
 //! * pair resultants, areas, pressures, stick/slip areas: [`pair_records`];
@@ -133,6 +146,7 @@ pub struct QuasiStaticStepper<const D: usize> {
     params: QuasiStaticParams,
     body_nodes: Vec<usize>,
     last: Option<StaticContactResult<D>>,
+    repair: Option<Vec<ContactPair<D>>>,
 }
 
 impl<const D: usize> QuasiStaticStepper<D> {
@@ -150,7 +164,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
     ) -> Result<Self, TimeError> {
         params.validate()?;
         let contact = StaticContact::new(model, pairs, elastic)?;
-        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None })
+        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None, repair: None })
     }
 
     /// Wraps an existing [`StaticContact`] of `model` (e.g. with nested iteration switched off).
@@ -163,7 +177,14 @@ impl<const D: usize> QuasiStaticStepper<D> {
         params: QuasiStaticParams,
     ) -> Result<Self, TimeError> {
         params.validate()?;
-        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None })
+        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None, repair: None })
+    }
+
+    /// Re-pair every level `i ≥ 1` from the configuration of level `i − 1` with the contact
+    /// pairs `pairs` (the pairs the stepper was built with; see the
+    /// [module documentation](self)), or (`None`) keep the geometry fixed (default).
+    pub fn set_repairing(&mut self, pairs: Option<&[ContactPair<D>]>) {
+        self.repair = pairs.map(<[ContactPair<D>]>::to_vec);
     }
 
     /// The static contact problem (factorisation, geometry).
@@ -174,7 +195,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
     pub fn contact_mut(&mut self) -> &mut StaticContact<D> {
         &mut self.contact
     }
-    /// The contact nodes.
+    /// The contact nodes (with re-pairing: of the last level solved).
     pub fn geometry(&self) -> &ContactGeometry<D> {
         self.contact.geometry()
     }
@@ -224,6 +245,13 @@ impl<const D: usize> QuasiStaticStepper<D> {
         let mut previous: Option<StaticContactResult<D>> = None;
         for (step, &t) in times.iter().enumerate() {
             let start = Instant::now();
+            if let (Some(pairs), Some(prev)) = (&self.repair, previous.as_mut()) {
+                let old = self
+                    .contact
+                    .update_geometry(model, pairs, &prev.displacement)
+                    .map_err(|source| TimeError::Contact { step, time: t, source })?;
+                *prev = transfer_result(&old, self.contact.geometry(), prev);
+            }
             let (result, iterations) = match &previous {
                 None => self.initial(model, t, solver)?,
                 Some(prev) => {
@@ -404,19 +432,54 @@ pub fn warm_start<const D: usize>(
     }
 }
 
+/// A contact result computed on the geometry `from`, carried to the nodes of the rebuilt
+/// geometry `to` ([`ContactGeometry::node_map`]): `Λ_n` node by node (0 for nodes new in `to`),
+/// friction cells (`cell_node`, `slip_bound`, `Λ_t`) of the nodes that are in both, in the node
+/// order of `to`; displacements, `U`, report and KKT residuals unchanged. Used as the previous
+/// level (slip bounds, warm start) after re-pairing.
+pub fn transfer_result<const D: usize>(
+    from: &ContactGeometry<D>,
+    to: &ContactGeometry<D>,
+    result: &StaticContactResult<D>,
+) -> StaticContactResult<D> {
+    let comps = D.saturating_sub(1);
+    let map = to.node_map(from);
+    let lambda_n = to.transfer(from, &result.solution.lambda_n);
+    let mut cell_of = vec![None; from.len()];
+    for (c, &r) in result.cell_node.iter().enumerate() {
+        if let Some(slot) = cell_of.get_mut(r) {
+            *slot = Some(c);
+        }
+    }
+    let (mut cell_node, mut slip_bound, mut lambda_t) = (Vec::new(), Vec::new(), Vec::new());
+    for (r_to, r_from) in map.iter().enumerate() {
+        let Some(c) = r_from.and_then(|r| cell_of.get(r).copied().flatten()) else {
+            continue;
+        };
+        let (Some(&g), Some(lt)) =
+            (result.slip_bound.get(c), result.solution.lambda_t.get(c * comps..(c + 1) * comps))
+        else {
+            continue;
+        };
+        cell_node.push(r_to);
+        slip_bound.push(g);
+        lambda_t.extend_from_slice(lt);
+    }
+    let mut out = result.clone();
+    out.solution.lambda_n = lambda_n;
+    out.solution.lambda_t = lambda_t;
+    out.cell_node = cell_node;
+    out.slip_bound = slip_bound;
+    out
+}
+
 /// `[u](s_r) = u^k(s_r) − u^l(s_r)` (or `u^k` for a rigid obstacle) of contact node `r`.
 fn relative_displacement<const D: usize>(
     geometry: &ContactGeometry<D>,
     r: usize,
     displacement: &[Vec<Vector<D>>],
 ) -> Option<Vector<D>> {
-    let node = geometry.nodes.get(r)?;
-    let uk = *displacement.get(node.node.0 .0)?.get(node.node.1)?;
-    let ul = match node.partner {
-        Some((b, j)) => *displacement.get(b.0)?.get(j)?,
-        None => Vector::<D>::zeros(),
-    };
-    Some(uk - ul)
+    geometry.nodes.get(r)?.jump(displacement)
 }
 
 /// The friction work of a step, `Σ_c g_c κ_c ‖T_cᵀ([u](s_c) − [u]_prev(s_c))‖` over the
@@ -446,7 +509,8 @@ pub fn friction_dissipation<const D: usize>(
     Ok(total)
 }
 
-/// Nodal contact fields of every body (`[body][node]`), see [`contact_fields`].
+/// Nodal contact fields of every body (`[body][node]`), see [`contact_fields`]. For
+/// node-to-segment pairs the fields are set on the slave side (body `k`) only.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactFields<const D: usize> {
     /// Contact pressure `Λ_n,r` at the contact node of body `k` and at its partner node of

@@ -1,0 +1,1471 @@
+//! From a parsed [`Scenario`] to a [`JointModel`]: meshes, materials, parts, boundary
+//! conditions, ties, contact pairs, solver and analysis, with every semantic error located at
+//! the value it is about.
+
+use std::any::Any;
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use synovia::builder::{Analysis, BodyMaterial, JointModel};
+use synovia::contact_ops::operators::{
+    ContactPair, CylinderObstacle, Partner, PlaneObstacle, SphereObstacle,
+};
+use synovia::contact_ops::{ContactParams, ExponentialFriction};
+use synovia::fem::{ComponentMask, ElasticParams, FemError, OrderingChoice};
+use synovia::io::gmsh::GmshMesh;
+use synovia::io::Encoding;
+use synovia::material::{
+    anisotropic, plane_strain, plane_stress, transversely_isotropic, transversely_isotropic_plane_strain,
+    transversely_isotropic_plane_stress, voigt_len, KelvinVoigt, LinearElastic, Material, TransverseIsotropy,
+    VoigtMatrix,
+};
+use synovia::mesh::generators::{
+    ball, box_mesh, disc, half_disc, half_disc_refined, hemisphere, hemisphere_refined, layered_arc_2d,
+    layered_cap_3d, rectangle, Grading,
+};
+use synovia::mesh::math::{Point, Vector};
+use synovia::mesh::{BoundaryKind, Mesh};
+use synovia::time::dynamic::{DynamicParams, MassKind};
+use synovia::time::history::{Constant, LoadHistory, Periodic, PiecewiseLinear, RigidMotion};
+use synovia::time::quasistatic::QuasiStaticParams;
+
+use crate::scenario::*;
+
+/// A scenario turned into a model, ready to run.
+#[derive(Debug)]
+pub struct Built<const D: usize> {
+    /// The model with its pairs, solver and analysis.
+    pub joint: JointModel<D>,
+    /// The analysis (also set on `joint`).
+    pub analysis: Analysis,
+    /// Output options.
+    pub output: OutputPlan,
+    /// Base name of the output files.
+    pub name: String,
+}
+
+/// Where and how often to write results.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OutputPlan {
+    /// `output.dir` (relative to the current directory), if given.
+    pub dir: Option<PathBuf>,
+    /// Write a `.vtu` every `vtu_every` steps (and the last one); 0 = none.
+    pub vtu_every: usize,
+    /// VTU encoding.
+    pub encoding: Encoding,
+}
+
+type R<T> = Result<T, ScenarioError>;
+
+fn key(prefix: &str, field: &str) -> String {
+    if prefix.is_empty() {
+        field.to_string()
+    } else {
+        format!("{prefix}.{field}")
+    }
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+struct Cx<'a> {
+    src: &'a Source,
+}
+
+impl Cx<'_> {
+    fn err(&self, key: impl Into<String>, span: Range<usize>, msg: impl Into<String>) -> ScenarioError {
+        self.src.error(key, Some(span), msg)
+    }
+
+    /// The required field `field` of the table at `span`.
+    fn req<'t, T>(
+        &self,
+        v: &'t Option<Sp<T>>,
+        prefix: &str,
+        field: &str,
+        span: &Range<usize>,
+        why: &str,
+    ) -> R<&'t Sp<T>> {
+        v.as_ref().ok_or_else(|| self.err(prefix, span.clone(), format!("missing `{field}` ({why})")))
+    }
+
+    /// Errors on the first present field that is not in `allowed`.
+    fn only(
+        &self,
+        prefix: &str,
+        present: &[(&str, Option<Range<usize>>)],
+        allowed: &[&str],
+        what: &str,
+    ) -> R<()> {
+        for (name, span) in present {
+            if let Some(span) = span {
+                if !allowed.contains(name) {
+                    return Err(self.err(
+                        key(prefix, name),
+                        span.clone(),
+                        format!(
+                            "`{name}` does not apply to {what} (keys used there: {})",
+                            allowed.join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn finite(&self, v: &Sp<f64>, k: &str) -> R<f64> {
+        let x = *v.get_ref();
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.err(k, v.span(), format!("must be finite, got {x}")))
+        }
+    }
+
+    fn positive(&self, v: &Sp<f64>, k: &str) -> R<f64> {
+        let x = *v.get_ref();
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(k, v.span(), format!("must be finite and > 0, got {x}")))
+        }
+    }
+
+    fn non_negative(&self, v: &Sp<f64>, k: &str) -> R<f64> {
+        let x = *v.get_ref();
+        if x.is_finite() && x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(k, v.span(), format!("must be finite and ≥ 0, got {x}")))
+        }
+    }
+
+    fn at_least(&self, v: &Sp<usize>, k: &str, min: usize) -> R<usize> {
+        let x = *v.get_ref();
+        if x >= min {
+            Ok(x)
+        } else {
+            Err(self.err(k, v.span(), format!("must be at least {min}, got {x}")))
+        }
+    }
+
+    /// A vector with exactly `n` finite entries.
+    fn array(&self, v: &Sp<Vec<f64>>, k: &str, n: usize, what: &str) -> R<Vec<f64>> {
+        let a = v.get_ref();
+        if a.len() != n {
+            return Err(self.err(k, v.span(), format!("{what} needs {n} numbers, got {}", a.len())));
+        }
+        if let Some(x) = a.iter().find(|x| !x.is_finite()) {
+            return Err(self.err(k, v.span(), format!("{what} must be finite, got {x}")));
+        }
+        Ok(a.clone())
+    }
+
+    fn vector<const D: usize>(&self, v: &Sp<Vec<f64>>, k: &str) -> R<Vector<D>> {
+        let a = self.array(v, k, D, &format!("a {D}D vector"))?;
+        Ok(Vector::<D>::from_fn(|i, _| a[i]))
+    }
+
+    fn point<const D: usize>(&self, v: &Sp<Vec<f64>>, k: &str) -> R<Point<D>> {
+        let a = self.array(v, k, D, &format!("a {D}D point"))?;
+        Ok(Point::<D>::from_fn(|i, _| a[i]))
+    }
+
+    fn nonzero<const D: usize>(&self, v: &Sp<Vec<f64>>, k: &str) -> R<Vector<D>> {
+        let n = self.vector::<D>(v, k)?;
+        if n.norm() > 0.0 {
+            Ok(n)
+        } else {
+            Err(self.err(k, v.span(), "must not be the zero vector"))
+        }
+    }
+
+    /// A `[lo, hi]` range with `lo ≤ hi` (infinite ends allowed).
+    fn range(&self, v: &Sp<Vec<f64>>, k: &str) -> R<(f64, f64)> {
+        let a = v.get_ref();
+        if a.len() != 2 || a.iter().any(|x| x.is_nan()) || a[0] > a[1] {
+            return Err(self.err(k, v.span(), format!("needs a range [lo, hi] with lo ≤ hi, got {a:?}")));
+        }
+        Ok((a[0], a[1]))
+    }
+
+    fn history(&self, h: Option<&Sp<HistorySpec>>, k: &str) -> R<Arc<dyn LoadHistory>> {
+        let Some(h) = h else { return Ok(Arc::new(Constant(1.0))) };
+        match h.get_ref() {
+            HistorySpec::Constant(c) => {
+                if c.is_finite() {
+                    Ok(Arc::new(Constant(*c)))
+                } else {
+                    Err(self.err(k, h.span(), format!("must be finite, got {c}")))
+                }
+            }
+            HistorySpec::Table { rows, period } => {
+                let table_key = if period.is_some() { key(k, "table") } else { k.to_string() };
+                if rows.is_empty() {
+                    return Err(self.err(
+                        &table_key,
+                        h.span(),
+                        "the history table is empty; give rows [t, v]",
+                    ));
+                }
+                let mut points = Vec::with_capacity(rows.len());
+                for (i, row) in rows.iter().enumerate() {
+                    let rk = format!("{table_key}[{i}]");
+                    let r = row.get_ref();
+                    if r.len() != 2 {
+                        return Err(self.err(
+                            rk,
+                            row.span(),
+                            format!("a history row is [t, v] (two numbers), got {r:?}"),
+                        ));
+                    }
+                    if !(r[0].is_finite() && r[1].is_finite()) {
+                        return Err(self.err(rk, row.span(), format!("history row {r:?} is not finite")));
+                    }
+                    if let Some(&(t_prev, _)) = points.last() {
+                        if r[0] <= t_prev {
+                            return Err(self.err(
+                                rk,
+                                row.span(),
+                                format!(
+                                    "history times must increase strictly: t = {} after t = {t_prev}",
+                                    r[0]
+                                ),
+                            ));
+                        }
+                    }
+                    points.push((r[0], r[1]));
+                }
+                let table = PiecewiseLinear::new(&points)
+                    .map_err(|e| self.err(&table_key, h.span(), e.to_string()))?;
+                match period {
+                    None => Ok(Arc::new(table)),
+                    Some(p) => {
+                        let pk = key(k, "period");
+                        let t = self.positive(p, &pk)?;
+                        Ok(Arc::new(
+                            Periodic::new(table, t).map_err(|e| self.err(pk, p.span(), e.to_string()))?,
+                        ))
+                    }
+                }
+            }
+        }
+    }
+}
+
+macro_rules! present {
+    ($s:expr; $($name:literal => $f:ident),* $(,)?) => {
+        [$(($name, $s.$f.as_ref().map(|v| v.span()))),*]
+    };
+}
+
+/// Builds the model of a parsed scenario in dimension `D` (which must be the scenario's
+/// `dimension`).
+///
+/// # Errors
+/// The first problem found, located at its key.
+pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
+    let cx = Cx { src: &sc.source };
+    let doc = &sc.doc;
+    let dim = doc.dimension.get_ref();
+    if *dim != D as i64 {
+        return Err(cx.err("dimension", doc.dimension.span(), format!("must be 2 or 3, got {dim}")));
+    }
+    let analysis = analysis(&cx, &doc.analysis)?;
+    let mut joint = JointModel::<D>::new();
+    let mut gmsh: HashMap<PathBuf, GmshMesh> = HashMap::new();
+    if doc.bodies.is_empty() {
+        return Err(cx.src.file_error("the scenario has no [[body]]"));
+    }
+    for (i, b) in doc.bodies.iter().enumerate() {
+        add_body(&cx, &mut joint, b.get_ref(), &format!("body[{i}]"), &mut gmsh, doc.bodies[..i].iter())?;
+    }
+    let names: Vec<String> = doc.bodies.iter().map(|b| b.get_ref().name.get_ref().clone()).collect();
+    for (i, bc) in doc.boundary.iter().enumerate() {
+        boundary(&cx, &mut joint, bc, &format!("boundary[{i}]"), &names)?;
+    }
+    for (i, t) in doc.ties.iter().enumerate() {
+        let k = format!("tie[{i}]");
+        let t = t.get_ref();
+        let (a, pa) =
+            body_part(&cx, &joint, &t.body_a, &t.part_a, &key(&k, "body_a"), &key(&k, "part_a"), &names)?;
+        let (b, pb) =
+            body_part(&cx, &joint, &t.body_b, &t.part_b, &key(&k, "body_b"), &key(&k, "part_b"), &names)?;
+        joint
+            .tie(a.as_str(), &pa, b.as_str(), &pb)
+            .map_err(|e| cx.err(&k, t.body_a.span(), e.to_string()))?;
+    }
+    let dynamic = matches!(analysis, Analysis::Dynamic { .. });
+    for (i, c) in doc.contact.iter().enumerate() {
+        contact(&cx, &mut joint, c, &format!("contact[{i}]"), &names, dynamic)?;
+    }
+    if let Some(s) = &doc.solver {
+        solver(&cx, &mut joint, s)?;
+    }
+    quasi_and_dynamic_params(&cx, &mut joint, &doc.analysis)?;
+    // missing data for Prescribed / Traction parts (e.g. Gmsh parts named `prescribed_*`)
+    if let Err(e) = joint.model().validate() {
+        let (k, span) = match &e {
+            FemError::MissingBoundaryData { body, .. } => names
+                .iter()
+                .position(|n| n == body)
+                .map(|i| (format!("body[{i}].mesh"), doc.bodies[i].get_ref().mesh.span()))
+                .unwrap_or_else(|| ("boundary".into(), doc.analysis.span())),
+            _ => ("body".into(), doc.bodies[0].span()),
+        };
+        return Err(cx.err(k, span, e.to_string()));
+    }
+    if dynamic {
+        for (i, b) in doc.bodies.iter().enumerate() {
+            let b = b.get_ref();
+            if b.density.is_none() && b.material.get_ref().kind.get_ref() != "kelvin_voigt" {
+                return Err(cx.err(
+                    format!("body[{i}]"),
+                    b.name.span(),
+                    format!(
+                        "body `{}` needs `density` (or a kelvin_voigt material) for a dynamic analysis",
+                        b.name.get_ref()
+                    ),
+                ));
+            }
+        }
+    }
+    joint.set_analysis(analysis.clone());
+    Ok(Built { joint, analysis, output: output(&cx, doc.output.as_ref())?, name: sc.name() })
+}
+
+/// Resolves a body name and one of its part names (errors list what exists).
+fn body_part<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &JointModel<D>,
+    body: &Sp<String>,
+    part: &Sp<String>,
+    body_key: &str,
+    part_key: &str,
+    names: &[String],
+) -> R<(String, String)> {
+    let b = check_body(cx, joint, body, body_key, names)?;
+    let mesh = &joint.model().bodies()[b].mesh;
+    let p = part.get_ref();
+    if mesh.boundary_part(p).is_err() {
+        let parts: Vec<&str> = mesh.boundary_parts().iter().map(|p| p.name()).collect();
+        return Err(cx.err(
+            part_key,
+            part.span(),
+            format!("body `{}` has no part `{p}` (its parts: {})", body.get_ref(), parts.join(", ")),
+        ));
+    }
+    Ok((body.get_ref().clone(), p.clone()))
+}
+
+fn check_body<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &JointModel<D>,
+    body: &Sp<String>,
+    body_key: &str,
+    names: &[String],
+) -> R<usize> {
+    joint.model().body_id(body.get_ref()).map(|id| id.0).map_err(|_| {
+        cx.err(body_key, body.span(), format!("no body `{}` (bodies: {})", body.get_ref(), names.join(", ")))
+    })
+}
+
+// ----- bodies -----
+
+fn add_body<'a, const D: usize>(
+    cx: &Cx<'_>,
+    joint: &mut JointModel<D>,
+    b: &BodySpec,
+    k: &str,
+    gmsh: &mut HashMap<PathBuf, GmshMesh>,
+    mut earlier: impl Iterator<Item = &'a Sp<BodySpec>>,
+) -> R<()> {
+    let name = b.name.get_ref();
+    if name.is_empty() {
+        return Err(cx.err(key(k, "name"), b.name.span(), "a body needs a non-empty name"));
+    }
+    if earlier.any(|e| e.get_ref().name.get_ref() == name) {
+        return Err(cx.err(key(k, "name"), b.name.span(), format!("two bodies are called `{name}`")));
+    }
+    let mut mesh = mesh::<D>(cx, &b.mesh, &key(k, "mesh"), name, gmsh)?;
+    for (j, p) in b.parts.iter().enumerate() {
+        define_part(cx, &mut mesh, p, &format!("{k}.part[{j}]"))?;
+    }
+    let material = material::<D>(cx, &b.material, &key(k, "material"), true)?;
+    let is_kv = matches!(material, BodyMaterial::KelvinVoigt(_));
+    let id = joint.add_body(name, mesh, material).map_err(|e| cx.err(k, b.name.span(), e.to_string()))?;
+    if let Some(d) = &b.density {
+        let dk = key(k, "density");
+        if is_kv {
+            return Err(cx.err(
+                dk,
+                d.span(),
+                "a kelvin_voigt material has its own `density`; remove this one",
+            ));
+        }
+        let rho = cx.positive(d, &dk)?;
+        joint.set_density(id, rho).map_err(|e| cx.err(dk, d.span(), e.to_string()))?;
+    }
+    if let Some(v) = &b.initial_velocity {
+        let vk = key(k, "initial_velocity");
+        let v0 = cx.vector::<D>(v, &vk)?;
+        joint.initial_velocity(id, v0).map_err(|e| cx.err(vk, v.span(), e.to_string()))?;
+    }
+    if let Some(f) = &b.body_force {
+        let fk = key(k, "body_force");
+        let l = f.get_ref();
+        let value = cx.vector::<D>(&l.value, &key(&fk, "value"))?;
+        let h = cx.history(l.history.as_ref(), &key(&fk, "history"))?;
+        joint.body_force(id, value, h).map_err(|e| cx.err(fk, f.span(), e.to_string()))?;
+    }
+    Ok(())
+}
+
+fn grading(cx: &Cx<'_>, g: &Sp<GradingSpec>, k: &str) -> R<Grading> {
+    let s = g.get_ref();
+    let kind = s.kind.get_ref().as_str();
+    let present = present!(s; "ratio" => ratio, "center" => center, "width" => width);
+    let span = g.span();
+    let ratio = |cx: &Cx<'_>| -> R<f64> {
+        cx.positive(cx.req(&s.ratio, k, "ratio", &span, &format!("grading `{kind}`"))?, &key(k, "ratio"))
+    };
+    Ok(match kind {
+        "uniform" => {
+            cx.only(k, &present, &[], "grading `uniform`")?;
+            Grading::Uniform
+        }
+        "geometric" | "toward_low" | "toward_high" => {
+            cx.only(k, &present, &["ratio"], &format!("grading `{kind}`"))?;
+            let r = ratio(cx)?;
+            match kind {
+                "geometric" => Grading::Geometric { ratio: r },
+                "toward_low" => Grading::TowardLow { ratio: r },
+                _ => Grading::TowardHigh { ratio: r },
+            }
+        }
+        "refined" => {
+            let why = "grading `refined`";
+            let center = cx.finite(cx.req(&s.center, k, "center", &span, why)?, &key(k, "center"))?;
+            let width = cx.positive(cx.req(&s.width, k, "width", &span, why)?, &key(k, "width"))?;
+            Grading::Refined { center, width, ratio: ratio(cx)? }
+        }
+        other => {
+            return Err(cx.err(
+                key(k, "type"),
+                s.kind.span(),
+                format!("unknown grading `{other}` (uniform, geometric, toward_low, toward_high, refined)"),
+            ))
+        }
+    })
+}
+
+fn mesh<const D: usize>(
+    cx: &Cx<'_>,
+    spec: &Sp<MeshSpec>,
+    k: &str,
+    body: &str,
+    gmsh: &mut HashMap<PathBuf, GmshMesh>,
+) -> R<Mesh<D>> {
+    let m = spec.get_ref();
+    let span = spec.span();
+    let present = present!(m;
+        "generator" => generator, "gmsh" => gmsh, "group" => group, "x" => x, "y" => y, "lo" => lo,
+        "hi" => hi, "cells" => cells, "grading" => grading, "center" => center, "radius" => radius,
+        "n" => n, "refine" => refine, "radii" => radii, "angles_deg" => angles_deg,
+        "half_angle_deg" => half_angle_deg, "n_angle" => n_angle, "n_surface" => n_surface,
+        "n_radial" => n_radial, "layer" => layer, "reflect" => reflect, "translate" => translate,
+    );
+    let common = ["reflect", "translate"];
+    let mut mesh: Mesh<D> = match (&m.generator, &m.gmsh) {
+        (Some(g), None) => {
+            let name = g.get_ref().as_str();
+            let (dim, allowed): (usize, &[&str]) = match name {
+                "rectangle" => (2, &["x", "y", "cells", "grading"]),
+                "box" => (3, &["lo", "hi", "cells", "grading"]),
+                "disc" | "ball" => (if name == "disc" { 2 } else { 3 }, &["center", "radius", "n"]),
+                "half_disc" | "hemisphere" => {
+                    (if name == "half_disc" { 2 } else { 3 }, &["center", "radius", "n", "refine"])
+                }
+                "layered_arc" => (2, &["center", "radii", "angles_deg", "n_angle", "n_radial", "layer"]),
+                "layered_cap" => (3, &["center", "radii", "half_angle_deg", "n_surface", "n_radial", "layer"]),
+                other => {
+                    return Err(cx.err(
+                        key(k, "generator"),
+                        g.span(),
+                        format!(
+                            "unknown generator `{other}` (rectangle, box, disc, half_disc, ball, hemisphere, layered_arc, layered_cap)"
+                        ),
+                    ))
+                }
+            };
+            if dim != D {
+                return Err(cx.err(
+                    key(k, "generator"),
+                    g.span(),
+                    format!("generator `{name}` makes {dim}D meshes but the scenario has dimension = {D}"),
+                ));
+            }
+            let mut ok: Vec<&str> = vec!["generator"];
+            ok.extend_from_slice(allowed);
+            ok.extend_from_slice(&common);
+            cx.only(k, &present, &ok, &format!("generator `{name}`"))?;
+            generate::<D>(cx, m, name, k, &span)?
+        }
+        (None, Some(file)) => {
+            let mut ok = vec!["gmsh", "group"];
+            ok.extend_from_slice(&common);
+            cx.only(k, &present, &ok, "a Gmsh mesh")?;
+            let path = cx.src.resolve(file.get_ref());
+            let gk = key(k, "gmsh");
+            if !gmsh.contains_key(&path) {
+                let read = synovia::io::gmsh::read_msh(&path)
+                    .map_err(|e| cx.err(&gk, file.span(), e.to_string()))?;
+                gmsh.insert(path.clone(), read);
+            }
+            let bodies = gmsh[&path].bodies::<D>().map_err(|e| cx.err(&gk, file.span(), e.to_string()))?;
+            let (group, group_span, group_key) = match &m.group {
+                Some(g) => (g.get_ref().clone(), g.span(), key(k, "group")),
+                None => (body.to_string(), file.span(), gk.clone()),
+            };
+            let available: Vec<String> = bodies.iter().map(|(n, _)| n.clone()).collect();
+            bodies.into_iter().find(|(n, _)| *n == group).map(|(_, mesh)| mesh).ok_or_else(|| {
+                cx.err(
+                    group_key,
+                    group_span,
+                    format!(
+                        "`{}` has no {D}D physical group `{group}` (its bodies: {}); set `group`",
+                        file.get_ref(),
+                        available.join(", ")
+                    ),
+                )
+            })?
+        }
+        (Some(_), Some(g)) => {
+            return Err(cx.err(key(k, "gmsh"), g.span(), "give either `generator` or `gmsh`, not both"))
+        }
+        (None, None) => return Err(cx.err(k, span, "missing `generator` or `gmsh`")),
+    };
+    if let Some(r) = &m.reflect {
+        let rk = key(k, "reflect");
+        let axis = r.get_ref().axis.get_ref();
+        let a = AXES.iter().take(D).position(|x| x == axis).ok_or_else(|| {
+            cx.err(key(&rk, "axis"), r.get_ref().axis.span(), format!("axis must be one of {:?}", &AXES[..D]))
+        })?;
+        mesh = mesh.reflected(a, r.get_ref().at).map_err(|e| cx.err(&rk, r.span(), e.to_string()))?;
+    }
+    if let Some(t) = &m.translate {
+        let tk = key(k, "translate");
+        let v = cx.vector::<D>(t, &tk)?;
+        mesh.map_nodes(|x| x + v).map_err(|e| cx.err(tk, t.span(), e.to_string()))?;
+    }
+    Ok(mesh)
+}
+
+fn generate<const D: usize>(
+    cx: &Cx<'_>,
+    m: &MeshSpec,
+    name: &str,
+    k: &str,
+    span: &Range<usize>,
+) -> R<Mesh<D>> {
+    let why = format!("generator `{name}`");
+    let why = why.as_str();
+    let gen_err = |e: synovia::mesh::MeshError| cx.err(k, span.clone(), e.to_string());
+    let counts = |n: usize| -> R<Vec<usize>> {
+        let c = cx.req(&m.cells, k, "cells", span, why)?;
+        let v = c.get_ref();
+        if v.len() != n || v.contains(&0) {
+            return Err(cx.err(
+                key(k, "cells"),
+                c.span(),
+                format!("needs {n} positive cell counts, got {v:?}"),
+            ));
+        }
+        Ok(v.clone())
+    };
+    let gradings = |n: usize| -> R<Vec<Grading>> {
+        match &m.grading {
+            None => Ok(vec![Grading::Uniform; n]),
+            Some(g) => {
+                let gk = key(k, "grading");
+                if g.get_ref().len() != n {
+                    return Err(cx.err(gk, g.span(), format!("needs {n} gradings (one per axis)")));
+                }
+                g.get_ref().iter().enumerate().map(|(i, gi)| grading(cx, gi, &format!("{gk}[{i}]"))).collect()
+            }
+        }
+    };
+    let center = |n: usize| -> R<Vec<f64>> {
+        let c = cx.req(&m.center, k, "center", span, why)?;
+        cx.array(c, &key(k, "center"), n, "the center")
+    };
+    let radius = || -> R<f64> { cx.positive(cx.req(&m.radius, k, "radius", span, why)?, &key(k, "radius")) };
+    let n_cells = || -> R<usize> { cx.at_least(cx.req(&m.n, k, "n", span, why)?, &key(k, "n"), 1) };
+    let layers = || -> R<(Vec<f64>, Vec<usize>, usize)> {
+        let r = cx.req(&m.radii, k, "radii", span, why)?;
+        let radii = r.get_ref().clone();
+        let nr = cx.req(&m.n_radial, k, "n_radial", span, why)?;
+        if radii.len() < 2 || nr.get_ref().len() + 1 != radii.len() {
+            return Err(cx.err(
+                key(k, "n_radial"),
+                nr.span(),
+                format!(
+                    "needs one count per layer: {} radii give {} layers",
+                    radii.len(),
+                    radii.len().saturating_sub(1)
+                ),
+            ));
+        }
+        let layer = m.layer.as_ref().map_or(0, |l| *l.get_ref());
+        if layer >= nr.get_ref().len() {
+            let lk = key(k, "layer");
+            let ls = m.layer.as_ref().map_or(span.clone(), |l| l.span());
+            return Err(cx.err(
+                lk,
+                ls,
+                format!("layer {layer} does not exist ({} layers)", nr.get_ref().len()),
+            ));
+        }
+        Ok((radii, nr.get_ref().clone(), layer))
+    };
+    let mesh: Box<dyn Any> = match name {
+        "rectangle" => {
+            let x = cx.range(cx.req(&m.x, k, "x", span, why)?, &key(k, "x"))?;
+            let y = cx.range(cx.req(&m.y, k, "y", span, why)?, &key(k, "y"))?;
+            let c = counts(2)?;
+            let g = gradings(2)?;
+            Box::new(rectangle(x.0, x.1, y.0, y.1, c[0], c[1], g[0], g[1]).map_err(gen_err)?)
+        }
+        "box" => {
+            let lo = cx.array(cx.req(&m.lo, k, "lo", span, why)?, &key(k, "lo"), 3, "`lo`")?;
+            let hi = cx.array(cx.req(&m.hi, k, "hi", span, why)?, &key(k, "hi"), 3, "`hi`")?;
+            let c = counts(3)?;
+            let g = gradings(3)?;
+            Box::new(
+                box_mesh(
+                    [lo[0], lo[1], lo[2]],
+                    [hi[0], hi[1], hi[2]],
+                    [c[0], c[1], c[2]],
+                    [g[0], g[1], g[2]],
+                )
+                .map_err(gen_err)?,
+            )
+        }
+        "disc" => {
+            let c = center(2)?;
+            Box::new(disc(Point::<2>::new(c[0], c[1]), radius()?, n_cells()?).map_err(gen_err)?)
+        }
+        "ball" => {
+            let c = center(3)?;
+            Box::new(ball(Point::<3>::new(c[0], c[1], c[2]), radius()?, n_cells()?).map_err(gen_err)?)
+        }
+        "half_disc" | "hemisphere" => {
+            let c = center(D)?;
+            let (r, n) = (radius()?, n_cells()?);
+            let refine = match &m.refine {
+                None => None,
+                Some(rf) => {
+                    let rk = key(k, "refine");
+                    let s = rf.get_ref();
+                    let rc = cx.array(&s.center, &key(&rk, "center"), D, "the center")?;
+                    Some((rc, cx.positive(&s.radius, &key(&rk, "radius"))?, *s.levels.get_ref()))
+                }
+            };
+            if name == "half_disc" {
+                let cp = Point::<2>::new(c[0], c[1]);
+                Box::new(match refine {
+                    None => half_disc(cp, r, n).map_err(gen_err)?,
+                    Some((rc, rr, l)) => {
+                        half_disc_refined(cp, r, n, Point::<2>::new(rc[0], rc[1]), rr, l).map_err(gen_err)?
+                    }
+                })
+            } else {
+                let cp = Point::<3>::new(c[0], c[1], c[2]);
+                Box::new(match refine {
+                    None => hemisphere(cp, r, n).map_err(gen_err)?,
+                    Some((rc, rr, l)) => {
+                        hemisphere_refined(cp, r, n, Point::<3>::new(rc[0], rc[1], rc[2]), rr, l)
+                            .map_err(gen_err)?
+                    }
+                })
+            }
+        }
+        "layered_arc" => {
+            let c = center(2)?;
+            let a = cx.req(&m.angles_deg, k, "angles_deg", span, why)?;
+            let a = cx.array(a, &key(k, "angles_deg"), 2, "the angle range [start, end] in degrees")?;
+            let n_angle = cx.at_least(cx.req(&m.n_angle, k, "n_angle", span, why)?, &key(k, "n_angle"), 1)?;
+            let (radii, nr, layer) = layers()?;
+            let mut all = layered_arc_2d(
+                Point::<2>::new(c[0], c[1]),
+                &radii,
+                (a[0].to_radians(), a[1].to_radians()),
+                n_angle,
+                &nr,
+            )
+            .map_err(gen_err)?;
+            Box::new(all.swap_remove(layer))
+        }
+        "layered_cap" => {
+            let c = center(3)?;
+            let h = cx.req(&m.half_angle_deg, k, "half_angle_deg", span, why)?;
+            let h = cx.positive(h, &key(k, "half_angle_deg"))?;
+            let ns =
+                cx.at_least(cx.req(&m.n_surface, k, "n_surface", span, why)?, &key(k, "n_surface"), 1)?;
+            let (radii, nr, layer) = layers()?;
+            let mut all = layered_cap_3d(Point::<3>::new(c[0], c[1], c[2]), &radii, h.to_radians(), ns, &nr)
+                .map_err(gen_err)?;
+            Box::new(all.swap_remove(layer))
+        }
+        _ => return Err(cx.err(key(k, "generator"), span.clone(), format!("unknown generator `{name}`"))),
+    };
+    mesh.downcast::<Mesh<D>>().map(|b| *b).map_err(|_| {
+        cx.err(key(k, "generator"), span.clone(), format!("generator `{name}` does not make {D}D meshes"))
+    })
+}
+
+fn define_part<const D: usize>(cx: &Cx<'_>, mesh: &mut Mesh<D>, p: &Sp<PartSpec>, k: &str) -> R<()> {
+    let s = p.get_ref();
+    let name = s.name.get_ref().clone();
+    if mesh.boundary_part(&name).is_ok() {
+        return Err(cx.err(key(k, "name"), s.name.span(), format!("the mesh already has a part `{name}`")));
+    }
+    let mut ranges: Vec<(usize, f64, f64)> = Vec::new();
+    for (a, r) in [&s.x, &s.y, &s.z].into_iter().enumerate() {
+        if let Some(r) = r {
+            let rk = key(k, AXES[a]);
+            if a >= D {
+                return Err(cx.err(rk, r.span(), format!("`{}` does not apply in {D}D", AXES[a])));
+            }
+            let (lo, hi) = cx.range(r, &rk)?;
+            ranges.push((a, lo, hi));
+        }
+    }
+    let direction = match &s.normal {
+        Some(n) => {
+            let d = cx.nonzero::<D>(n, &key(k, "normal"))?;
+            Some(d / d.norm())
+        }
+        None => None,
+    };
+    let max_angle = match &s.max_angle_deg {
+        Some(a) => {
+            let ak = key(k, "max_angle_deg");
+            if s.normal.is_none() {
+                return Err(cx.err(ak, a.span(), "`max_angle_deg` needs `normal`"));
+            }
+            let v = cx.positive(a, &ak)?;
+            if v > 180.0 {
+                return Err(cx.err(ak, a.span(), format!("must be at most 180, got {v}")));
+            }
+            v
+        }
+        None => 90.0,
+    };
+    let cos_max = max_angle.to_radians().cos();
+    let ball = match &s.within {
+        Some(w) => {
+            let wk = key(k, "within");
+            let c = cx.point::<D>(&w.get_ref().center, &key(&wk, "center"))?;
+            Some((c, cx.positive(&w.get_ref().radius, &key(&wk, "radius"))?))
+        }
+        None => None,
+    };
+    let select = |x: &Point<D>, n: &Vector<D>| -> bool {
+        ranges.iter().all(|&(a, lo, hi)| x[a] >= lo && x[a] <= hi)
+            && direction.is_none_or(|d| n.dot(&d) > cos_max + 1e-12)
+            && ball.is_none_or(|(c, r)| (x - c).norm() <= r)
+    };
+    let result = match &s.from {
+        None => mesh.add_boundary_part(&name, BoundaryKind::TractionFree, select).map(|_| ()),
+        Some(from) => {
+            let part = mesh.boundary_part(from.get_ref()).map_err(|_| {
+                let parts: Vec<&str> = mesh.boundary_parts().iter().map(|p| p.name()).collect();
+                cx.err(
+                    key(k, "from"),
+                    from.span(),
+                    format!("the mesh has no part `{}` (its parts: {})", from.get_ref(), parts.join(", ")),
+                )
+            })?;
+            let facets: Vec<Vec<usize>> = part
+                .facets()
+                .filter(|f| select(&mesh.facet_centroid(f), &mesh.facet_normal(f)))
+                .map(<[usize]>::to_vec)
+                .collect();
+            mesh.add_boundary_part_from_facets(&name, BoundaryKind::TractionFree, &facets).map(|_| ())
+        }
+    };
+    result.map_err(|e| cx.err(k, p.span(), format!("part `{name}`: {e}")))
+}
+
+/// The linear elastic material of a `material` table (`kelvin_voigt` only where `allow_kv`).
+fn material<const D: usize>(
+    cx: &Cx<'_>,
+    spec: &Sp<MaterialSpec>,
+    k: &str,
+    allow_kv: bool,
+) -> R<BodyMaterial<D>> {
+    let m = spec.get_ref();
+    let span = spec.span();
+    let kind = m.kind.get_ref().as_str();
+    let why = format!("material `{kind}`");
+    let why = why.as_str();
+    let present = present!(m;
+        "E" => e, "nu" => nu, "plane" => plane, "E_p" => e_p, "nu_p" => nu_p, "E_a" => e_a,
+        "nu_ap" => nu_ap, "G_a" => g_a, "axis" => axis, "C" => c, "elastic" => elastic,
+        "viscous" => viscous, "density" => density, "damping" => damping,
+    );
+    let plane_stress_wanted = || -> R<bool> {
+        match &m.plane {
+            None => Ok(false),
+            Some(p) => {
+                let pk = key(k, "plane");
+                if D != 2 {
+                    return Err(cx.err(pk, p.span(), "`plane` applies to 2D scenarios only"));
+                }
+                match p.get_ref().as_str() {
+                    "strain" => Ok(false),
+                    "stress" => Ok(true),
+                    other => {
+                        Err(cx.err(pk, p.span(), format!("`plane` is `strain` or `stress`, got `{other}`")))
+                    }
+                }
+            }
+        }
+    };
+    let mat_err = |e: synovia::material::MaterialError| cx.err(k, span.clone(), e.to_string());
+    let linear: Box<dyn Any> = match kind {
+        "isotropic" => {
+            cx.only(k, &present, &["E", "nu", "plane"], why)?;
+            let e = cx.positive(cx.req(&m.e, k, "E", &span, why)?, &key(k, "E"))?;
+            let nu = cx.finite(cx.req(&m.nu, k, "nu", &span, why)?, &key(k, "nu"))?;
+            if D == 2 {
+                let mat = if plane_stress_wanted()? { plane_stress(e, nu) } else { plane_strain(e, nu) };
+                Box::new(mat.map_err(mat_err)?)
+            } else {
+                Box::new(synovia::material::isotropic(e, nu).map_err(mat_err)?)
+            }
+        }
+        "transversely_isotropic" => {
+            cx.only(k, &present, &["E_p", "nu_p", "E_a", "nu_ap", "G_a", "axis", "plane"], why)?;
+            let p = TransverseIsotropy {
+                e_p: cx.finite(cx.req(&m.e_p, k, "E_p", &span, why)?, &key(k, "E_p"))?,
+                nu_p: cx.finite(cx.req(&m.nu_p, k, "nu_p", &span, why)?, &key(k, "nu_p"))?,
+                e_a: cx.finite(cx.req(&m.e_a, k, "E_a", &span, why)?, &key(k, "E_a"))?,
+                nu_ap: cx.finite(cx.req(&m.nu_ap, k, "nu_ap", &span, why)?, &key(k, "nu_ap"))?,
+                g_a: cx.finite(cx.req(&m.g_a, k, "G_a", &span, why)?, &key(k, "G_a"))?,
+            };
+            let axis = cx.nonzero::<D>(cx.req(&m.axis, k, "axis", &span, why)?, &key(k, "axis"))?;
+            if D == 2 {
+                let a = Vector::<2>::new(axis[0], axis[1]);
+                let mat = if plane_stress_wanted()? {
+                    transversely_isotropic_plane_stress(p, a)
+                } else {
+                    transversely_isotropic_plane_strain(p, a)
+                };
+                Box::new(mat.map_err(mat_err)?)
+            } else {
+                let a = Vector::<3>::new(axis[0], axis[1], axis.get(2).copied().unwrap_or(0.0));
+                Box::new(transversely_isotropic(p, a).map_err(mat_err)?)
+            }
+        }
+        "anisotropic" => {
+            cx.only(k, &present, &["C", "plane"], why)?;
+            let c = cx.req(&m.c, k, "C", &span, why)?;
+            let ck = key(k, "C");
+            let rows = c.get_ref();
+            let n = rows.len();
+            if rows.iter().any(|r| r.len() != n) || rows.iter().flatten().any(|x| !x.is_finite()) {
+                return Err(cx.err(ck, c.span(), "`C` must be a square matrix of finite numbers (rows of equal length)"));
+            }
+            let data: Vec<f64> = rows.iter().flatten().copied().collect();
+            let matrix = VoigtMatrix::from_row_slice(n, n, &data);
+            let cerr = |e: synovia::material::MaterialError| cx.err(&ck, c.span(), e.to_string());
+            if n == voigt_len(D) && m.plane.is_none() {
+                Box::new(anisotropic::<D>(matrix).map_err(cerr)?)
+            } else if D == 2 && n == 6 {
+                let full = anisotropic::<3>(matrix).map_err(cerr)?;
+                Box::new(if plane_stress_wanted()? { full.plane_stress().map_err(cerr)? } else { full.plane_strain() })
+            } else {
+                return Err(cx.err(
+                    ck,
+                    c.span(),
+                    format!(
+                        "`C` is {n}×{n}; in {D}D give the {v}×{v} Voigt matrix{extra}",
+                        v = voigt_len(D),
+                        extra = if D == 2 { " (without `plane`), or a 6×6 3D matrix with `plane`" } else { "" }
+                    ),
+                ));
+            }
+        }
+        "kelvin_voigt" => {
+            if !allow_kv {
+                return Err(cx.err(key(k, "type"), m.kind.span(), "a kelvin_voigt material cannot be nested"));
+            }
+            cx.only(k, &present, &["elastic", "viscous", "density", "damping"], why)?;
+            let el = cx.req(&m.elastic, k, "elastic", &span, why)?;
+            let c0 = linear_of::<D>(cx, el, &key(k, "elastic"))?;
+            let c1: Option<Arc<dyn Material<D>>> = match &m.viscous {
+                None => None,
+                Some(v) => Some(Arc::new(linear_of::<D>(cx, v, &key(k, "viscous"))?)),
+            };
+            let rho = cx.positive(cx.req(&m.density, k, "density", &span, why)?, &key(k, "density"))?;
+            let alpha = match &m.damping {
+                Some(d) => cx.non_negative(d, &key(k, "damping"))?,
+                None => 0.0,
+            };
+            let kv = KelvinVoigt::new(Arc::new(c0), c1, rho, alpha).map_err(mat_err)?;
+            return Ok(BodyMaterial::KelvinVoigt(kv));
+        }
+        other => {
+            return Err(cx.err(
+                key(k, "type"),
+                m.kind.span(),
+                format!("unknown material type `{other}` (isotropic, transversely_isotropic, anisotropic, kelvin_voigt)"),
+            ))
+        }
+    };
+    let linear = linear
+        .downcast::<LinearElastic<D>>()
+        .map_err(|_| cx.err(k, span.clone(), format!("material `{kind}` is not available in {D}D")))?;
+    Ok(BodyMaterial::Elastic(Arc::new(*linear)))
+}
+
+/// A nested (`elastic` / `viscous`) material of a Kelvin–Voigt body.
+fn linear_of<const D: usize>(cx: &Cx<'_>, spec: &Sp<Box<MaterialSpec>>, k: &str) -> R<LinearElastic<D>> {
+    let inner = Sp::new(spec.span(), (**spec.get_ref()).clone());
+    match material::<D>(cx, &inner, k, false)? {
+        BodyMaterial::Elastic(m) => {
+            let c = m.linear_stiffness().ok_or_else(|| cx.err(k, spec.span(), "needs a linear material"))?;
+            anisotropic::<D>(c).map_err(|e| cx.err(k, spec.span(), e.to_string()))
+        }
+        BodyMaterial::KelvinVoigt(_) => {
+            Err(cx.err(k, spec.span(), "a kelvin_voigt material cannot be nested"))
+        }
+    }
+}
+
+// ----- boundary conditions -----
+
+fn boundary<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &mut JointModel<D>,
+    bc: &Sp<BoundarySpec>,
+    k: &str,
+    names: &[String],
+) -> R<()> {
+    let s = bc.get_ref();
+    let span = bc.span();
+    let (body, part) = body_part(cx, joint, &s.body, &s.part, &key(k, "body"), &key(k, "part"), names)?;
+    let kind = s.kind.get_ref().as_str();
+    let why = format!("kind `{kind}`");
+    let why = why.as_str();
+    let present = present!(s;
+        "value" => value, "components" => components, "history" => history,
+        "translation" => translation, "rotation_deg" => rotation_deg, "center" => center, "axis" => axis,
+        "rotation_history" => rotation_history,
+    );
+    let vector_value = || -> R<Vector<D>> {
+        let v = cx.req(&s.value, k, "value", &span, &format!("a `{kind}` part needs its vector"))?;
+        match v.get_ref() {
+            NumOrVec::Vec(a) => cx.vector::<D>(&Sp::new(v.span(), a.clone()), &key(k, "value")),
+            NumOrVec::Num(x) => Err(cx.err(
+                key(k, "value"),
+                v.span(),
+                format!("a `{kind}` value is a {D}D vector, got the number {x}"),
+            )),
+        }
+    };
+    let history = || cx.history(s.history.as_ref(), &key(k, "history"));
+    let built_err = |e: synovia::builder::JointError| cx.err(key(k, "kind"), s.kind.span(), e.to_string());
+    match kind {
+        "clamped" | "symmetry" | "traction_free" => {
+            cx.only(k, &present, &[], why)?;
+            match kind {
+                "clamped" => joint.clamp(body.as_str(), &part).map(|_| ()),
+                "symmetry" => joint.symmetry(body.as_str(), &part).map(|_| ()),
+                _ => {
+                    let id = joint.model().body_id(&body).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
+                    let b = joint.model_mut().body_mut(id).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
+                    b.mesh.set_part_kind(&part, BoundaryKind::TractionFree).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
+                    Ok(())
+                }
+            }
+            .map_err(built_err)?;
+        }
+        "prescribed" => {
+            cx.only(k, &present, &["value", "components", "history"], why)?;
+            let value = vector_value()?;
+            let mut mask = ComponentMask::ALL;
+            if let Some(c) = &s.components {
+                let ck = key(k, "components");
+                let mut m = [false; 3];
+                if c.get_ref().is_empty() {
+                    return Err(cx.err(ck, c.span(), "give at least one component"));
+                }
+                for (j, comp) in c.get_ref().iter().enumerate() {
+                    let a = AXES.iter().take(D).position(|x| x == comp.get_ref()).ok_or_else(|| {
+                        cx.err(format!("{ck}[{j}]"), comp.span(), format!("a component is one of {:?}", &AXES[..D]))
+                    })?;
+                    m[a] = true;
+                }
+                mask = ComponentMask(m);
+            }
+            joint.prescribe_components(body.as_str(), &part, mask, value, history()?).map_err(built_err)?;
+        }
+        "rigid_motion" => {
+            cx.only(
+                k,
+                &present,
+                &["translation", "history", "rotation_deg", "center", "axis", "rotation_history"],
+                why,
+            )?;
+            if s.translation.is_none() && s.rotation_deg.is_none() {
+                return Err(cx.err(k, span, "missing `translation` or `rotation_deg` (kind `rigid_motion`)"));
+            }
+            let mut motion = match &s.rotation_deg {
+                None => {
+                    for (name, v) in [("center", &s.center), ("axis", &s.axis)] {
+                        if let Some(v) = v {
+                            return Err(cx.err(key(k, name), v.span(), format!("`{name}` needs `rotation_deg`")));
+                        }
+                    }
+                    if let Some(h) = &s.rotation_history {
+                        return Err(cx.err(key(k, "rotation_history"), h.span(), "`rotation_history` needs `rotation_deg`"));
+                    }
+                    RigidMotion::<D>::identity()
+                }
+                Some(rot) => {
+                    let angle = cx.finite(rot, &key(k, "rotation_deg"))?.to_radians();
+                    let h = cx.history(s.rotation_history.as_ref(), &key(k, "rotation_history"))?;
+                    let theta = synovia::time::history::FnHistory::new(move |t| angle * h.value(t));
+                    let c = cx.req(&s.center, k, "center", &span, "a rotation")?;
+                    let cv = cx.array(c, &key(k, "center"), D, "the rotation center")?;
+                    let m: Box<dyn Any> = if D == 2 {
+                        if let Some(a) = &s.axis {
+                            return Err(cx.err(key(k, "axis"), a.span(), "`axis` applies to 3D rotations only"));
+                        }
+                        Box::new(RigidMotion::<2>::rotation(Point::<2>::new(cv[0], cv[1]), theta))
+                    } else {
+                        let a = cx.req(&s.axis, k, "axis", &span, "a 3D rotation")?;
+                        let av = cx.nonzero::<3>(&Sp::new(a.span(), a.get_ref().clone()), &key(k, "axis"))?;
+                        Box::new(
+                            RigidMotion::<3>::rotation(Point::<3>::new(cv[0], cv[1], cv[2]), av, theta)
+                                .map_err(|e| cx.err(key(k, "axis"), a.span(), e.to_string()))?,
+                        )
+                    };
+                    *m.downcast::<RigidMotion<D>>().map_err(|_| cx.err(k, span.clone(), "rotation not available"))?
+                }
+            };
+            if let Some(t) = &s.translation {
+                let tv = cx.vector::<D>(t, &key(k, "translation"))?;
+                let h = history()?;
+                for (a, &v) in tv.iter().enumerate() {
+                    let h = h.clone();
+                    motion = motion
+                        .with_translation_component(a, synovia::time::history::FnHistory::new(move |t| v * h.value(t)))
+                        .map_err(|e| cx.err(key(k, "translation"), t.span(), e.to_string()))?;
+                }
+            } else if let Some(h) = &s.history {
+                return Err(cx.err(key(k, "history"), h.span(), "`history` scales `translation`; use `rotation_history` for the angle"));
+            }
+            joint.rigid_motion(body.as_str(), &part, motion).map_err(built_err)?;
+        }
+        "traction" => {
+            cx.only(k, &present, &["value", "history"], why)?;
+            let value = vector_value()?;
+            joint.traction(body.as_str(), &part, value, history()?).map_err(built_err)?;
+        }
+        "pressure" => {
+            cx.only(k, &present, &["value", "history"], why)?;
+            let v = cx.req(&s.value, k, "value", &span, "a `pressure` part needs its pressure")?;
+            let p = match v.get_ref() {
+                NumOrVec::Num(x) if x.is_finite() => *x,
+                other => {
+                    return Err(cx.err(key(k, "value"), v.span(), format!("a pressure is one finite number, got {other:?}")))
+                }
+            };
+            joint.pressure(body.as_str(), &part, p, history()?).map_err(built_err)?;
+        }
+        other => {
+            return Err(cx.err(
+                key(k, "kind"),
+                s.kind.span(),
+                format!(
+                    "unknown boundary kind `{other}` (clamped, symmetry, prescribed, rigid_motion, traction, pressure, traction_free)"
+                ),
+            ))
+        }
+    }
+    Ok(())
+}
+
+// ----- contact -----
+
+fn contact<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &mut JointModel<D>,
+    c: &Sp<ContactSpec>,
+    k: &str,
+    names: &[String],
+    dynamic: bool,
+) -> R<()> {
+    let s = c.get_ref();
+    let span = c.span();
+    let (body, part) = body_part(cx, joint, &s.body, &s.part, &key(k, "body"), &key(k, "part"), names)?;
+    let name = match &s.name {
+        Some(n) => n.get_ref().clone(),
+        None => format!("{body}:{part}"),
+    };
+    if joint.pairs().iter().any(|p| p.name == name) {
+        let ns = s.name.as_ref().map_or(span.clone(), |n| n.span());
+        return Err(cx.err(key(k, "name"), ns, format!("two contact pairs are called `{name}`")));
+    }
+    let friction = match &s.friction {
+        Some(f) => cx.non_negative(f, &key(k, "friction"))?,
+        None => 0.0,
+    };
+    let id = joint.model().body_id(&body).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
+    let mut pair = match (&s.partner, &s.obstacle) {
+        (Some(p), None) => {
+            let pk = key(k, "partner");
+            let (lb, lp) = body_part(
+                cx,
+                joint,
+                &p.get_ref().body,
+                &p.get_ref().part,
+                &key(&pk, "body"),
+                &key(&pk, "part"),
+                names,
+            )?;
+            if lb == body {
+                return Err(cx.err(
+                    key(&pk, "body"),
+                    p.get_ref().body.span(),
+                    "a body cannot be in contact with itself",
+                ));
+            }
+            let l = joint.model().body_id(&lb).map_err(|e| cx.err(&pk, p.span(), e.to_string()))?;
+            let mut pair = ContactPair::<D>::node_to_node(&name, id, &part, l, &lp);
+            if let Some(n) = &s.normal {
+                pair = pair.with_fixed_normal(cx.nonzero::<D>(n, &key(k, "normal"))?);
+            }
+            if let Some(t) = &s.tolerance {
+                let tol = cx.positive(t, &key(k, "tolerance"))?;
+                if let Partner::Body { tolerance, .. } = &mut pair.partner {
+                    *tolerance = Some(tol);
+                }
+            }
+            pair
+        }
+        (None, Some(o)) => {
+            for (f, v) in [
+                ("normal", s.normal.as_ref().map(|v| v.span())),
+                ("tolerance", s.tolerance.as_ref().map(|v| v.span())),
+            ] {
+                if let Some(sp) = v {
+                    return Err(cx.err(
+                        key(k, f),
+                        sp,
+                        format!("`{f}` applies to body-body pairs (`partner`) only"),
+                    ));
+                }
+            }
+            ContactPair::rigid(&name, id, &part, obstacle::<D>(cx, o, &key(k, "obstacle"))?)
+        }
+        (Some(_), Some(o)) => {
+            return Err(cx.err(key(k, "obstacle"), o.span(), "give either `partner` or `obstacle`, not both"))
+        }
+        (None, None) => {
+            return Err(cx.err(k, span, "missing `partner` (another body) or `obstacle` (a rigid one)"))
+        }
+    };
+    pair.friction = friction;
+    joint.add_contact(pair).map_err(|e| cx.err(key(k, "part"), s.part.span(), e.to_string()))?;
+    if let Some(l) = &s.friction_law {
+        let lk = key(k, "friction_law");
+        if !dynamic {
+            return Err(cx.err(
+                lk,
+                l.span(),
+                "`friction_law` applies to dynamic analyses only (use `friction`)",
+            ));
+        }
+        let ls = l.get_ref();
+        let law = ExponentialFriction {
+            static_coefficient: cx.non_negative(&ls.static_coefficient, &key(&lk, "static"))?,
+            kinetic_coefficient: cx.non_negative(&ls.kinetic_coefficient, &key(&lk, "kinetic"))?,
+            characteristic_speed: cx.positive(&ls.characteristic_speed, &key(&lk, "speed"))?,
+        };
+        joint.friction_law(&name, Arc::new(law)).map_err(|e| cx.err(lk, l.span(), e.to_string()))?;
+    }
+    Ok(())
+}
+
+fn obstacle<const D: usize>(
+    cx: &Cx<'_>,
+    o: &Sp<ObstacleSpec>,
+    k: &str,
+) -> R<Arc<dyn synovia::contact_ops::operators::SignedDistance<D>>> {
+    let s = o.get_ref();
+    let span = o.span();
+    let kind = s.kind.get_ref().as_str();
+    let why = format!("obstacle `{kind}`");
+    let why = why.as_str();
+    let present = present!(s; "point" => point, "normal" => normal, "center" => center, "radius" => radius,
+        "axis" => axis, "cavity" => cavity);
+    let cavity = s.cavity.as_ref().is_some_and(|c| *c.get_ref());
+    let any: Box<dyn Any> = match kind {
+        "plane" => {
+            cx.only(k, &present, &["point", "normal"], why)?;
+            let p = cx.point::<D>(cx.req(&s.point, k, "point", &span, why)?, &key(k, "point"))?;
+            let n = cx.nonzero::<D>(cx.req(&s.normal, k, "normal", &span, why)?, &key(k, "normal"))?;
+            let plane = PlaneObstacle::new(p, n).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
+            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<D>> = Arc::new(plane);
+            return Ok(d);
+        }
+        "sphere" => {
+            cx.only(k, &present, &["center", "radius", "cavity"], why)?;
+            let c = cx.point::<D>(cx.req(&s.center, k, "center", &span, why)?, &key(k, "center"))?;
+            let r = cx.positive(cx.req(&s.radius, k, "radius", &span, why)?, &key(k, "radius"))?;
+            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<D>> =
+                Arc::new(SphereObstacle { center: c, radius: r, cavity });
+            return Ok(d);
+        }
+        "cylinder" => {
+            if D != 3 {
+                return Err(cx.err(
+                    key(k, "type"),
+                    s.kind.span(),
+                    "a `cylinder` obstacle is 3D; in 2D use `sphere`",
+                ));
+            }
+            cx.only(k, &present, &["point", "axis", "radius", "cavity"], why)?;
+            let p = cx.point::<3>(cx.req(&s.point, k, "point", &span, why)?, &key(k, "point"))?;
+            let a = cx.nonzero::<3>(cx.req(&s.axis, k, "axis", &span, why)?, &key(k, "axis"))?;
+            let r = cx.positive(cx.req(&s.radius, k, "radius", &span, why)?, &key(k, "radius"))?;
+            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<3>> =
+                Arc::new(CylinderObstacle { point: p, axis: a / a.norm(), radius: r, cavity });
+            Box::new(d)
+        }
+        other => {
+            return Err(cx.err(
+                key(k, "type"),
+                s.kind.span(),
+                format!("unknown obstacle `{other}` (plane, sphere, cylinder)"),
+            ))
+        }
+    };
+    any.downcast::<Arc<dyn synovia::contact_ops::operators::SignedDistance<D>>>()
+        .map(|b| *b)
+        .map_err(|_| cx.err(k, span, format!("obstacle `{kind}` is not available in {D}D")))
+}
+
+// ----- solver, analysis, output -----
+
+fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverSpec>) -> R<()> {
+    let k = "solver";
+    let s = s.get_ref();
+    let mut params = ContactParams::default();
+    if let Some(t) = &s.tolerance {
+        params.tolerance = cx.positive(t, "solver.tolerance")?;
+    }
+    if let Some(m) = &s.max_iterations {
+        params.max_iterations = cx.at_least(m, "solver.max_iterations", 1)?;
+    }
+    if let Some(r) = &s.rho_scale {
+        params.rho_scale = cx.positive(r, "solver.rho_scale")?;
+    }
+    joint.contact_params(params);
+    if let Some(n) = &s.name {
+        joint.solver(n.get_ref()).map_err(|e| cx.err(key(k, "name"), n.span(), e.to_string()))?;
+    }
+    if let Some(n) = &s.nested_iteration {
+        let v = *n.get_ref();
+        joint.nested_iteration((v > 0).then_some(v));
+    }
+    let mut elastic = ElasticParams::default();
+    if let Some(o) = &s.ordering {
+        elastic.ordering = match o.get_ref().as_str() {
+            "auto" => OrderingChoice::Auto,
+            "amd" => OrderingChoice::Amd,
+            "metis" => OrderingChoice::Metis,
+            other => {
+                return Err(cx.err(
+                    "solver.ordering",
+                    o.span(),
+                    format!("ordering is `auto`, `amd` or `metis`, got `{other}`"),
+                ))
+            }
+        };
+    }
+    if let Some(d) = &s.load_degree {
+        elastic.load_degree = cx.at_least(d, "solver.load_degree", 1)?;
+    }
+    joint.elastic_params(elastic);
+    Ok(())
+}
+
+fn analysis(cx: &Cx<'_>, a: &Sp<AnalysisSpec>) -> R<Analysis> {
+    let k = "analysis";
+    let s = a.get_ref();
+    let span = a.span();
+    let kind = s.kind.get_ref().as_str();
+    let why = format!("analysis `{kind}`");
+    let why = why.as_str();
+    let present = present!(s;
+        "time" => time, "times" => times, "coulomb_fixed_point" => coulomb_fixed_point,
+        "max_fixed_point" => max_fixed_point, "fixed_point_tolerance" => fixed_point_tolerance,
+        "incremental_slip" => incremental_slip, "initial_friction" => initial_friction, "dt" => dt,
+        "steps" => steps, "t0" => t0, "mass" => mass, "coulomb_iterations" => coulomb_iterations,
+        "coulomb_tolerance" => coulomb_tolerance,
+    );
+    let friction_keys = ["coulomb_fixed_point", "max_fixed_point", "fixed_point_tolerance"];
+    match kind {
+        "static" => {
+            let mut ok = vec!["time", "initial_friction"];
+            ok.extend_from_slice(&friction_keys);
+            cx.only(k, &present, &ok, why)?;
+            let time = match &s.time {
+                Some(t) => cx.finite(t, "analysis.time")?,
+                None => 0.0,
+            };
+            Ok(Analysis::Static { time })
+        }
+        "quasistatic" => {
+            let mut ok = vec!["times", "incremental_slip", "initial_friction"];
+            ok.extend_from_slice(&friction_keys);
+            cx.only(k, &present, &ok, why)?;
+            let t = cx.req(&s.times, k, "times", &span, why)?;
+            let tk = "analysis.times";
+            let times = match t.get_ref() {
+                TimesSpec::List(v) => v.clone(),
+                TimesSpec::Range { start, end, steps } => {
+                    if !(start.is_finite() && end.is_finite() && end > start && *steps >= 1) {
+                        return Err(cx.err(tk, t.span(), "needs finite start < end and steps ≥ 1"));
+                    }
+                    (0..=*steps).map(|i| start + (end - start) * i as f64 / *steps as f64).collect()
+                }
+            };
+            if times.is_empty() {
+                return Err(cx.err(tk, t.span(), "needs at least one time level"));
+            }
+            for (i, w) in times.windows(2).enumerate() {
+                if !(w[1] > w[0]) {
+                    return Err(cx.err(
+                        tk,
+                        t.span(),
+                        format!(
+                            "times must increase strictly: t[{}] = {} after t[{i}] = {}",
+                            i + 1,
+                            w[1],
+                            w[0]
+                        ),
+                    ));
+                }
+            }
+            if let Some(x) = times.iter().find(|x| !x.is_finite()) {
+                return Err(cx.err(tk, t.span(), format!("times must be finite, got {x}")));
+            }
+            Ok(Analysis::QuasiStatic { times })
+        }
+        "dynamic" => {
+            cx.only(
+                k,
+                &present,
+                &["dt", "steps", "t0", "mass", "coulomb_iterations", "coulomb_tolerance"],
+                why,
+            )?;
+            let dt = cx.positive(cx.req(&s.dt, k, "dt", &span, why)?, "analysis.dt")?;
+            let steps = cx.at_least(cx.req(&s.steps, k, "steps", &span, why)?, "analysis.steps", 1)?;
+            Ok(Analysis::Dynamic { dt, steps })
+        }
+        other => Err(cx.err(
+            "analysis.type",
+            s.kind.span(),
+            format!("unknown analysis `{other}` (static, quasistatic, dynamic)"),
+        )),
+    }
+}
+
+/// The stepper options of `[analysis]` (its keys were checked by [`analysis`]).
+fn quasi_and_dynamic_params<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &mut JointModel<D>,
+    a: &Sp<AnalysisSpec>,
+) -> R<()> {
+    let s = a.get_ref();
+    let mut q = QuasiStaticParams::default();
+    if let Some(v) = &s.coulomb_fixed_point {
+        q.coulomb_fixed_point = *v.get_ref();
+    }
+    if let Some(v) = &s.max_fixed_point {
+        q.max_fixed_point = cx.at_least(v, "analysis.max_fixed_point", 1)?;
+    }
+    if let Some(v) = &s.fixed_point_tolerance {
+        q.fixed_point_tolerance = cx.positive(v, "analysis.fixed_point_tolerance")?;
+    }
+    if let Some(v) = &s.incremental_slip {
+        q.incremental_slip = *v.get_ref();
+    }
+    if let Some(v) = &s.initial_friction {
+        q.initial_friction = *v.get_ref();
+    }
+    joint.quasistatic_params(q);
+    let mut d = DynamicParams::new(1.0);
+    if let Some(v) = &s.t0 {
+        d.t0 = cx.finite(v, "analysis.t0")?;
+    }
+    if let Some(v) = &s.mass {
+        d.mass = match v.get_ref().as_str() {
+            "consistent" => MassKind::Consistent,
+            "lumped" => MassKind::Lumped,
+            other => {
+                return Err(cx.err(
+                    "analysis.mass",
+                    v.span(),
+                    format!("mass is `consistent` or `lumped`, got `{other}`"),
+                ))
+            }
+        };
+    }
+    if let Some(v) = &s.coulomb_iterations {
+        d.coulomb_iterations = *v.get_ref();
+    }
+    if let Some(v) = &s.coulomb_tolerance {
+        d.coulomb_tolerance = cx.positive(v, "analysis.coulomb_tolerance")?;
+    }
+    joint.dynamic_params(d);
+    Ok(())
+}
+
+fn output(cx: &Cx<'_>, o: Option<&Sp<OutputSpec>>) -> R<OutputPlan> {
+    let mut plan = OutputPlan { dir: None, vtu_every: 1, encoding: Encoding::Base64 };
+    let Some(o) = o else { return Ok(plan) };
+    let s = o.get_ref();
+    if let Some(d) = &s.dir {
+        if d.get_ref().is_empty() {
+            return Err(cx.err("output.dir", d.span(), "must not be empty"));
+        }
+        plan.dir = Some(PathBuf::from(d.get_ref()));
+    }
+    if let Some(v) = &s.vtu_every {
+        plan.vtu_every = *v.get_ref();
+    }
+    if let Some(e) = &s.encoding {
+        plan.encoding = match e.get_ref().as_str() {
+            "binary" | "base64" => Encoding::Base64,
+            "ascii" => Encoding::Ascii,
+            other => {
+                return Err(cx.err(
+                    "output.encoding",
+                    e.span(),
+                    format!("encoding is `binary` or `ascii`, got `{other}`"),
+                ))
+            }
+        };
+    }
+    Ok(plan)
+}

@@ -1,0 +1,333 @@
+//! Running a scenario: build the model, step through the analysis, write the ParaView series,
+//! the per-step CSV and `summary.json`.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+use synovia::builder::JointError;
+use synovia::time::quasistatic::QuasiStaticOutput;
+use synovia::time::results::{write_csv, StepRecord};
+
+use crate::build::{build, Built};
+use crate::scenario::{Scenario, ScenarioError};
+
+/// Why a run failed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The scenario is broken (with its key and position).
+    #[error("{0}")]
+    Scenario(#[from] ScenarioError),
+    /// The model is valid but solving or writing failed.
+    #[error("{0}")]
+    Failed(#[from] anyhow::Error),
+}
+
+/// Progress of a run, for a progress bar.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Progress {
+    /// The model is built; `steps` records will follow.
+    Start {
+        /// Number of steps (records).
+        steps: usize,
+    },
+    /// A step is done.
+    Step {
+        /// Its index (0-based).
+        index: usize,
+        /// Its time.
+        time: f64,
+    },
+}
+
+/// The figures of one contact pair at one step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PairSummary {
+    /// Pair name.
+    pub name: String,
+    /// Resultant contact force on body `k` (normal + friction), `[x, y, z]` (`z = 0` in 2D;
+    /// per unit thickness in 2D).
+    pub force: [f64; 3],
+    /// Normal force.
+    pub normal_force: f64,
+    /// Magnitude of the friction force.
+    pub tangential_force: f64,
+    /// Contact area (length in 2D).
+    pub contact_area: f64,
+    /// Peak contact pressure.
+    pub peak_pressure: f64,
+    /// Sticking area.
+    pub stick_area: f64,
+    /// Slipping area.
+    pub slip_area: f64,
+}
+
+/// The figures of one step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StepSummary {
+    /// Step index (0 = first level / initial state).
+    pub step: usize,
+    /// Time.
+    pub time: f64,
+    /// Contact solver iterations.
+    pub iterations: usize,
+    /// Wall time of the step, s.
+    pub step_s: f64,
+    /// Sum of the pairs' normal forces.
+    pub contact_force: f64,
+    /// Per contact pair.
+    pub pairs: Vec<PairSummary>,
+    /// Strain energy.
+    pub strain_energy: f64,
+    /// Kinetic energy (dynamic runs).
+    pub kinetic_energy: f64,
+    /// Friction work of the step.
+    pub friction_dissipation: f64,
+    /// The step's `.vtu` file (relative to the output directory), if written.
+    pub vtu: Option<String>,
+}
+
+/// One body of the model.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct BodySummary {
+    /// Name.
+    pub name: String,
+    /// Nodes.
+    pub nodes: usize,
+    /// Cells.
+    pub cells: usize,
+}
+
+/// The files written, relative to the output directory.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FilesSummary {
+    /// The ParaView time series (`None` with `vtu_every = 0`).
+    pub pvd: Option<String>,
+    /// The per-step CSV.
+    pub csv: String,
+    /// Number of `.vtu` files.
+    pub vtu: usize,
+}
+
+/// `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// The scenario file.
+    pub scenario: String,
+    /// Its name (base name of the outputs).
+    pub name: String,
+    /// Its title.
+    pub title: Option<String>,
+    /// 2 or 3.
+    pub dimension: usize,
+    /// `static`, `quasistatic` or `dynamic`.
+    pub analysis: String,
+    /// Contact solver.
+    pub solver: String,
+    /// Reduced unknowns.
+    pub dofs: usize,
+    /// Contact nodes.
+    pub contact_nodes: usize,
+    /// Bodies.
+    pub bodies: Vec<BodySummary>,
+    /// Contact pair names.
+    pub pairs: Vec<String>,
+    /// Set-up time (assembly, factorisation, contact geometry), s.
+    pub setup_s: f64,
+    /// Wall time of the solve (set-up and steps, without writing the summary), s.
+    pub total_s: f64,
+    /// One entry per step.
+    pub steps: Vec<StepSummary>,
+    /// Files written.
+    pub files: FilesSummary,
+}
+
+/// What a successful run wrote.
+#[derive(Debug, Clone)]
+pub struct RunReport {
+    /// The summary (also in `summary.json`).
+    pub summary: Summary,
+    /// The output directory.
+    pub out_dir: PathBuf,
+}
+
+/// A short description of a built model (`synovia check`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModelInfo {
+    /// Dimension.
+    pub dimension: usize,
+    /// Bodies `(name, nodes, cells)`.
+    pub bodies: Vec<(String, usize, usize)>,
+    /// Contact pair names.
+    pub pairs: Vec<String>,
+    /// Analysis kind.
+    pub analysis: String,
+    /// Steps the analysis will produce.
+    pub steps: usize,
+}
+
+fn dimension(sc: &Scenario) -> Result<usize, ScenarioError> {
+    match *sc.doc.dimension.get_ref() {
+        2 => Ok(2),
+        3 => Ok(3),
+        d => Err(sc.source.error(
+            "dimension",
+            Some(sc.doc.dimension.span()),
+            format!("must be 2 or 3, got {d}"),
+        )),
+    }
+}
+
+/// Builds the model of a scenario without solving it (reads the meshes, checks every name and
+/// value).
+///
+/// # Errors
+/// The scenario's first problem.
+pub fn check(sc: &Scenario) -> Result<ModelInfo, ScenarioError> {
+    fn info<const D: usize>(b: &Built<D>) -> ModelInfo {
+        ModelInfo {
+            dimension: D,
+            bodies: b
+                .joint
+                .model()
+                .bodies()
+                .iter()
+                .map(|x| (x.name.clone(), x.mesh.n_nodes(), x.mesh.n_cells()))
+                .collect(),
+            pairs: b.joint.pairs().iter().map(|p| p.name.clone()).collect(),
+            analysis: b.analysis.kind().to_string(),
+            steps: b.analysis.n_records(),
+        }
+    }
+    match dimension(sc)? {
+        2 => Ok(info(&build::<2>(sc)?)),
+        _ => Ok(info(&build::<3>(sc)?)),
+    }
+}
+
+/// Runs a scenario and writes its results to `out` (default: `output.dir` of the scenario, or
+/// `out/NAME`), calling `progress` as it goes.
+///
+/// # Errors
+/// [`RunError::Scenario`] for a broken scenario, [`RunError::Failed`] when solving or writing
+/// fails.
+pub fn run(
+    sc: &Scenario,
+    out: Option<&Path>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunReport, RunError> {
+    match dimension(sc)? {
+        2 => run_dim::<2>(sc, out, progress),
+        _ => run_dim::<3>(sc, out, progress),
+    }
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+fn step_summary(record: &StepRecord, vtu: Option<String>) -> StepSummary {
+    StepSummary {
+        step: record.step,
+        time: record.time,
+        iterations: record.iterations,
+        step_s: record.step_s,
+        contact_force: record.pairs.iter().map(|p| p.normal_force).sum(),
+        pairs: record
+            .pairs
+            .iter()
+            .map(|p| PairSummary {
+                name: p.name.clone(),
+                force: p.force,
+                normal_force: p.normal_force,
+                tangential_force: p.tangential_force,
+                contact_area: p.contact_area,
+                peak_pressure: p.peak_pressure,
+                stick_area: p.stick_area,
+                slip_area: p.slip_area,
+            })
+            .collect(),
+        strain_energy: record.strain_energy,
+        kinetic_energy: record.kinetic_energy,
+        friction_dissipation: record.friction_dissipation,
+        vtu,
+    }
+}
+
+fn run_dim<const D: usize>(
+    sc: &Scenario,
+    out: Option<&Path>,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunReport, RunError> {
+    let built = build::<D>(sc)?;
+    let name = built.name.clone();
+    let out_dir = match (out, &built.output.dir) {
+        (Some(o), _) => o.to_path_buf(),
+        (None, Some(d)) => d.clone(),
+        (None, None) => PathBuf::from("out").join(&name),
+    };
+    std::fs::create_dir_all(&out_dir)
+        .map_err(|e| anyhow::anyhow!("cannot create the output directory `{}`: {e}", out_dir.display()))?;
+    let plan = built.output.clone();
+    let n_steps = built.analysis.n_records();
+    progress(Progress::Start { steps: n_steps });
+    let mut writer: Option<QuasiStaticOutput<D>> = None;
+    let mut steps: Vec<StepSummary> = Vec::with_capacity(n_steps);
+    let result = built
+        .joint
+        .run_with(|view| {
+            let index = steps.len();
+            let vtu = if plan.vtu_every > 0 && (index % plan.vtu_every == 0 || index + 1 == view.n_steps) {
+                if writer.is_none() {
+                    writer = Some(QuasiStaticOutput::with_encoding(
+                        &out_dir,
+                        &name,
+                        view.geometry,
+                        plan.encoding,
+                    )?);
+                }
+                match writer.as_mut() {
+                    Some(w) => Some(file_name(&w.write_step(view.model, view.record, view.result)?)),
+                    None => None,
+                }
+            } else {
+                None
+            };
+            steps.push(step_summary(view.record, vtu));
+            progress(Progress::Step { index, time: view.record.time });
+            Ok::<(), JointError>(())
+        })
+        .map_err(|e| anyhow::Error::new(e).context(format!("running `{}`", sc.source.file)))?;
+    let csv = out_dir.join(format!("{name}.csv"));
+    write_csv(&csv, &result.records).map_err(anyhow::Error::new)?;
+    let summary = Summary {
+        scenario: sc.source.file.clone(),
+        name: name.clone(),
+        title: sc.doc.title.clone(),
+        dimension: D,
+        analysis: built.analysis.kind().to_string(),
+        solver: result.solver.clone(),
+        dofs: result.n_dofs,
+        contact_nodes: result.contact_nodes,
+        bodies: built
+            .joint
+            .model()
+            .bodies()
+            .iter()
+            .map(|b| BodySummary { name: b.name.clone(), nodes: b.mesh.n_nodes(), cells: b.mesh.n_cells() })
+            .collect(),
+        pairs: built.joint.pairs().iter().map(|p| p.name.clone()).collect(),
+        setup_s: result.setup_s,
+        total_s: result.total_s,
+        files: FilesSummary {
+            pvd: writer.as_ref().map(|w| file_name(w.pvd_path())),
+            csv: file_name(&csv),
+            vtu: steps.iter().filter(|s| s.vtu.is_some()).count(),
+        },
+        steps,
+    };
+    let json = serde_json::to_string_pretty(&summary).map_err(anyhow::Error::new)?;
+    let path = out_dir.join("summary.json");
+    std::fs::write(&path, json + "\n")
+        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
+    Ok(RunReport { summary, out_dir })
+}
