@@ -1089,6 +1089,21 @@ mod tests {
     }
 
     #[test]
+    fn gmsh_bodies_get_their_materials_by_name() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenarios/block2d.msh");
+        let mut jm = JointModel::<2>::new();
+        let ids = jm
+            .add_gmsh_bodies(&path, |name| (name == "block").then(|| plane_strain(5.0, 0.4).unwrap().into()))
+            .unwrap();
+        assert_eq!(ids.len(), 1);
+        jm.clamp("block", "bottom").unwrap().pressure("block", "top", 0.1, Constant(1.0)).unwrap();
+        let res = jm.run_static(0.0).unwrap();
+        assert!(res.displacement[0].iter().any(|u| u[1] < 0.0));
+        let e = JointModel::<2>::new().add_gmsh_bodies(&path, |_| None).unwrap_err();
+        assert!(e.to_string().contains("block"), "{e}");
+    }
+
+    #[test]
     fn elastic_model_without_pairs_and_dynamic_needs_density() {
         let mut jm = JointModel::<2>::new();
         let b = jm.add_body("b", block(), plane_strain(1.0, 0.3).unwrap()).unwrap();

@@ -1,17 +1,25 @@
-//! Choosing a contact solver by name (examples, scenario files).
+//! Choosing a contact solver by name (examples, scenario files), and the `pdas-fallback`
+//! combinator.
 
-use synovia_contact::{ContactError, ContactParams, ContactSolver};
+use synovia_contact::{ContactError, ContactParams, ContactProblem, ContactSolution, ContactSolver};
+use synovia_pdas::Pdas;
+use synovia_uzawa::DualMprgp;
 
-/// Names accepted by [`by_name`].
+/// Names accepted by [`by_name`] for the four basic solvers.
 pub const SOLVER_NAMES: &[&str] = &["pdas", "au-pdas", "uzawa-mprgp", "dual-mprgp"];
 
-/// The solver called `name` (see [`SOLVER_NAMES`]) with its default parameters.
+/// Further names accepted by [`by_name`]: combinators of the basic solvers ([`PdasFallback`]).
+pub const COMBINATOR_NAMES: &[&str] = &["pdas-fallback"];
+
+/// The solver called `name` (see [`SOLVER_NAMES`], [`COMBINATOR_NAMES`]) with its default
+/// parameters.
 pub fn by_name(name: &str) -> Result<Box<dyn ContactSolver>, ContactError> {
     Ok(match name {
         "pdas" => Box::new(synovia_pdas::Pdas::default()),
         "au-pdas" => Box::new(synovia_pdas::AuPdas::default()),
         "uzawa-mprgp" => Box::new(synovia_uzawa::UzawaMprgp::default()),
         "dual-mprgp" => Box::new(synovia_uzawa::DualMprgp::default()),
+        "pdas-fallback" => Box::new(PdasFallback::default()),
         _ => return by_name_with(name, ContactParams::default()),
     })
 }
@@ -23,10 +31,75 @@ pub fn by_name_with(name: &str, params: ContactParams) -> Result<Box<dyn Contact
         "au-pdas" => Box::new(synovia_pdas::AuPdas::new(params)),
         "uzawa-mprgp" => Box::new(synovia_uzawa::UzawaMprgp::new(params)),
         "dual-mprgp" => Box::new(synovia_uzawa::DualMprgp::new(params)),
+        "pdas-fallback" => Box::new(PdasFallback::new(params)),
         _ => {
             return Err(ContactError::InvalidParameter(format!(
-                "unknown contact solver `{name}`; choose one of {SOLVER_NAMES:?}"
+                "unknown contact solver `{name}`; choose one of {SOLVER_NAMES:?} or {COMBINATOR_NAMES:?}"
             )))
         }
     })
+}
+
+/// PDAS with a safeguard against its failure modes (name `"pdas-fallback"`).
+///
+/// Runs [`Pdas::solve_traced`] with `stop_on_cycling = true`. If PDAS converges, its solution
+/// is returned (with [`SolverReport::cycling_detected`](synovia_contact::SolverReport) and
+/// `stagnation_detected` as observed). If it fails with [`ContactError::NoConvergence`] (a
+/// detected active-set cycle ends it early, otherwise the iteration limit) or
+/// [`ContactError::Singular`] (linearly dependent active constraints), the problem is handed to
+/// [`DualMprgp`] warm-started from the last PDAS iterate: the dual QP is convex, so its
+/// projected-gradient iteration cannot cycle and it tolerates a semi-definite `S`. The returned
+/// report is that of `dual-mprgp` with `cycling_detected`/`stagnation_detected` from the PDAS
+/// phase and `fallback = Some(…)` naming the PDAS failure. Other errors (invalid input,
+/// infeasibility) are returned unchanged, as are the fallback's own errors.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PdasFallback {
+    /// The PDAS phase.
+    pub pdas: Pdas,
+    /// The fallback (default: the PDAS parameters with at least 10 000 QP iterations).
+    pub fallback: DualMprgp,
+}
+
+impl PdasFallback {
+    /// PDAS with `params`, the fallback with `params` and at least 10 000 QP iterations.
+    pub fn new(params: ContactParams) -> Self {
+        let fb = ContactParams { max_iterations: params.max_iterations.max(10_000), ..params };
+        Self { pdas: Pdas::new(params), fallback: DualMprgp::new(fb) }
+    }
+}
+
+impl Default for PdasFallback {
+    fn default() -> Self {
+        Self::new(ContactParams::default())
+    }
+}
+
+impl ContactSolver for PdasFallback {
+    fn name(&self) -> &str {
+        "pdas-fallback"
+    }
+
+    fn solve(
+        &self,
+        problem: &ContactProblem<'_>,
+        warm_start: Option<&ContactSolution>,
+    ) -> Result<ContactSolution, ContactError> {
+        let trace = self.pdas.solve_traced(problem, warm_start, true);
+        let failure = match trace.result {
+            Ok(sol) => return Ok(sol),
+            Err(e @ (ContactError::NoConvergence { .. } | ContactError::Singular { .. })) => e,
+            Err(e) => return Err(e),
+        };
+        let warm = trace.last_iterate.as_ref().or(warm_start);
+        let mut sol = self.fallback.solve(problem, warm)?;
+        sol.report.cycling_detected = trace.cycle_period.is_some();
+        sol.report.stagnation_detected = trace.stagnation;
+        let why = match trace.cycle_period {
+            Some(p) => format!("active-set cycle of period {p} detected; {failure}"),
+            None => failure.to_string(),
+        };
+        sol.report.fallback =
+            Some(format!("pdas failed ({why}); dual-mprgp warm-started from its last iterate"));
+        Ok(sol)
+    }
 }

@@ -266,9 +266,16 @@ fn several_contact_pairs_in_one_model() {
 #[test]
 fn the_solvers_agree_in_3d_with_friction() {
     use synovia::contact_ops::testing::BlockOnFoundation;
-    let owned = BlockOnFoundation { n: 6, push: 0.02, shift: 0.01, curvature: 0.5, slip_bound: Some(0.01) }
-        .build::<3>()
-        .expect("problem");
+    let owned = BlockOnFoundation {
+        n: 6,
+        push: 0.02,
+        shift: 0.01,
+        curvature: 0.5,
+        slip_bound: Some(0.01),
+        ..Default::default()
+    }
+    .build::<3>()
+    .expect("problem");
     let problem = owned.problem();
     let tight = ContactParams { tolerance: 1e-10, max_iterations: 5000, ..Default::default() };
     let mut sols = Vec::new();

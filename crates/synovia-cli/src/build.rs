@@ -3,7 +3,7 @@
 //! the value it is about.
 
 use std::any::Any;
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::ops::Range;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -58,6 +58,12 @@ pub struct OutputPlan {
 }
 
 type R<T> = Result<T, ScenarioError>;
+
+/// Largest mesh a generator may make (cells, estimated from its parameters).
+const MAX_CELLS: f64 = 2.0e7;
+/// Most refinement levels of `half_disc` / `hemisphere` (the cell size halves about every two
+/// levels in 2D and three in 3D).
+const MAX_REFINE_LEVELS: usize = 30;
 
 fn key(prefix: &str, field: &str) -> String {
     if prefix.is_empty() {
@@ -273,6 +279,19 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
     if *dim != D as i64 {
         return Err(cx.err("dimension", doc.dimension.span(), format!("must be 2 or 3, got {dim}")));
     }
+    if let Some(n) = &doc.name {
+        let v = n.get_ref();
+        if v.is_empty()
+            || !v.chars().all(|c| c.is_ascii_alphanumeric() || "_-.".contains(c))
+            || v.starts_with('.')
+        {
+            return Err(cx.err(
+                "name",
+                n.span(),
+                format!("`{v}` is not a usable file name: use letters, digits, `_`, `-` and `.`"),
+            ));
+        }
+    }
     let analysis = analysis(&cx, &doc.analysis)?;
     let mut joint = JointModel::<D>::new();
     let mut gmsh: HashMap<PathBuf, GmshMesh> = HashMap::new();
@@ -283,8 +302,9 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
         add_body(&cx, &mut joint, b.get_ref(), &format!("body[{i}]"), &mut gmsh, doc.bodies[..i].iter())?;
     }
     let names: Vec<String> = doc.bodies.iter().map(|b| b.get_ref().name.get_ref().clone()).collect();
+    let mut used = HashSet::new();
     for (i, bc) in doc.boundary.iter().enumerate() {
-        boundary(&cx, &mut joint, bc, &format!("boundary[{i}]"), &names)?;
+        boundary(&cx, &mut joint, bc, &format!("boundary[{i}]"), &names, &mut used)?;
     }
     for (i, t) in doc.ties.iter().enumerate() {
         let k = format!("tie[{i}]");
@@ -630,6 +650,38 @@ fn generate<const D: usize>(
         }
         Ok((radii, nr.get_ref().clone(), layer))
     };
+    // guard against meshes that cannot fit in memory (or take hours) before generating them
+    let get = |v: &Option<Sp<usize>>| v.as_ref().map_or(0.0, |x| *x.get_ref() as f64);
+    let prod = m.cells.as_ref().map_or(0.0, |c| c.get_ref().iter().map(|&x| x as f64).product::<f64>());
+    let n_layers = m.n_radial.as_ref().map_or(0.0, |c| c.get_ref().iter().map(|&x| x as f64).sum::<f64>());
+    let n = get(&m.n);
+    let estimate = match name {
+        "rectangle" => 2.0 * prod,
+        "box" => 6.0 * prod,
+        "disc" => 8.0 * n * n,
+        "half_disc" => 4.0 * n * n,
+        "ball" => 48.0 * n * n * n,
+        "hemisphere" => 24.0 * n * n * n,
+        "layered_arc" => 2.0 * get(&m.n_angle) * n_layers,
+        _ => 24.0 * get(&m.n_surface).powi(2) * n_layers,
+    };
+    if estimate > MAX_CELLS {
+        return Err(cx.err(
+            k,
+            span.clone(),
+            format!("the mesh would have about {estimate:.3e} cells, more than the limit {MAX_CELLS:e}"),
+        ));
+    }
+    if let Some(r) = &m.refine {
+        let levels = *r.get_ref().levels.get_ref();
+        if levels > MAX_REFINE_LEVELS {
+            return Err(cx.err(
+                key(k, "refine.levels"),
+                r.get_ref().levels.span(),
+                format!("at most {MAX_REFINE_LEVELS} refinement levels, got {levels}"),
+            ));
+        }
+    }
     let mesh: Box<dyn Any> = match name {
         "rectangle" => {
             let x = cx.range(cx.req(&m.x, k, "x", span, why)?, &key(k, "x"))?;
@@ -800,7 +852,7 @@ fn define_part<const D: usize>(cx: &Cx<'_>, mesh: &mut Mesh<D>, p: &Sp<PartSpec>
     result.map_err(|e| cx.err(k, p.span(), format!("part `{name}`: {e}")))
 }
 
-/// The linear elastic material of a `material` table (`kelvin_voigt` only where `allow_kv`).
+/// The material of a `material` table (`kelvin_voigt` only where `allow_kv`).
 fn material<const D: usize>(
     cx: &Cx<'_>,
     spec: &Sp<MaterialSpec>,
@@ -909,14 +961,14 @@ fn material<const D: usize>(
             let c0 = linear_of::<D>(cx, el, &key(k, "elastic"))?;
             let c1: Option<Arc<dyn Material<D>>> = match &m.viscous {
                 None => None,
-                Some(v) => Some(Arc::new(linear_of::<D>(cx, v, &key(k, "viscous"))?)),
+                Some(v) => Some(linear_of::<D>(cx, v, &key(k, "viscous"))?),
             };
             let rho = cx.positive(cx.req(&m.density, k, "density", &span, why)?, &key(k, "density"))?;
             let alpha = match &m.damping {
                 Some(d) => cx.non_negative(d, &key(k, "damping"))?,
                 None => 0.0,
             };
-            let kv = KelvinVoigt::new(Arc::new(c0), c1, rho, alpha).map_err(mat_err)?;
+            let kv = KelvinVoigt::new(c0, c1, rho, alpha).map_err(mat_err)?;
             return Ok(BodyMaterial::KelvinVoigt(kv));
         }
         other => {
@@ -933,14 +985,12 @@ fn material<const D: usize>(
     Ok(BodyMaterial::Elastic(Arc::new(*linear)))
 }
 
-/// A nested (`elastic` / `viscous`) material of a Kelvin–Voigt body.
-fn linear_of<const D: usize>(cx: &Cx<'_>, spec: &Sp<Box<MaterialSpec>>, k: &str) -> R<LinearElastic<D>> {
+/// A nested (`elastic` / `viscous`) material of a Kelvin–Voigt body (linear, kept as built so
+/// that 2D plane-strain data survive).
+fn linear_of<const D: usize>(cx: &Cx<'_>, spec: &Sp<Box<MaterialSpec>>, k: &str) -> R<Arc<dyn Material<D>>> {
     let inner = Sp::new(spec.span(), (**spec.get_ref()).clone());
     match material::<D>(cx, &inner, k, false)? {
-        BodyMaterial::Elastic(m) => {
-            let c = m.linear_stiffness().ok_or_else(|| cx.err(k, spec.span(), "needs a linear material"))?;
-            anisotropic::<D>(c).map_err(|e| cx.err(k, spec.span(), e.to_string()))
-        }
+        BodyMaterial::Elastic(m) => Ok(m),
         BodyMaterial::KelvinVoigt(_) => {
             Err(cx.err(k, spec.span(), "a kelvin_voigt material cannot be nested"))
         }
@@ -955,10 +1005,14 @@ fn boundary<const D: usize>(
     bc: &Sp<BoundarySpec>,
     k: &str,
     names: &[String],
+    used: &mut HashSet<(String, String)>,
 ) -> R<()> {
     let s = bc.get_ref();
     let span = bc.span();
     let (body, part) = body_part(cx, joint, &s.body, &s.part, &key(k, "body"), &key(k, "part"), names)?;
+    if s.kind.get_ref() != "traction_free" {
+        used.insert((body.clone(), part.clone()));
+    }
     let kind = s.kind.get_ref().as_str();
     let why = format!("kind `{kind}`");
     let why = why.as_str();
@@ -987,6 +1041,13 @@ fn boundary<const D: usize>(
                 "clamped" => joint.clamp(body.as_str(), &part).map(|_| ()),
                 "symmetry" => joint.symmetry(body.as_str(), &part).map(|_| ()),
                 _ => {
+                    if used.contains(&(body.clone(), part.clone())) {
+                        return Err(cx.err(
+                            key(k, "kind"),
+                            s.kind.span(),
+                            format!("part `{part}` of body `{body}` already has a condition above"),
+                        ));
+                    }
                     let id = joint.model().body_id(&body).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
                     let b = joint.model_mut().body_mut(id).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
                     b.mesh.set_part_kind(&part, BoundaryKind::TractionFree).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
@@ -1230,8 +1291,9 @@ fn obstacle<const D: usize>(
             cx.only(k, &present, &["center", "radius", "cavity"], why)?;
             let c = cx.point::<D>(cx.req(&s.center, k, "center", &span, why)?, &key(k, "center"))?;
             let r = cx.positive(cx.req(&s.radius, k, "radius", &span, why)?, &key(k, "radius"))?;
-            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<D>> =
-                Arc::new(SphereObstacle { center: c, radius: r, cavity });
+            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<D>> = Arc::new(
+                SphereObstacle::new(c, r, cavity).map_err(|e| cx.err(k, span.clone(), e.to_string()))?,
+            );
             return Ok(d);
         }
         "cylinder" => {
@@ -1246,8 +1308,9 @@ fn obstacle<const D: usize>(
             let p = cx.point::<3>(cx.req(&s.point, k, "point", &span, why)?, &key(k, "point"))?;
             let a = cx.nonzero::<3>(cx.req(&s.axis, k, "axis", &span, why)?, &key(k, "axis"))?;
             let r = cx.positive(cx.req(&s.radius, k, "radius", &span, why)?, &key(k, "radius"))?;
-            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<3>> =
-                Arc::new(CylinderObstacle { point: p, axis: a / a.norm(), radius: r, cavity });
+            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<3>> = Arc::new(
+                CylinderObstacle::new(p, a, r, cavity).map_err(|e| cx.err(k, span.clone(), e.to_string()))?,
+            );
             Box::new(d)
         }
         other => {
@@ -1352,8 +1415,11 @@ fn analysis(cx: &Cx<'_>, a: &Sp<AnalysisSpec>) -> R<Analysis> {
             if times.is_empty() {
                 return Err(cx.err(tk, t.span(), "needs at least one time level"));
             }
+            if let Some(x) = times.iter().find(|x| !x.is_finite()) {
+                return Err(cx.err(tk, t.span(), format!("times must be finite, got {x}")));
+            }
             for (i, w) in times.windows(2).enumerate() {
-                if !(w[1] > w[0]) {
+                if w[1] <= w[0] {
                     return Err(cx.err(
                         tk,
                         t.span(),
@@ -1365,9 +1431,6 @@ fn analysis(cx: &Cx<'_>, a: &Sp<AnalysisSpec>) -> R<Analysis> {
                         ),
                     ));
                 }
-            }
-            if let Some(x) = times.iter().find(|x| !x.is_finite()) {
-                return Err(cx.err(tk, t.span(), format!("times must be finite, got {x}")));
             }
             Ok(Analysis::QuasiStatic { times })
         }

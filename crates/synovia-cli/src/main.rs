@@ -94,8 +94,8 @@ fn main() -> ExitCode {
             let result = run::run(&sc, out.as_deref(), &mut |p| match p {
                 Progress::Start { steps } => bar.set_length(steps as u64),
                 Progress::Step { index, time } => {
-                    bar.set_position(index as u64 + 1);
                     bar.set_message(format!("t = {time:.4e}"));
+                    bar.set_position(index as u64 + 1);
                 }
             });
             bar.finish_and_clear();

@@ -164,22 +164,24 @@ pub fn key_path_at(text: &str, offset: usize) -> String {
     // Tables opened by a header (`[solver]`, `[[body]]`) span only their header, not their
     // keys, so every child is searched, innermost first.
     fn in_value(v: &Spanned<DeValue<'_>>, offset: usize, path: &mut Vec<String>) -> bool {
-        match v.get_ref() {
-            DeValue::Table(t) => {
-                if in_table(t, offset, path) {
-                    return true;
-                }
-            }
+        let found = match v.get_ref() {
+            DeValue::Table(t) => in_table(t, offset, path),
             DeValue::Array(a) => {
+                let mut hit = false;
                 for (i, e) in a.iter().enumerate() {
                     path.push(format!("[{i}]"));
                     if in_value(e, offset, path) {
-                        return true;
+                        hit = true;
+                        break;
                     }
                     path.pop();
                 }
+                hit
             }
-            _ => {}
+            _ => false,
+        };
+        if found {
+            return true;
         }
         contains(&v.span(), offset)
     }
@@ -246,9 +248,17 @@ impl Scenario {
     pub fn name(&self) -> String {
         match &self.doc.name {
             Some(n) => n.get_ref().clone(),
+            // the file stem, with characters unusable in output file names replaced by `_`
             None => Path::new(&self.source.file)
                 .file_stem()
-                .map_or_else(|| "scenario".to_string(), |s| s.to_string_lossy().into_owned()),
+                .map(|s| {
+                    s.to_string_lossy()
+                        .chars()
+                        .map(|c| if c.is_ascii_alphanumeric() || "_-.".contains(c) { c } else { '_' })
+                        .collect::<String>()
+                })
+                .filter(|s| !s.is_empty() && !s.starts_with('.'))
+                .unwrap_or_else(|| "scenario".to_string()),
         }
     }
 }
@@ -717,4 +727,3 @@ impl<'de> Deserialize<'de> for TimesSpec {
         d.deserialize_any(V)
     }
 }
-

@@ -132,10 +132,31 @@ fn rejects(name: &str, from: &str, to: &str, key: &str, line_col: &str, words: &
 #[test]
 fn broken_scenarios_are_rejected_with_key_and_position() {
     // line 16 is `material = { type = "isotropic", E = 10.0, ... }`
-    rejects("unknown_key", "material = {", "materal = {", "body[0].materal", "16:1", "unknown field `materal`");
+    rejects(
+        "unknown_key",
+        "material = {",
+        "materal = {",
+        "body[0].materal",
+        "16:1",
+        "unknown field `materal`",
+    );
     rejects("wrong_type", "E = 10.0", "E = \"ten\"", "body[0].material.E", "16:38", "invalid type");
-    rejects("unknown_part", "part = \"top\"", "part = \"topp\"", "boundary[0].part", "27:8", "no part `topp`");
-    rejects("unknown_body", "body = \"cylinder\"", "body = \"cylindre\"", "boundary[0].body", "26:8", "no body");
+    rejects(
+        "unknown_part",
+        "part = \"top\"",
+        "part = \"topp\"",
+        "boundary[0].part",
+        "27:8",
+        "no part `topp`",
+    );
+    rejects(
+        "unknown_body",
+        "body = \"cylinder\"",
+        "body = \"cylindre\"",
+        "boundary[0].body",
+        "26:8",
+        "no body",
+    );
     rejects(
         "missing_value",
         "value = [0.0, -0.1]",
@@ -176,10 +197,31 @@ fn broken_scenarios_are_rejected_with_key_and_position() {
         "30:56",
         "> 0",
     );
-    rejects("vector_length", "value = [0.0, -0.1]", "value = [0.0, -0.1, 0.0]", "boundary[0].value", "29:9", "2D vector");
-    rejects("bad_solver", "name = \"pdas\"", "name = \"newton\"", "solver.name", "40:8", "unknown contact solver");
-    rejects("syntax", "dimension = 2", "dimension = 2\nfoo = [1, 2", "foo[2]", "13:1", "comma");
-    rejects("no_analysis", "[analysis]\ntype = \"static\"", "", "analysis", "1:1", "missing field `analysis`");
+    rejects(
+        "vector_length",
+        "value = [0.0, -0.1]",
+        "value = [0.0, -0.1, 0.0]",
+        "boundary[0].value",
+        "29:9",
+        "2D vector",
+    );
+    rejects(
+        "bad_solver",
+        "name = \"pdas\"",
+        "name = \"newton\"",
+        "solver.name",
+        "38:8",
+        "unknown contact solver",
+    );
+    rejects("syntax", "dimension = 2", "dimension = 2\nfoo = [1, 2", "foo[2]", "12:1", "comma");
+    rejects(
+        "no_analysis",
+        "[analysis]\ntype = \"static\"",
+        "",
+        "analysis",
+        "1:1",
+        "missing field `analysis`",
+    );
 }
 
 #[test]
@@ -200,15 +242,21 @@ fn gmsh_part_of_kind_prescribed_needs_data() {
     assert!(err.contains("`body[0].mesh`") && err.contains("prescribed_top"), "{err}");
     assert!(err.contains("missing boundary data"), "{err}");
     // a missing group and a missing file name the `gmsh` key
-    std::fs::write(&file, text.replace("{ gmsh = \"block2d.msh\" }", "{ gmsh = \"block2d.msh\", group = \"femur\" }"))
-        .unwrap();
+    std::fs::write(
+        &file,
+        text.replace("{ gmsh = \"block2d.msh\" }", "{ gmsh = \"block2d.msh\", group = \"femur\" }"),
+    )
+    .unwrap();
     let o = run(&file, &dir.join("out"));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("`body[0].mesh.group`") && err.contains("femur"), "{err}");
     std::fs::write(&file, text.replace("block2d.msh", "nothere.msh")).unwrap();
     let o = run(&file, &dir.join("out"));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("`body[0].mesh.gmsh`") && err.contains("nothere.msh"), "{err}");
+    assert!(
+        !o.status.success() && err.contains("`body[0].mesh.gmsh`") && err.contains("nothere.msh"),
+        "{err}"
+    );
 }
 
 #[test]

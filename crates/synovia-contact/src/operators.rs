@@ -83,6 +83,40 @@ pub trait SignedDistance<const D: usize>: Send + Sync + fmt::Debug {
     fn distance(&self, x: &Point<D>) -> Real;
     /// `∇φ(x)`: the unit normal of the obstacle surface pointing into the free space.
     fn gradient(&self, x: &Point<D>) -> Vector<D>;
+    /// Checks the obstacle's parameters (finite, positive radius, unit directions); the
+    /// error names the offending parameter. [`ContactGeometry::new`] calls it for every rigid
+    /// pair and reports a failure as [`ContactError::InvalidPair`]. Default: no check.
+    fn validate(&self) -> Result<(), String> {
+        Ok(())
+    }
+}
+
+/// `Err` naming `what` unless every entry of `v` is finite.
+fn check_finite(what: &str, v: &[Real]) -> Result<(), String> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(format!("{what} {v:?} is not finite"))
+    }
+}
+
+/// `Err` unless `v` is a finite unit vector (within 1e-9).
+fn check_unit(what: &str, v: &[Real]) -> Result<(), String> {
+    check_finite(what, v)?;
+    let n = v.iter().map(|x| x * x).sum::<Real>().sqrt();
+    if (n - 1.0).abs() > 1e-9 {
+        return Err(format!("{what} {v:?} must be a unit vector (length {n:e})"));
+    }
+    Ok(())
+}
+
+/// `Err` unless `r` is finite and positive.
+fn check_radius(r: Real) -> Result<(), String> {
+    if r.is_finite() && r > 0.0 {
+        Ok(())
+    } else {
+        Err(format!("radius {r} must be finite and > 0"))
+    }
 }
 
 /// The half-space `{(x − p) · n < 0}` is the obstacle; `n` points into the free space.
@@ -114,6 +148,10 @@ impl<const D: usize> SignedDistance<D> for PlaneObstacle<D> {
     fn gradient(&self, _x: &Point<D>) -> Vector<D> {
         self.normal
     }
+    fn validate(&self) -> Result<(), String> {
+        check_finite("plane point", self.point.as_slice())?;
+        check_unit("plane normal", self.normal.as_slice())
+    }
 }
 
 /// A rigid ball (circle in 2D) `|x − c| ≤ R`, or with `cavity = true` the outside of it (a
@@ -128,7 +166,21 @@ pub struct SphereObstacle<const D: usize> {
     pub cavity: bool,
 }
 
+impl<const D: usize> SphereObstacle<D> {
+    /// A ball (`cavity = false`) or spherical socket (`cavity = true`); error if the centre
+    /// is not finite or the radius not finite and positive.
+    pub fn new(center: Point<D>, radius: Real, cavity: bool) -> Result<Self, ContactError> {
+        let s = Self { center, radius, cavity };
+        s.validate().map_err(|m| ContactError::InvalidParameter(format!("sphere obstacle: {m}")))?;
+        Ok(s)
+    }
+}
+
 impl<const D: usize> SignedDistance<D> for SphereObstacle<D> {
+    fn validate(&self) -> Result<(), String> {
+        check_finite("sphere centre", self.center.as_slice())?;
+        check_radius(self.radius)
+    }
     fn distance(&self, x: &Point<D>) -> Real {
         let r = (x - self.center).norm();
         if self.cavity {
@@ -162,7 +214,28 @@ pub struct CylinderObstacle {
     pub cavity: bool,
 }
 
+impl CylinderObstacle {
+    /// A cylinder about the axis through `point` along `axis` (normalised); error if the point
+    /// or axis is not finite, the axis is zero, or the radius not finite and positive.
+    pub fn new(point: Point<3>, axis: Vector<3>, radius: Real, cavity: bool) -> Result<Self, ContactError> {
+        let bad = |m: String| ContactError::InvalidParameter(format!("cylinder obstacle: {m}"));
+        check_finite("cylinder axis", axis.as_slice()).map_err(bad)?;
+        let len = axis.norm();
+        if len <= 0.0 {
+            return Err(bad("axis is zero".into()));
+        }
+        let s = Self { point, axis: axis / len, radius, cavity };
+        s.validate().map_err(bad)?;
+        Ok(s)
+    }
+}
+
 impl SignedDistance<3> for CylinderObstacle {
+    fn validate(&self) -> Result<(), String> {
+        check_finite("cylinder point", self.point.as_slice())?;
+        check_unit("cylinder axis", self.axis.as_slice())?;
+        check_radius(self.radius)
+    }
     fn distance(&self, x: &Point<3>) -> Real {
         let v = x - self.point;
         let r = (v - self.axis * v.dot(&self.axis)).norm();
@@ -524,8 +597,25 @@ impl<const D: usize> ContactGeometry<D> {
             }
             let normals = nodal_normals_at(pos_k, part.facets());
             let reference = |i: usize| *body.mesh.node(i);
+            // distinct nodes of the part at the same reference position (a duplicated node,
+            // e.g. an unmerged mesh seam) would give two constraints on one point
+            {
+                let mut seen: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
+                for i in part.nodes() {
+                    let key: Vec<u64> = reference(i).iter().map(|x| (x + 0.0).to_bits()).collect();
+                    if let Some(j) = seen.insert(key, i) {
+                        return Err(invalid(format!(
+                            "nodes {j} and {i} of part `{}` of body `{}` coincide at {:?} (duplicated node)",
+                            pair.part,
+                            body.name,
+                            reference(i).as_slice()
+                        )));
+                    }
+                }
+            }
             match &pair.partner {
                 Partner::Rigid(obstacle) => {
+                    obstacle.validate().map_err(|m| invalid(format!("obstacle: {m}")))?;
                     for (i, nk) in normals {
                         let x = pos_k[i];
                         let phi = obstacle.distance(&x);
@@ -632,6 +722,16 @@ impl<const D: usize> ContactGeometry<D> {
                             gap: (xlj - xk).dot(&n),
                             friction: pair.friction,
                         });
+                    }
+                    // every node penetrating its partner by more than an element edge: the
+                    // normals of part k point away from part l (or the parts are swapped)
+                    let largest_gap =
+                        nodes[start..].iter().map(|c| c.gap).fold(Real::NEG_INFINITY, Real::max);
+                    if nodes.len() > start && largest_gap < -min_edge {
+                        return Err(invalid(format!(
+                            "every node of part `{}` lies more than one element edge ({min_edge:.3e}) behind                              its partner on part `{pl}` (largest gap {largest_gap:.3e}): do the normals of                              `{}` point away from `{pl}`?",
+                            pair.part, pair.part
+                        )));
                     }
                 }
                 Partner::Segment { body: bl, part: pl, search_distance } => {

@@ -42,6 +42,14 @@ pub struct SolverReport {
     pub slip: usize,
     /// Wall time (s).
     pub time_s: f64,
+    /// An active-set configuration (normal and stick/slip states) recurred within the last
+    /// few iterations without a decrease of the residual (PDAS; see `synovia_pdas::Pdas`).
+    pub cycling_detected: bool,
+    /// The residual stopped decreasing over several iterations (PDAS).
+    pub stagnation_detected: bool,
+    /// The fallback that produced this solution, if any (e.g. the `pdas-fallback` solver of
+    /// the `synovia` facade hands a cycling PDAS iteration over to `dual-mprgp`).
+    pub fallback: Option<String>,
 }
 
 /// A solution of the contact problem of spec §5.

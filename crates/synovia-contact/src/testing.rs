@@ -59,16 +59,40 @@ pub struct BlockOnFoundation {
     pub curvature: f64,
     /// Slip bound `g_c` (force per area); `None` = frictionless.
     pub slip_bound: Option<f64>,
+    /// Young's modulus (default 1).
+    pub young: f64,
+    /// Poisson's ratio (default 0.3; plane strain in 2D).
+    pub poisson: f64,
+    /// Random displacement of the interior nodes, as a fraction of the cell size `h`
+    /// (default 0: a structured mesh). Each coordinate moves by at most `jitter · h / 2`.
+    pub jitter: f64,
+    /// Seed of the node jitter.
+    pub seed: u64,
+    /// Constant added to every gap: `d = c (x − ½)² + gap_offset` (default 0; negative values
+    /// are an initial penetration).
+    pub gap_offset: f64,
 }
 
 impl Default for BlockOnFoundation {
     fn default() -> Self {
-        Self { n: 16, push: 0.02, shift: 0.01, curvature: 0.5, slip_bound: Some(0.05) }
+        Self {
+            n: 16,
+            push: 0.02,
+            shift: 0.01,
+            curvature: 0.5,
+            slip_bound: Some(0.05),
+            young: 1.0,
+            poisson: 0.3,
+            jitter: 0.0,
+            seed: 0,
+            gap_offset: 0.0,
+        }
     }
 }
 
 impl BlockOnFoundation {
-    /// Builds the problem in dimension `D` (2 or 3); E = 1, ν = 0.3 (plane strain in 2D).
+    /// Builds the problem in dimension `D` (2 or 3) with `E = young`, `ν = poisson` (plane
+    /// strain in 2D), interior nodes jittered by `jitter` (fraction of `h`).
     pub fn build<const D: usize>(&self) -> Result<OwnedProblem, ContactError> {
         let n = self.n.max(2);
         let (push, shift) = (self.push, self.shift);
@@ -80,9 +104,35 @@ impl BlockOnFoundation {
         } else {
             box_mesh([0.0; 3], [1.0, 1.0, 0.5], [n, n, n / 2], [Grading::Uniform; 3])?.recast::<D>()?
         };
+        if self.jitter != 0.0 {
+            if !(self.jitter.is_finite() && self.jitter.abs() < 0.5) {
+                return Err(ContactError::InvalidParameter(format!(
+                    "jitter {} must be a finite fraction of h below 0.5",
+                    self.jitter
+                )));
+            }
+            let h = 1.0 / n as f64;
+            let (amp, seed) = (0.5 * self.jitter * h, self.seed);
+            let hi = [1.0, if D == 2 { 0.5 } else { 1.0 }, 0.5];
+            mesh.map_nodes(|x| {
+                let interior = (0..D).all(|k| x[k] > 1e-9 && x[k] < hi[k] - 1e-9);
+                if !interior {
+                    return *x;
+                }
+                let mut key = seed;
+                for k in 0..D {
+                    key = splitmix(key ^ x[k].to_bits());
+                }
+                Point::<D>::from_fn(|k, _| {
+                    let r = splitmix(key.wrapping_add(k as u64 + 1));
+                    let unit = (r >> 11) as f64 / (1u64 << 53) as f64; // [0, 1)
+                    x[k] + amp * (2.0 * unit - 1.0)
+                })
+            })?;
+        }
         mesh.set_part_kind(top, BoundaryKind::Prescribed)?;
         mesh.set_part_kind(bottom, BoundaryKind::Contact)?;
-        let b = model.add_body("block", mesh, Arc::new(block_material::<D>()?))?;
+        let b = model.add_body("block", mesh, Arc::new(block_material::<D>(self.young, self.poisson)?))?;
         model.prescribe(b, top, move |_, _| {
             Vector::<D>::from_fn(|i, _| {
                 if i == 0 {
@@ -117,7 +167,7 @@ impl BlockOnFoundation {
             let gi = dofs.group_of(synovia_fem::BodyId(0), node);
             let g = &dofs.groups()[gi];
             let x: Point<D> = *mesh.node(node);
-            let mut d = 0.0;
+            let mut d = self.gap_offset;
             for k in 0..D - 1 {
                 d += self.curvature * (x[k] - 0.5).powi(2);
             }
@@ -146,13 +196,42 @@ impl BlockOnFoundation {
     }
 }
 
-/// E = 1, ν = 0.3: plane strain in 2D, isotropic in 3D.
-fn block_material<const D: usize>() -> Result<synovia_material::LinearElastic<D>, ContactError> {
+/// SplitMix64 step (a small deterministic hash for the node jitter).
+fn splitmix(x: u64) -> u64 {
+    let mut z = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// `E`, `ν`: plane strain in 2D, isotropic in 3D.
+fn block_material<const D: usize>(
+    e: f64,
+    nu: f64,
+) -> Result<synovia_material::LinearElastic<D>, ContactError> {
     let c = if D == 2 {
-        plane_strain(1.0, 0.3).map(|m| m.stiffness().clone())
+        plane_strain(e, nu).map(|m| m.stiffness().clone())
     } else {
-        isotropic(1.0, 0.3).map(|m| m.stiffness().clone())
+        isotropic(e, nu).map(|m| m.stiffness().clone())
     }
     .map_err(synovia_fem::FemError::from)?;
     Ok(synovia_material::anisotropic::<D>(c).map_err(synovia_fem::FemError::from)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jitter_moves_interior_nodes_only_and_keeps_a_valid_problem() {
+        let base = BlockOnFoundation { n: 6, ..Default::default() };
+        let a = base.build::<2>().expect("structured");
+        let b = BlockOnFoundation { jitter: 0.3, seed: 7, ..base }.build::<2>().expect("jittered");
+        // same rows (boundary nodes do not move), different stiffness
+        assert_eq!(a.normal.gap, b.normal.gap);
+        assert_eq!(a.normal.weights, b.normal.weights);
+        assert_ne!(a.matrix.diagonal(), b.matrix.diagonal());
+        let bad = BlockOnFoundation { jitter: 0.7, ..base }.build::<2>();
+        assert!(matches!(bad, Err(ContactError::InvalidParameter(_))));
+    }
 }

@@ -1,5 +1,6 @@
 //! The primal–dual active set method (semismooth Newton) on the contact interface.
 
+use std::collections::VecDeque;
 use std::time::Instant;
 
 use synovia_contact::{
@@ -65,6 +66,174 @@ impl Pdas {
     }
 }
 
+/// Length of the window in which [`Pdas`] looks for recurring active-set configurations and
+/// for progress of the residual.
+pub const CYCLE_WINDOW: usize = 8;
+
+/// What [`Pdas::solve_traced`] observed besides its result: the last iterate and the
+/// failure modes detected.
+#[derive(Debug)]
+pub struct PdasTrace {
+    /// The result, as returned by [`ContactSolver::solve`] (with `stop_on_cycling`, a
+    /// detected cycle ends the iteration early with [`ContactError::NoConvergence`]).
+    pub result: Result<ContactSolution, ContactError>,
+    /// The last iterate `(U, Λ_n, Λ_t)` reached (also on failure), e.g. to warm-start another
+    /// solver; `None` if the iteration failed before the first step.
+    pub last_iterate: Option<ContactSolution>,
+    /// Period (in iterations) of a detected active-set cycle.
+    pub cycle_period: Option<usize>,
+    /// The residual did not decrease (by at least 0.1 %) over the last [`CYCLE_WINDOW`]
+    /// iterations.
+    pub stagnation: bool,
+}
+
+impl Pdas {
+    /// Solves like [`ContactSolver::solve`] and also returns the last iterate and the
+    /// failure modes detected:
+    ///
+    /// * **cycling** — the sets `(𝒜_n, stick/slip)` computed after iteration `k` equal those
+    ///   after an iteration `j ∈ [k − CYCLE_WINDOW, k − 1]` although they changed in
+    ///   iteration `k`, and the residual `max(normal, tangential)` at `k` is not below
+    ///   0.999 × that at `j`. In 2D the step depends on the sets only, so such a recurrence
+    ///   repeats for ever;
+    /// * **stagnation** — after `2 · CYCLE_WINDOW` iterations, the smallest residual of the
+    ///   last `CYCLE_WINDOW` iterations is not below 0.999 × the smallest one before.
+    ///
+    /// With `stop_on_cycling` a detected cycle ends the iteration at once with
+    /// [`ContactError::NoConvergence`] (its history up to that iteration), so that a caller
+    /// can switch to another method (the `pdas-fallback` solver of the `synovia` facade hands
+    /// over to `dual-mprgp`). Otherwise the iteration continues to `max_iterations` as in
+    /// [`ContactSolver::solve`]. A converged solution records the detections in
+    /// [`SolverReport::cycling_detected`] and [`SolverReport::stagnation_detected`].
+    pub fn solve_traced(
+        &self,
+        problem: &ContactProblem<'_>,
+        warm_start: Option<&ContactSolution>,
+        stop_on_cycling: bool,
+    ) -> PdasTrace {
+        let mut trace = PdasTrace {
+            result: Ok(empty_solution()),
+            last_iterate: None,
+            cycle_period: None,
+            stagnation: false,
+        };
+        let mut last_nu = None;
+        trace.result = self.iterate(problem, warm_start, stop_on_cycling, &mut trace, &mut last_nu);
+        if let Some((nu, u)) = last_nu {
+            let (lambda_n, lambda_t) = problem.split_multipliers(&nu);
+            trace.last_iterate =
+                Some(ContactSolution { u, lambda_n, lambda_t, report: SolverReport::default() });
+        }
+        trace
+    }
+
+    fn iterate(
+        &self,
+        problem: &ContactProblem<'_>,
+        warm_start: Option<&ContactSolution>,
+        stop_on_cycling: bool,
+        trace: &mut PdasTrace,
+        last_nu: &mut Option<(Vec<f64>, Vec<f64>)>,
+    ) -> Result<ContactSolution, ContactError> {
+        let start = Instant::now();
+        let name = "pdas";
+        let mut st = State::new(problem, &self.params)?;
+        let mut nu = st.initial_nu(problem, warm_start)?;
+        let mut y = st.values(&nu)?;
+        let mut sets =
+            Sets { normal: st.classify_normal(&nu, &y, None), cells: st.classify_cells(&nu, &y, None) };
+        let mut history = Vec::new();
+        let mut recent: VecDeque<(Sets, f64)> = VecDeque::with_capacity(CYCLE_WINDOW + 1);
+        let mut best_before = f64::INFINITY;
+        let tol = self.params.tolerance;
+        let outcome = 'outer: {
+            for it in 1..=self.params.max_iterations {
+                let zetas = st.zetas(&nu, &y);
+                let mut fixed = vec![0.0; nu.len()];
+                let mut unknowns = Vec::new();
+                st.normal_part(&sets.normal, &mut fixed, &mut unknowns);
+                st.tangential_part(&sets.cells, &zetas, true, &mut fixed, &mut unknowns);
+                let step = st.solve_step(fixed, &unknowns, name, it);
+                nu = match step {
+                    Ok(v) => v,
+                    Err(e) => break 'outer Err(e),
+                };
+                y = st.values(&nu)?;
+                let new_sets = Sets {
+                    normal: st.classify_normal(&nu, &y, Some(&sets.normal)),
+                    cells: st.classify_cells(&nu, &y, Some(&sets.cells)),
+                };
+                let set_changes = new_sets.changes(&sets);
+                let (normal, tangential) = st.residual(&nu, &y);
+                history.push(IterationResidual { iteration: it, normal, tangential, set_changes });
+                let r = normal.max(tangential);
+                // failure modes: recurring sets without progress, and stagnation
+                if set_changes > 0 {
+                    let back = recent.iter().rev().position(|(s, rj)| *s == new_sets && r >= 0.999 * rj);
+                    if let Some(k) = back {
+                        trace.cycle_period.get_or_insert(k + 1);
+                    }
+                }
+                if it > CYCLE_WINDOW {
+                    let (old, _) = history.split_at(it - CYCLE_WINDOW);
+                    if let Some(h) = old.last() {
+                        best_before = best_before.min(h.normal.max(h.tangential));
+                    }
+                    let best_recent = history[it - CYCLE_WINDOW..]
+                        .iter()
+                        .map(|h| h.normal.max(h.tangential))
+                        .fold(f64::INFINITY, f64::min);
+                    if it >= 2 * CYCLE_WINDOW && best_recent >= 0.999 * best_before && best_recent > tol {
+                        trace.stagnation = true;
+                    }
+                }
+                recent.push_back((new_sets.clone(), r));
+                if recent.len() > CYCLE_WINDOW {
+                    recent.pop_front();
+                }
+                sets = new_sets;
+                if set_changes == 0 && normal <= tol && tangential <= tol {
+                    let report = SolverReport {
+                        solver: name.to_string(),
+                        iterations: it,
+                        history,
+                        cycling_detected: trace.cycle_period.is_some(),
+                        stagnation_detected: trace.stagnation,
+                        ..Default::default()
+                    };
+                    let sol = finish(&mut st, problem, &nu, &sets, report, start)?;
+                    *last_nu = Some((nu, sol.u.clone()));
+                    return Ok(sol);
+                }
+                if stop_on_cycling && trace.cycle_period.is_some() {
+                    break 'outer Err(ContactError::NoConvergence {
+                        solver: name.to_string(),
+                        iterations: it,
+                        history,
+                    });
+                }
+            }
+            Err(ContactError::NoConvergence {
+                solver: name.to_string(),
+                iterations: self.params.max_iterations,
+                history,
+            })
+        };
+        let u = st.iface.displacement(&nu)?;
+        *last_nu = Some((nu, u));
+        outcome
+    }
+}
+
+fn empty_solution() -> ContactSolution {
+    ContactSolution {
+        u: Vec::new(),
+        lambda_n: Vec::new(),
+        lambda_t: Vec::new(),
+        report: SolverReport::default(),
+    }
+}
+
 impl ContactSolver for Pdas {
     fn name(&self) -> &str {
         "pdas"
@@ -75,41 +244,6 @@ impl ContactSolver for Pdas {
         problem: &ContactProblem<'_>,
         warm_start: Option<&ContactSolution>,
     ) -> Result<ContactSolution, ContactError> {
-        let start = Instant::now();
-        let name = self.name();
-        let mut st = State::new(problem, &self.params)?;
-        let mut nu = st.initial_nu(problem, warm_start)?;
-        let mut y = st.values(&nu)?;
-        let mut sets =
-            Sets { normal: st.classify_normal(&nu, &y, None), cells: st.classify_cells(&nu, &y, None) };
-        let mut history = Vec::new();
-        let tol = self.params.tolerance;
-        for it in 1..=self.params.max_iterations {
-            let zetas = st.zetas(&nu, &y);
-            let mut fixed = vec![0.0; nu.len()];
-            let mut unknowns = Vec::new();
-            st.normal_part(&sets.normal, &mut fixed, &mut unknowns);
-            st.tangential_part(&sets.cells, &zetas, true, &mut fixed, &mut unknowns);
-            nu = st.solve_step(fixed, &unknowns, name, it)?;
-            y = st.values(&nu)?;
-            let new_sets = Sets {
-                normal: st.classify_normal(&nu, &y, Some(&sets.normal)),
-                cells: st.classify_cells(&nu, &y, Some(&sets.cells)),
-            };
-            let set_changes = new_sets.changes(&sets);
-            let (normal, tangential) = st.residual(&nu, &y);
-            history.push(IterationResidual { iteration: it, normal, tangential, set_changes });
-            sets = new_sets;
-            if set_changes == 0 && normal <= tol && tangential <= tol {
-                let report =
-                    SolverReport { solver: name.to_string(), iterations: it, history, ..Default::default() };
-                return finish(&mut st, problem, &nu, &sets, report, start);
-            }
-        }
-        Err(ContactError::NoConvergence {
-            solver: name.to_string(),
-            iterations: self.params.max_iterations,
-            history,
-        })
+        self.solve_traced(problem, warm_start, false).result
     }
 }

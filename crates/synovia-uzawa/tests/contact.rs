@@ -19,7 +19,10 @@ fn build(dim: usize, cfg: BlockOnFoundation) -> OwnedProblem {
 fn problem(dim: usize, friction: bool) -> OwnedProblem {
     let n = if dim == 2 { 16 } else { 8 };
     let slip_bound = friction.then_some(0.02);
-    build(dim, BlockOnFoundation { n, push: 0.02, shift: 0.03, curvature: 0.5, slip_bound })
+    build(
+        dim,
+        BlockOnFoundation { n, push: 0.02, shift: 0.03, curvature: 0.5, slip_bound, ..Default::default() },
+    )
 }
 
 fn params(tolerance: f64) -> ContactParams {
@@ -139,6 +142,7 @@ fn warm_start_reuses_the_solution() {
                 shift: 0.03,
                 curvature: 0.5,
                 slip_bound: Some(0.02),
+                ..Default::default()
             },
         );
         let q = moved.problem();
