@@ -8,7 +8,7 @@ use synovia_contact::{
     SolverReport,
 };
 
-use crate::sets::{finish, Sets, State};
+use crate::sets::{finish, CellState, Sets, State};
 
 /// Primal–dual active set method (PDAS) = semismooth Newton method for the contact problem of
 /// spec §5 (frictionless or Tresca, 2D or 3D), condensed on the contact interface.
@@ -91,11 +91,13 @@ impl Pdas {
     /// Solves like [`ContactSolver::solve`] and also returns the last iterate and the
     /// failure modes detected:
     ///
-    /// * **cycling** — the sets `(𝒜_n, stick/slip)` computed after iteration `k` equal those
+    /// * **cycling** — the sets `(𝒜_n, stick/slip)` (and, in 2D, the signs of `ζ_c` on the
+    ///   slipping cells) computed after iteration `k` equal those
     ///   after an iteration `j ∈ [k − CYCLE_WINDOW, k − 1]` although they changed in
     ///   iteration `k`, and the residual `max(normal, tangential)` at `k` is not below
-    ///   0.999 × that at `j`. In 2D the step depends on the sets only, so such a recurrence
-    ///   repeats for ever;
+    ///   0.999 × that at `j`. In 2D the step depends on the sets and those signs only, so such
+    ///   a recurrence repeats for ever; in 3D (slip directions vary continuously) it is a
+    ///   heuristic;
     /// * **stagnation** — after `2 · CYCLE_WINDOW` iterations, the smallest residual of the
     ///   last `CYCLE_WINDOW` iterations is not below 0.999 × the smallest one before.
     ///
@@ -143,7 +145,7 @@ impl Pdas {
         let mut sets =
             Sets { normal: st.classify_normal(&nu, &y, None), cells: st.classify_cells(&nu, &y, None) };
         let mut history = Vec::new();
-        let mut recent: VecDeque<(Sets, f64)> = VecDeque::with_capacity(CYCLE_WINDOW + 1);
+        let mut recent: VecDeque<(Sets, Vec<bool>, f64)> = VecDeque::with_capacity(CYCLE_WINDOW + 1);
         let mut best_before = f64::INFINITY;
         let tol = self.params.tolerance;
         let outcome = 'outer: {
@@ -168,8 +170,20 @@ impl Pdas {
                 history.push(IterationResidual { iteration: it, normal, tangential, set_changes });
                 let r = normal.max(tangential);
                 // failure modes: recurring sets without progress, and stagnation
+                // In 2D the next step is fixed by the sets and the signs of ζ on the slipping
+                // cells, so a recurrence of both repeats the whole sequence.
+                let signs: Vec<bool> = if st.comps == 1 {
+                    (0..st.n_cells)
+                        .map(|c| new_sets.cells[c] == CellState::Slip && st.zeta(c, &nu, &y)[0] > 0.0)
+                        .collect()
+                } else {
+                    Vec::new()
+                };
                 if set_changes > 0 {
-                    let back = recent.iter().rev().position(|(s, rj)| *s == new_sets && r >= 0.999 * rj);
+                    let back = recent
+                        .iter()
+                        .rev()
+                        .position(|(s, sg, rj)| *s == new_sets && *sg == signs && r >= 0.999 * rj);
                     if let Some(k) = back {
                         trace.cycle_period.get_or_insert(k + 1);
                     }
@@ -187,7 +201,7 @@ impl Pdas {
                         trace.stagnation = true;
                     }
                 }
-                recent.push_back((new_sets.clone(), r));
+                recent.push_back((new_sets.clone(), signs, r));
                 if recent.len() > CYCLE_WINDOW {
                     recent.pop_front();
                 }
