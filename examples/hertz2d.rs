@@ -95,8 +95,62 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("  nested, coarse levels: {:?}", rigid.iter().map(|r| r.coarse_iterations).collect::<Vec<_>>());
     println!("  cold start: {:?}", cold.iter().map(|r| r.iterations).collect::<Vec<_>>());
     assert!(name != "pdas" || last <= first + 3, "PDAS iterations grow with refinement");
+    let svg = std::path::Path::new("out/hertz2d/pressure.svg");
+    plot_pressure(svg, &rigid[rigid.len() - 1])?;
+    println!("wrote {} (computed nodal pressure vs the Hertz curve)", svg.display());
     for r in rigid.iter().chain(&cold).chain(&pair) {
         println!("{}", r.json());
     }
+    Ok(())
+}
+
+/// The computed nodal pressures of `run` against the Hertz curve `p₀ sqrt(1 − x²/a²)` (exact
+/// `a`, `p₀` for the computed force), as an SVG.
+fn plot_pressure(path: &std::path::Path, run: &ContactRun) -> Result<(), Box<dyn std::error::Error>> {
+    use plotters::prelude::*;
+    let (a, p0) = (run.a_exact, run.p0_exact);
+    let xmax = 1.5 * a;
+    let root = SVGBackend::new(path, (800, 500)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("2D Hertz, cylinder on a rigid flat (level {})", run.level), ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(-xmax..xmax, 0.0..1.15 * p0)
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc("x / R")
+        .y_desc("contact pressure / E")
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let n = 400;
+    let curve = (0..=n).map(|i| {
+        let x = -xmax + 2.0 * xmax * i as f64 / n as f64;
+        (x, if x.abs() < a { p0 * (1.0 - (x / a).powi(2)).sqrt() } else { 0.0 })
+    });
+    chart
+        .draw_series(LineSeries::new(curve, &RED))
+        .map_err(|e| e.to_string())?
+        .label("Hertz: p0 sqrt(1 - x²/a²)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    chart
+        .draw_series(
+            run.profile
+                .iter()
+                .filter(|(x, _)| x.abs() <= xmax)
+                .map(|&(x, p)| Circle::new((x, p), 2, BLUE.filled())),
+        )
+        .map_err(|e| e.to_string())?
+        .label("computed nodal pressure")
+        .legend(|(x, y)| Circle::new((x + 10, y), 3, BLUE.filled()));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())?;
     Ok(())
 }

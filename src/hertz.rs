@@ -78,6 +78,9 @@ pub struct ContactRun {
     pub coulomb_excess: Real,
     /// Largest KKT residual of the solution (spec §5).
     pub kkt: Real,
+    /// The computed nodal pressure profile `(radial coordinate, Λ_n)` of the contact nodes,
+    /// in contact-node order (for plots against the Hertz curve).
+    pub profile: Vec<(Real, Real)>,
 }
 
 impl ContactRun {
@@ -351,6 +354,7 @@ fn hertz_run<const D: usize>(
         traction_l2_err: 0.0,
         coulomb_excess: 0.0,
         kkt: res.kkt.max(),
+        profile: pts,
     }
 }
 

@@ -70,6 +70,7 @@ pub mod contact {
 }
 pub mod builder;
 pub mod hertz;
+pub mod knee2d;
 pub mod output;
 pub mod solvers;
 pub mod verification;

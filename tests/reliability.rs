@@ -153,3 +153,72 @@ fn pdas_fallback_passes_input_errors_through() {
     let e = PdasFallback::default().solve(&owned.problem(), None);
     assert!(matches!(e, Err(ContactError::InvalidParameter(_))), "{e:?}");
 }
+
+/// Found by an exploratory property-test run with `PROPTEST_CASES=20000` (shrunk): a Tresca problem with an
+/// almost vanishing load (`|U| ≈ 4e-6`, `g_c = 0.16`, no contact). `uzawa-mprgp` stops on its
+/// absolute tangential residual (`≤ 1e-10` in `Λ_t`), which bounds the slip of the sticking
+/// cells only by `1e-10/ρ`; relative to the tiny displacement scale the KKT checker then sees
+/// a stick-slip residual of ≈ 5e-7 > 1e-7. Known limitation (docs/reliability.md); PDAS and
+/// `dual-mprgp` pass.
+#[test]
+#[ignore = "known limitation of uzawa-mprgp's stopping test on nearly unloaded problems"]
+fn uzawa_mprgp_kkt_on_a_nearly_unloaded_tresca_problem() {
+    let b = BlockOnFoundation {
+        n: 5,
+        push: 0.0,
+        shift: 6.109005055206135e-6,
+        curvature: 0.0,
+        slip_bound: Some(0.16009151907989216),
+        young: 0.5,
+        poisson: 0.0,
+        ..Default::default()
+    };
+    let owned = b.build::<2>().expect("problem");
+    let p = owned.problem();
+    for name in ["pdas", "dual-mprgp", "uzawa-mprgp"] {
+        let sol = by_name(name).expect("solver").solve(&p, None).expect("solve");
+        let kkt = check_kkt(&p, &sol.u, &sol.lambda_n, &sol.lambda_t);
+        println!("{name}: {kkt:?}");
+        assert!(kkt.satisfied(1e-7), "{name}: {kkt:?}");
+    }
+}
+
+/// Found by an exploratory property-test run (`PROPTEST_CASES=20000`, random seed; 1 case in
+/// 20 000):
+/// a 2D Tresca block on which plain PDAS cycles through four active sets (slip-reversal
+/// safeguard notwithstanding). The cycle is detected and `pdas-fallback` returns a KKT
+/// solution through `dual-mprgp`.
+#[test]
+fn pdas_cycles_on_a_random_tresca_block_and_the_fallback_recovers() {
+    let b = BlockOnFoundation {
+        n: 8,
+        push: 0.03766673799529499,
+        shift: 0.02203312580045642,
+        curvature: 0.04349773532142543,
+        slip_bound: Some(0.04516927543383259),
+        young: 2.100499261424239,
+        poisson: 0.4417346432702067,
+        jitter: 0.08220285046558384,
+        seed: 7992037326756013494,
+        gap_offset: 0.008440732165689854,
+    };
+    let owned = b.build::<2>().expect("problem");
+    let p = owned.problem();
+    let trace = Pdas::default().solve_traced(&p, None, false);
+    assert!(
+        matches!(trace.result, Err(ContactError::NoConvergence { iterations: 200, .. })),
+        "{:?}",
+        trace.result
+    );
+    assert_eq!(trace.cycle_period, Some(4));
+    let sol = PdasFallback::default().solve(&p, None).expect("fallback");
+    let kkt = check_kkt(&p, &sol.u, &sol.lambda_n, &sol.lambda_t);
+    println!("{:?}\n{kkt:?}", sol.report.fallback);
+    assert!(kkt.satisfied(1e-7), "{kkt:?}");
+    assert!(sol.report.cycling_detected && sol.report.fallback.is_some());
+    // the other solvers agree
+    let dual = by_name("uzawa-mprgp").expect("solver").solve(&p, None).expect("uzawa");
+    let scale = sol.u.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+    let du = sol.u.iter().zip(&dual.u).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs())) / scale;
+    assert!(du < 1e-6, "{du}");
+}

@@ -103,6 +103,16 @@
 //! [`ContactError::Singular`] when the dense interface system is singular (e.g. linearly
 //! dependent active constraints); [`ContactError::NoConvergence`] with the residual history
 //! after `max_iterations`.
+//!
+//! ## Failure modes
+//!
+//! Plain PDAS (Newton-min) can cycle: on interface problems whose `S` is not an M-matrix, and
+//! rarely on 2D Tresca problems despite the slip-reversal safeguard (≈ 1 random case in
+//! 20 000 of the property tests). [`Pdas::solve_traced`] detects recurring active-set
+//! configurations without residual decrease (cycling, window [`CYCLE_WINDOW`]) and stagnation,
+//! reports them in [`SolverReport::cycling_detected`]/[`SolverReport::stagnation_detected`]
+//! and returns the last iterate, so that a caller can hand over to a dual solver (the
+//! `pdas-fallback` solver of the `synovia` facade; `docs/reliability.md`).
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 

@@ -1,0 +1,201 @@
+//! # Sagittal tibiofemoral contact over the ISO 14243-1 gait cycle
+//!
+//! A plane-strain sagittal slice of one knee compartment ([`synovia::knee2d`]): a femoral
+//! condyle (bone arc, subchondral radius 20 mm, with a 2.5 mm cartilage layer) on a tibial
+//! plateau (bone block with a 2.5 mm cartilage layer), cartilage E = 10 MPa, ν = 0.45, bone
+//! E = 800 MPa, ν = 0.3; frictionless node-to-segment contact between the two (non-matching)
+//! cartilage surfaces. The femur is flexed by the ISO 14243-1:2009 flexion angle (rotation about
+//! the condyle centre) and pushed down until the contact resultant equals the ISO axial force
+//! divided by an effective condyle width of 30 mm. Both ISO curves are approximations digitised
+//! from the standard (`synovia::knee2d::ISO14243_*`). See `docs/knee2d.md`.
+//!
+//! Every step checks the load balance (contact resultant vs applied load, ≤ 0.5 %) and the KKT
+//! conditions of the contact solution, prints the peak cartilage pressure, and writes
+//! `OUT/knee2d.pvd` (+ one `.vtu` per step), `OUT/knee2d.csv` and
+//! `OUT/force_and_peak_pressure.svg`. Ends with one JSON line.
+//!
+//! Run: `cargo run --release --example knee2d [OUT_DIR] [STEPS]` (defaults `out/knee2d`, 40).
+
+use std::fmt::Write as _;
+use std::time::Instant;
+
+use plotters::prelude::*;
+use synovia::io::{Encoding, TimeSeriesWriter};
+use synovia::knee2d::{cycle_times, hertz_estimate, Knee2d, KneeError, KneeStep};
+
+fn main() -> Result<(), KneeError> {
+    let out = std::env::args().nth(1).unwrap_or_else(|| "out/knee2d".to_string());
+    let n: usize = std::env::args().nth(2).map(|s| s.parse()).transpose()?.unwrap_or(40);
+    std::fs::create_dir_all(&out)?;
+    let start = Instant::now();
+    let knee = Knee2d::default();
+    let solver = synovia::solvers::by_name("pdas")?;
+    let times = cycle_times(n);
+    let mut series = TimeSeriesWriter::new(&out, "knee2d", Encoding::Base64)?;
+    let mut dofs = 0;
+    println!(
+        "| step | cycle % | flexion ° | F (N) | P (N/mm) | contact (N/mm) | balance err | peak p (MPa) | contact length (mm) | δ (mm) | solves | KKT | s |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let mut i = 0;
+    let steps = knee.run(&times, solver.as_ref(), |pose| {
+        let s = &pose.step;
+        dofs = pose.contact.elastic().info().n_dofs;
+        println!(
+            "| {i} | {:.1} | {:.1} | {:.0} | {:.2} | {:.4} | {:.1e} | {:.3} | {:.2} | {:.4} | {} | {:.1e} | {:.2} |",
+            100.0 * s.time,
+            s.flexion_deg,
+            s.load_n,
+            s.load_per_mm,
+            s.contact_force_per_mm,
+            s.balance_error,
+            s.peak_pressure,
+            s.contact_length,
+            s.approach,
+            s.solves,
+            s.kkt,
+            s.seconds
+        );
+        if s.balance_error > 5e-3 {
+            return Err(format!("step {i}: load balance error {:.2e} > 0.5 %", s.balance_error).into());
+        }
+        if !pose.result.kkt.satisfied(1e-8) {
+            return Err(format!("step {i}: KKT violated: {:?}", pose.result.kkt).into());
+        }
+        let vtu = synovia::output::contact_vtu(&pose.model, pose.contact.geometry(), &pose.result, Encoding::Base64)?;
+        series.write_step(s.time, &vtu)?;
+        i += 1;
+        Ok(())
+    })?;
+
+    let csv = std::path::Path::new(&out).join("knee2d.csv");
+    std::fs::write(&csv, csv_text(&steps))?;
+    let svg = std::path::Path::new(&out).join("force_and_peak_pressure.svg");
+    plot(&svg, &steps, knee.width)?;
+
+    let max_err = steps.iter().map(|s| s.balance_error).fold(0.0, f64::max);
+    let peak = steps.iter().max_by(|a, b| a.peak_pressure.total_cmp(&b.peak_pressure)).ok_or("no steps")?;
+    let min_peak = steps.iter().map(|s| s.peak_pressure).fold(f64::INFINITY, f64::min);
+    let max_kkt = steps.iter().map(|s| s.kkt).fold(0.0, f64::max);
+    let (a_h, p0_h) = hertz_estimate(
+        2600.0 / knee.width,
+        knee.condyle_bone_radius + knee.femur_cartilage,
+        knee.cartilage.0,
+        knee.cartilage.1,
+    );
+    println!(
+        "peak cartilage pressure over the cycle {:.3} MPa at {:.1} % (flexion {:.1}°, F = {:.0} N); swing minimum {:.3} MPa",
+        peak.peak_pressure,
+        100.0 * peak.time,
+        peak.flexion_deg,
+        peak.load_n,
+        min_peak
+    );
+    println!(
+        "half-space Hertz estimate at 2600 N (both cartilages, no bone): a = {a_h:.2} mm, p0 = {p0_h:.3} MPa"
+    );
+    println!(
+        "wrote {}, {} ({} steps) and {}",
+        csv.display(),
+        series.pvd_path().display(),
+        steps.len(),
+        svg.display()
+    );
+    println!("open the .pvd in ParaView: colour by contact_pressure, Warp By Vector on displacement, play the time steps");
+    let total = start.elapsed().as_secs_f64();
+    println!(
+        "{{\"problem\":\"knee2d\",\"dofs\":{dofs},\"steps\":{},\"solves\":{},\"max_load_balance_error\":{max_err:.3e},\"max_peak_pressure_mpa\":{:.4},\"max_peak_time\":{:.4},\"min_peak_pressure_mpa\":{min_peak:.4},\"max_kkt\":{max_kkt:.2e},\"width_mm\":{},\"total_s\":{total:.3}}}",
+        steps.len(),
+        steps.iter().map(|s| s.solves).sum::<usize>(),
+        peak.peak_pressure,
+        peak.time,
+        knee.width
+    );
+    Ok(())
+}
+
+fn csv_text(steps: &[KneeStep]) -> String {
+    let mut s = String::from(
+        "time,flexion_deg,load_n,load_n_per_mm,contact_force_n_per_mm,contact_shear_n_per_mm,balance_error,peak_pressure_mpa,peak_x_mm,contact_length_mm,approach_mm,solves,solver_iterations,kkt,seconds\n",
+    );
+    for r in steps {
+        let _ = writeln!(
+            s,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.time,
+            r.flexion_deg,
+            r.load_n,
+            r.load_per_mm,
+            r.contact_force_per_mm,
+            r.contact_shear_per_mm,
+            r.balance_error,
+            r.peak_pressure,
+            r.peak_x,
+            r.contact_length,
+            r.approach,
+            r.solves,
+            r.solver_iterations,
+            r.kkt,
+            r.seconds
+        );
+    }
+    s
+}
+
+/// Applied and computed contact force (N, i.e. per-mm values × width) and peak pressure (MPa,
+/// right axis) over the cycle.
+fn plot(path: &std::path::Path, steps: &[KneeStep], width: f64) -> Result<(), KneeError> {
+    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let f_max = steps.iter().map(|s| s.load_n).fold(0.0, f64::max) * 1.1;
+    let p_max = steps.iter().map(|s| s.peak_pressure).fold(0.0, f64::max) * 1.1;
+    let mut chart = ChartBuilder::on(&root)
+        .caption("knee2d: ISO 14243-1 gait cycle", ("sans-serif", 22))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .right_y_label_area_size(60)
+        .build_cartesian_2d(0.0..100.0, 0.0..f_max)
+        .map_err(|e| e.to_string())?
+        .set_secondary_coord(0.0..100.0, 0.0..p_max);
+    chart
+        .configure_mesh()
+        .x_desc("gait cycle (%)")
+        .y_desc("axial force (N)")
+        .draw()
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_secondary_axes()
+        .y_desc("peak contact pressure (MPa)")
+        .draw()
+        .map_err(|e| e.to_string())?;
+    let table = synovia::knee2d::ISO14243_AXIAL_FORCE;
+    chart
+        .draw_series(LineSeries::new(table.iter().copied(), &BLUE))
+        .map_err(|e| e.to_string())?
+        .label("ISO 14243-1 axial force (applied)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
+    chart
+        .draw_series(
+            steps
+                .iter()
+                .map(|s| Circle::new((100.0 * s.time, s.contact_force_per_mm * width), 3, BLACK.filled())),
+        )
+        .map_err(|e| e.to_string())?
+        .label("computed contact force × width")
+        .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.filled()));
+    chart
+        .draw_secondary_series(LineSeries::new(steps.iter().map(|s| (100.0 * s.time, s.peak_pressure)), &RED))
+        .map_err(|e| e.to_string())?
+        .label("peak cartilage pressure (right axis)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())?;
+    Ok(())
+}

@@ -1,0 +1,439 @@
+//! A sagittal-plane (plane-strain) tibiofemoral contact model driven through the ISO 14243-1
+//! gait cycle (the `knee2d` example, `docs/knee2d.md`).
+//!
+//! # Model
+//!
+//! Axes: `x` anterior, `y` proximal; lengths in mm, forces in N, stresses in MPa.
+//!
+//! * **Femur**: a circular condyle, bone (`radii[0] ≤ r ≤ R_b`) with a bonded cartilage layer
+//!   (`R_b ≤ r ≤ R_b + t_f`), meshed by [`layered_arc_2d`] (matching nodes on the interface,
+//!   tied). The inner bone arc is driven by a prescribed rigid translation.
+//! * **Tibia**: a bone block (`60 × 20 mm`) with a bonded cartilage layer of thickness `t_t` on
+//!   top, both meshed by [`rectangle`] refined toward `x = 0`; the base is clamped.
+//! * **Contact**: the two cartilage surfaces, non-matching, node-to-segment
+//!   ([`ContactPair::node_to_segment`]): slave nodes on the (flat) tibial cartilage, master
+//!   segments on the femoral cartilage. Frictionless (synovial joints have μ ≈ 0.01–0.02, which
+//!   changes the normal load transfer by a similar relative amount).
+//!
+//! # Kinematics per pose
+//!
+//! The flexion angle `θ(t)` is a rotation of the femur about the condyle centre
+//! ([`RigidMotion`], a rotation). Since linear (small-strain) elasticity cannot carry a 58°
+//! rigid rotation as a displacement (the linearised strain of a rotation is `cos θ − 1`, 47 % at
+//! 58°), each pose is a separate small-deformation problem: the femur mesh is placed in the
+//! pose `R(θ(t))(x − c) + c` and the elastic deformation is measured from there. For a
+//! frictionless contact the solution of a pose does not depend on the path, so no state is
+//! carried between steps. With flexion the contact moves over the femoral cartilage (toward the
+//! posterior condyle), i.e. over different elements of the femur mesh.
+//!
+//! # Load control
+//!
+//! The ISO axial force `F(t)` (N) is applied per unit slice thickness, `P(t) = F(t) / w` with
+//! the effective condyle width `w` ([`Knee2d::width`], 30 mm). The vertical translation `δ` of
+//! the femur's driven arc that makes the contact resultant equal `P(t)` is found per step by a
+//! secant iteration on `δ` (one factorisation per pose, one contact solve per iterate, warm
+//! started), to the relative tolerance [`Knee2d::tolerance`].
+
+use std::error::Error;
+use std::f64::consts::PI;
+use std::sync::Arc;
+use std::time::Instant;
+
+use synovia_contact::operators::{ContactGeometry, ContactPair};
+use synovia_contact::{ContactSolver, StaticContact, StaticContactResult};
+use synovia_fem::{ElasticParams, Model};
+use synovia_material::plane_strain;
+use synovia_mesh::generators::{layered_arc_2d, rectangle, Grading};
+use synovia_mesh::math::{Point, Real, Vector};
+use synovia_mesh::BoundaryKind;
+use synovia_time::history::{LoadHistory, PiecewiseLinear, RigidMotion};
+
+/// Errors of the knee model (mesh, model, contact and iteration failures).
+pub type KneeError = Box<dyn Error + Send + Sync>;
+
+/// ISO 14243-1:2009 axial force (N) over the gait cycle (% of cycle), **an approximation**
+/// digitised from the load curve of the standard (load-controlled knee wear simulator):
+/// two peaks of 2600 N at ≈ 13 % and ≈ 50 %, a swing-phase minimum of ≈ 168 N.
+pub const ISO14243_AXIAL_FORCE: &[(Real, Real)] = &[
+    (0.0, 168.0),
+    (3.0, 500.0),
+    (6.0, 1150.0),
+    (9.0, 1900.0),
+    (11.0, 2400.0),
+    (13.0, 2600.0),
+    (15.0, 2450.0),
+    (18.0, 2000.0),
+    (22.0, 1550.0),
+    (27.0, 1250.0),
+    (32.0, 1150.0),
+    (37.0, 1300.0),
+    (42.0, 1750.0),
+    (46.0, 2250.0),
+    (50.0, 2600.0),
+    (53.0, 2250.0),
+    (56.0, 1500.0),
+    (59.0, 750.0),
+    (62.0, 300.0),
+    (65.0, 168.0),
+    (80.0, 168.0),
+    (100.0, 168.0),
+];
+
+/// ISO 14243-1:2009 flexion angle (degrees) over the gait cycle (% of cycle), **an
+/// approximation** digitised from the standard's curve: stance flexion of ≈ 20° near 15 %,
+/// near extension at ≈ 40 %, the swing-phase maximum of 58° near 72 %, back to 0° at 100 %.
+pub const ISO14243_FLEXION_DEG: &[(Real, Real)] = &[
+    (0.0, 0.0),
+    (4.0, 7.0),
+    (8.0, 14.0),
+    (12.0, 18.5),
+    (16.0, 20.0),
+    (20.0, 18.0),
+    (26.0, 12.0),
+    (32.0, 7.0),
+    (38.0, 4.5),
+    (44.0, 6.0),
+    (50.0, 11.0),
+    (55.0, 20.0),
+    (60.0, 34.0),
+    (65.0, 48.0),
+    (70.0, 56.5),
+    (73.0, 58.0),
+    (77.0, 56.0),
+    (82.0, 47.0),
+    (87.0, 33.0),
+    (92.0, 17.0),
+    (96.0, 6.0),
+    (100.0, 0.0),
+];
+
+/// The ISO 14243-1 axial force `F(t)` in N, `t` the fraction of the cycle (`0 ≤ t ≤ 1`).
+///
+/// # Errors
+/// Never for the built-in table (kept fallible as [`PiecewiseLinear::new`]).
+pub fn iso14243_axial_force() -> Result<PiecewiseLinear, KneeError> {
+    let pts: Vec<(Real, Real)> = ISO14243_AXIAL_FORCE.iter().map(|&(p, f)| (p / 100.0, f)).collect();
+    Ok(PiecewiseLinear::new(&pts)?)
+}
+
+/// The ISO 14243-1 flexion angle `θ(t)` in radians, `t` the fraction of the cycle.
+///
+/// # Errors
+/// Never for the built-in table.
+pub fn iso14243_flexion() -> Result<PiecewiseLinear, KneeError> {
+    let pts: Vec<(Real, Real)> =
+        ISO14243_FLEXION_DEG.iter().map(|&(p, a)| (p / 100.0, a.to_radians())).collect();
+    Ok(PiecewiseLinear::new(&pts)?)
+}
+
+/// Parameters of the sagittal knee model (see the [module documentation](self)).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Knee2d {
+    /// Inner radius of the femoral bone arc (the driven boundary), mm.
+    pub femur_inner_radius: Real,
+    /// Radius of the subchondral bone surface of the condyle, mm.
+    pub condyle_bone_radius: Real,
+    /// Femoral cartilage thickness, mm.
+    pub femur_cartilage: Real,
+    /// Tibial cartilage thickness, mm.
+    pub tibia_cartilage: Real,
+    /// Half the anteroposterior length of the tibial block, mm.
+    pub tibia_half_length: Real,
+    /// Depth of the tibial bone block below the cartilage, mm.
+    pub tibia_depth: Real,
+    /// Cartilage Young's modulus (MPa) and Poisson ratio.
+    pub cartilage: (Real, Real),
+    /// Bone Young's modulus (MPa) and Poisson ratio.
+    pub bone: (Real, Real),
+    /// Effective condyle width `w` (mm): the load per unit slice thickness is `F / w`.
+    pub width: Real,
+    /// Femur mesh: cells along the arc, across the bone, across the cartilage.
+    pub femur_cells: (usize, usize, usize),
+    /// Tibia mesh: cells along x, across the bone, across the cartilage.
+    pub tibia_cells: (usize, usize, usize),
+    /// Relative tolerance of the load balance `|P_contact − P| / P` of the secant iteration.
+    pub tolerance: Real,
+    /// Node-to-segment search distance (mm).
+    pub search_distance: Real,
+}
+
+impl Default for Knee2d {
+    fn default() -> Self {
+        Self {
+            femur_inner_radius: 10.0,
+            condyle_bone_radius: 20.0,
+            femur_cartilage: 2.5,
+            tibia_cartilage: 2.5,
+            tibia_half_length: 30.0,
+            tibia_depth: 20.0,
+            cartilage: (10.0, 0.45),
+            bone: (800.0, 0.3),
+            width: 30.0,
+            femur_cells: (200, 10, 5),
+            tibia_cells: (180, 24, 5),
+            tolerance: 1e-4,
+            search_distance: 4.0,
+        }
+    }
+}
+
+/// The figures of one pose of the cycle.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KneeStep {
+    /// Cycle fraction `t`.
+    pub time: Real,
+    /// Flexion angle, degrees.
+    pub flexion_deg: Real,
+    /// ISO axial force `F(t)`, N.
+    pub load_n: Real,
+    /// Applied load per unit thickness `P = F / w`, N/mm.
+    pub load_per_mm: Real,
+    /// Vertical resultant of the contact tractions, `|Σ_r κ_r Λ_n,r n_r · e_y|`, N/mm.
+    pub contact_force_per_mm: Real,
+    /// Horizontal resultant of the contact tractions, N/mm (≈ 0 for the flat plateau).
+    pub contact_shear_per_mm: Real,
+    /// `|contact_force − P| / P`.
+    pub balance_error: Real,
+    /// Largest nodal contact pressure `max Λ_n`, MPa.
+    pub peak_pressure: Real,
+    /// Extent of the active contact nodes along x, mm.
+    pub contact_length: Real,
+    /// x of the pressure peak on the tibial plateau, mm.
+    pub peak_x: Real,
+    /// Vertical approach `δ` of the femur's driven arc, mm.
+    pub approach: Real,
+    /// Contact solves of the secant iteration.
+    pub solves: usize,
+    /// Contact solver iterations, summed over the solves.
+    pub solver_iterations: usize,
+    /// Largest KKT residual of the accepted solution.
+    pub kkt: Real,
+    /// Wall time of the pose (model, factorisation, solves), s.
+    pub seconds: Real,
+}
+
+/// One solved pose: the figures, the model in that pose, its contact problem and the solution.
+#[derive(Debug)]
+pub struct KneePose {
+    /// Figures of the pose.
+    pub step: KneeStep,
+    /// The model (femur mesh in the pose).
+    pub model: Model<2>,
+    /// The contact problem (factorisation, geometry).
+    pub contact: StaticContact<2>,
+    /// The accepted contact solution.
+    pub result: StaticContactResult<2>,
+}
+
+impl Knee2d {
+    /// A coarse mesh for tests (≈ 3 000 dofs).
+    pub fn coarse() -> Self {
+        Self { femur_cells: (100, 5, 3), tibia_cells: (90, 10, 3), ..Self::default() }
+    }
+
+    /// The condyle centre in the reference (touching) position: the femoral cartilage touches
+    /// the tibial cartilage surface `y = 0` at `x = 0`.
+    pub fn condyle_centre(&self) -> Point<2> {
+        Point::<2>::new(0.0, self.condyle_bone_radius + self.femur_cartilage)
+    }
+
+    /// The flexion as a rigid motion of the femur: rotation by `θ(t)` about the condyle centre.
+    ///
+    /// # Errors
+    /// Never for the built-in table.
+    pub fn flexion_motion(&self) -> Result<RigidMotion<2>, KneeError> {
+        Ok(RigidMotion::<2>::rotation(self.condyle_centre(), iso14243_flexion()?))
+    }
+
+    /// The model in the pose of cycle fraction `time`: bodies 0 `femur_bone`, 1
+    /// `femur_cartilage`, 2 `tibia_bone`, 3 `tibia_cartilage`; the femur's inner arc moves down
+    /// by the model time `δ` (the "time" argument of the solves is the approach `δ`).
+    ///
+    /// # Errors
+    /// Mesh, material or model errors.
+    pub fn model(&self, time: Real) -> Result<(Model<2>, Vec<ContactPair<2>>), KneeError> {
+        let c = self.condyle_centre();
+        let (na, nb, nc) = self.femur_cells;
+        // body-frame arc: the contact point of flexion θ is at the body angle −90° − θ
+        let range = ((-170.0_f64).to_radians(), (-60.0_f64).to_radians());
+        let radii = [
+            self.femur_inner_radius,
+            self.condyle_bone_radius,
+            self.condyle_bone_radius + self.femur_cartilage,
+        ];
+        let mut layers = layered_arc_2d(c, &radii, range, na, &[nb, nc])?;
+        let motion = self.flexion_motion()?;
+        for m in &mut layers {
+            m.map_nodes(|x| motion.position(x, time))?;
+        }
+        let mut f_cart = layers.pop().ok_or("layered_arc_2d returned no layers")?;
+        let mut f_bone = layers.pop().ok_or("layered_arc_2d returned one layer")?;
+        f_bone.set_part_kind("inner", BoundaryKind::Prescribed)?;
+        f_cart.set_part_kind("outer", BoundaryKind::Contact)?;
+
+        let (nx, nyb, nyc) = self.tibia_cells;
+        let l = self.tibia_half_length;
+        let gx = Grading::Refined { center: 0.0, width: 24.0, ratio: 4.0 };
+        let tc = self.tibia_cartilage;
+        let mut t_bone =
+            rectangle(-l, l, -tc - self.tibia_depth, -tc, nx, nyb, gx, Grading::TowardHigh { ratio: 1.08 })?;
+        let mut t_cart = rectangle(-l, l, -tc, 0.0, nx, nyc, gx, Grading::Uniform)?;
+        t_bone.set_part_kind("bottom", BoundaryKind::Clamped)?;
+        t_cart.set_part_kind("top", BoundaryKind::Contact)?;
+
+        let cart = Arc::new(plane_strain(self.cartilage.0, self.cartilage.1)?);
+        let bone = Arc::new(plane_strain(self.bone.0, self.bone.1)?);
+        let mut model = Model::<2>::new();
+        let fb = model.add_body("femur_bone", f_bone, bone.clone())?;
+        let fc = model.add_body("femur_cartilage", f_cart, cart.clone())?;
+        let tb = model.add_body("tibia_bone", t_bone, bone)?;
+        let tcb = model.add_body("tibia_cartilage", t_cart, cart)?;
+        model.tie(fb, "outer", fc, "inner")?;
+        model.tie(tb, "top", tcb, "bottom")?;
+        model.prescribe(fb, "inner", |_, d| Vector::<2>::new(0.0, -d))?;
+        let pair = ContactPair::node_to_segment("tibia-femur", tcb, "top", fc, "outer")
+            .with_search_distance(self.search_distance);
+        Ok((model, vec![pair]))
+    }
+
+    /// Solves the pose of cycle fraction `time` under the ISO load: secant iteration on the
+    /// approach `δ` (starting from `guess`, e.g. the previous pose's) until the contact
+    /// resultant equals `F(t) / w` within [`Knee2d::tolerance`].
+    ///
+    /// # Errors
+    /// Model or contact failures, or no convergence of the secant iteration in 40 solves.
+    pub fn solve_pose(
+        &self,
+        time: Real,
+        solver: &dyn ContactSolver,
+        guess: Option<Real>,
+    ) -> Result<KneePose, KneeError> {
+        let start = Instant::now();
+        let load_n = iso14243_axial_force()?.value(time);
+        let target = load_n / self.width;
+        let (model, pairs) = self.model(time)?;
+        let contact = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+        let mut solves = 0;
+        let mut its = 0;
+        let mut solve = |d: Real,
+                         warm: Option<&StaticContactResult<2>>|
+         -> Result<(Real, StaticContactResult<2>), KneeError> {
+            let res = contact.solve(&model, d, solver, None, None, warm.map(|w| &w.solution))?;
+            solves += 1;
+            its += res.solution.report.iterations + res.coarse_iterations;
+            let f = resultant(contact.geometry(), &res)[1].abs();
+            Ok((f, res))
+        };
+        // bracket from below: a positive force
+        let mut d0 = guess.filter(|g| *g > 0.0).unwrap_or(0.05);
+        let (mut f0, mut r0) = solve(d0, None)?;
+        while f0 <= 0.0 {
+            d0 *= 2.0;
+            (f0, r0) = solve(d0, Some(&r0))?;
+            if d0 > 10.0 {
+                return Err(format!("t = {time}: no contact up to an approach of {d0} mm").into());
+            }
+        }
+        // contact force ~ δ^(3/2) for a thin layer, roughly: first step by that power law
+        let mut d1 = d0 * (target / f0).powf(2.0 / 3.0).clamp(0.3, 3.0);
+        let (mut f1, mut r1) = solve(d1, Some(&r0))?;
+        let mut iter = 0;
+        while (f1 - target).abs() > self.tolerance * target {
+            iter += 1;
+            if iter > 40 {
+                return Err(format!("t = {time}: load balance not reached: {f1} vs {target} N/mm").into());
+            }
+            let slope = (f1 - f0) / (d1 - d0);
+            let mut d2 = if slope > 0.0 && slope.is_finite() { d1 + (target - f1) / slope } else { 1.5 * d1 };
+            if d2 <= 0.0 {
+                d2 = 0.5 * d1;
+            }
+            let (f2, r2) = solve(d2, Some(&r1))?;
+            (d0, f0, r0) = (d1, f1, r1);
+            (d1, f1, r1) = (d2, f2, r2);
+        }
+        drop(r0);
+        let geo = contact.geometry();
+        let force = resultant(geo, &r1);
+        let active: Vec<usize> = (0..geo.len()).filter(|&r| r1.solution.lambda_n[r] > 0.0).collect();
+        let xs = active.iter().map(|&r| geo.nodes[r].position[0]);
+        let contact_length =
+            xs.clone().fold(Real::NEG_INFINITY, Real::max) - xs.fold(Real::INFINITY, Real::min);
+        let (peak_r, peak) = r1
+            .solution
+            .lambda_n
+            .iter()
+            .copied()
+            .enumerate()
+            .fold((0, 0.0), |(ri, m), (r, l)| if l > m { (r, l) } else { (ri, m) });
+        let step = KneeStep {
+            time,
+            flexion_deg: iso14243_flexion()?.value(time).to_degrees(),
+            load_n,
+            load_per_mm: target,
+            contact_force_per_mm: force[1].abs(),
+            contact_shear_per_mm: force[0],
+            balance_error: (force[1].abs() - target).abs() / target,
+            peak_pressure: peak,
+            contact_length,
+            peak_x: geo.nodes.get(peak_r).map_or(0.0, |n| n.position[0]),
+            approach: d1,
+            solves,
+            solver_iterations: its,
+            kkt: r1.kkt.max(),
+            seconds: start.elapsed().as_secs_f64(),
+        };
+        Ok(KneePose { step, model, contact, result: r1 })
+    }
+
+    /// Solves the poses `times` in order (each started from the previous approach), calling
+    /// `each` after every pose.
+    ///
+    /// # Errors
+    /// From [`Knee2d::solve_pose`] or `each`.
+    pub fn run(
+        &self,
+        times: &[Real],
+        solver: &dyn ContactSolver,
+        mut each: impl FnMut(&KneePose) -> Result<(), KneeError>,
+    ) -> Result<Vec<KneeStep>, KneeError> {
+        let mut guess = None;
+        let mut steps = Vec::with_capacity(times.len());
+        for &t in times {
+            let pose = self.solve_pose(t, solver, guess)?;
+            guess = Some(pose.step.approach);
+            each(&pose)?;
+            steps.push(pose.step);
+        }
+        Ok(steps)
+    }
+}
+
+/// The resultant `Σ_r κ_r Λ_n,r n_r` of the contact tractions on the slave side (N/mm).
+pub fn resultant(geometry: &ContactGeometry<2>, result: &StaticContactResult<2>) -> Vector<2> {
+    geometry
+        .nodes
+        .iter()
+        .zip(&result.solution.lambda_n)
+        .fold(Vector::<2>::zeros(), |acc, (n, &l)| acc + n.normal * (n.weight * l))
+}
+
+/// The cycle fractions of `n` uniform steps over one cycle, `i / n` for `i = 0, …, n − 1`, with
+/// the first load peak (13 %) added.
+pub fn cycle_times(n: usize) -> Vec<Real> {
+    let mut t: Vec<Real> = (0..n).map(|i| i as Real / n as Real).collect();
+    if !t.iter().any(|&x| (x - 0.13).abs() < 1e-9) {
+        t.push(0.13);
+        t.sort_by(Real::total_cmp);
+    }
+    t
+}
+
+/// Half-space Hertz estimate `(a, p₀)` of a cylinder of radius `r` pressed with `p` (N/mm) on a
+/// flat, both sides of modulus `e`, ratio `nu`: `E* = E / (2 (1 − ν²))`, `a = √(4 P R / (π E*))`,
+/// `p₀ = 2 P / (π a)`.
+pub fn hertz_estimate(p: Real, r: Real, e: Real, nu: Real) -> (Real, Real) {
+    let e_star = e / (2.0 * (1.0 - nu * nu));
+    let a = (4.0 * p * r / (PI * e_star)).sqrt();
+    (a, 2.0 * p / (PI * a))
+}
