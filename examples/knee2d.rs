@@ -16,12 +16,12 @@
 //!
 //! Run: `cargo run --release --example knee2d [OUT_DIR] [STEPS]` (defaults `out/knee2d`, 40).
 
-use std::fmt::Write as _;
 use std::time::Instant;
 
-use plotters::prelude::*;
+mod knee_common;
 use synovia::io::{Encoding, TimeSeriesWriter};
-use synovia::knee2d::{cycle_times, hertz_estimate, Knee2d, KneeError, KneeStep};
+use knee_common::{csv_text, plot};
+use synovia::knee2d::{cycle_times, hertz_estimate, Knee2d, KneeError};
 
 fn main() -> Result<(), KneeError> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "out/knee2d".to_string());
@@ -71,7 +71,7 @@ fn main() -> Result<(), KneeError> {
     let csv = std::path::Path::new(&out).join("knee2d.csv");
     std::fs::write(&csv, csv_text(&steps))?;
     let svg = std::path::Path::new(&out).join("force_and_peak_pressure.svg");
-    plot(&svg, &steps, knee.width)?;
+    plot(&svg, &steps, knee.width, "knee2d: ISO 14243-1 gait cycle", "peak cartilage pressure (right axis)")?;
 
     let max_err = steps.iter().map(|s| s.balance_error).fold(0.0, f64::max);
     let peak = steps.iter().max_by(|a, b| a.peak_pressure.total_cmp(&b.peak_pressure)).ok_or("no steps")?;
@@ -111,91 +111,5 @@ fn main() -> Result<(), KneeError> {
         peak.time,
         knee.width
     );
-    Ok(())
-}
-
-fn csv_text(steps: &[KneeStep]) -> String {
-    let mut s = String::from(
-        "time,flexion_deg,load_n,load_n_per_mm,contact_force_n_per_mm,contact_shear_n_per_mm,balance_error,peak_pressure_mpa,peak_x_mm,contact_length_mm,approach_mm,solves,solver_iterations,kkt,seconds\n",
-    );
-    for r in steps {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            r.time,
-            r.flexion_deg,
-            r.load_n,
-            r.load_per_mm,
-            r.contact_force_per_mm,
-            r.contact_shear_per_mm,
-            r.balance_error,
-            r.peak_pressure,
-            r.peak_x,
-            r.contact_length,
-            r.approach,
-            r.solves,
-            r.solver_iterations,
-            r.kkt,
-            r.seconds
-        );
-    }
-    s
-}
-
-/// Applied and computed contact force (N, i.e. per-mm values × width) and peak pressure (MPa,
-/// right axis) over the cycle.
-fn plot(path: &std::path::Path, steps: &[KneeStep], width: f64) -> Result<(), KneeError> {
-    let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let f_max = steps.iter().map(|s| s.load_n).fold(0.0, f64::max) * 1.1;
-    let p_max = steps.iter().map(|s| s.peak_pressure).fold(0.0, f64::max) * 1.1;
-    let mut chart = ChartBuilder::on(&root)
-        .caption("knee2d: ISO 14243-1 gait cycle", ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .right_y_label_area_size(60)
-        .build_cartesian_2d(0.0..100.0, 0.0..f_max)
-        .map_err(|e| e.to_string())?
-        .set_secondary_coord(0.0..100.0, 0.0..p_max);
-    chart
-        .configure_mesh()
-        .x_desc("gait cycle (%)")
-        .y_desc("axial force (N)")
-        .draw()
-        .map_err(|e| e.to_string())?;
-    chart
-        .configure_secondary_axes()
-        .y_desc("peak contact pressure (MPa)")
-        .draw()
-        .map_err(|e| e.to_string())?;
-    let table = synovia::knee2d::ISO14243_AXIAL_FORCE;
-    chart
-        .draw_series(LineSeries::new(table.iter().copied(), &BLUE))
-        .map_err(|e| e.to_string())?
-        .label("ISO 14243-1 axial force (applied)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLUE));
-    chart
-        .draw_series(
-            steps
-                .iter()
-                .map(|s| Circle::new((100.0 * s.time, s.contact_force_per_mm * width), 3, BLACK.filled())),
-        )
-        .map_err(|e| e.to_string())?
-        .label("computed contact force × width")
-        .legend(|(x, y)| Circle::new((x + 10, y), 3, BLACK.filled()));
-    chart
-        .draw_secondary_series(LineSeries::new(steps.iter().map(|s| (100.0 * s.time, s.peak_pressure)), &RED))
-        .map_err(|e| e.to_string())?
-        .label("peak cartilage pressure (right axis)")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(|e| e.to_string())?;
-    root.present().map_err(|e| e.to_string())?;
     Ok(())
 }

@@ -155,6 +155,19 @@ pub struct Knee2d {
     pub tolerance: Real,
     /// Node-to-segment search distance (mm).
     pub search_distance: Real,
+    /// Material (E in MPa, ν) of the femoral layer when it is not cartilage (e.g. the CoCr
+    /// femoral component of a knee replacement, [`Knee2d::tkr`]); `None`: [`Knee2d::cartilage`].
+    pub femur_layer_material: Option<(Real, Real)>,
+    /// Material of the tibial layer when it is not cartilage (e.g. a UHMWPE insert); `None`:
+    /// [`Knee2d::cartilage`].
+    pub tibia_layer_material: Option<(Real, Real)>,
+    /// Material of the tibial block when it is not bone (e.g. a metal tray); `None`:
+    /// [`Knee2d::bone`].
+    pub tibia_base_material: Option<(Real, Real)>,
+    /// Width (mm) of the region around `x = 0` toward which the tibial mesh is refined (ratio 4).
+    pub tibia_refinement_width: Real,
+    /// Body names: femoral bone, femoral layer, tibial block, tibial layer (VTU piece names).
+    pub body_names: [&'static str; 4],
 }
 
 impl Default for Knee2d {
@@ -173,6 +186,11 @@ impl Default for Knee2d {
             tibia_cells: (180, 24, 5),
             tolerance: 1e-4,
             search_distance: 4.0,
+            femur_layer_material: None,
+            tibia_layer_material: None,
+            tibia_base_material: None,
+            tibia_refinement_width: 24.0,
+            body_names: ["femur_bone", "femur_cartilage", "tibia_bone", "tibia_cartilage"],
         }
     }
 }
@@ -231,6 +249,33 @@ impl Knee2d {
         Self { femur_cells: (100, 5, 3), tibia_cells: (90, 10, 3), ..Self::default() }
     }
 
+    /// A total knee replacement (the `tkr2d` example, `docs/knee2d.md`): a 4 mm CoCr femoral
+    /// component (E = 210 GPa, ν = 0.3) on the femoral bone arc (outer radius 24 mm), on a 9 mm
+    /// UHMWPE insert (E = 700 MPa, ν = 0.46) on a metal (Ti-6Al-4V, E = 110 GPa, ν = 0.3) tray
+    /// block; the tibial mesh is refined toward the narrower contact of the stiff materials.
+    pub fn tkr() -> Self {
+        Self {
+            condyle_bone_radius: 20.0,
+            femur_cartilage: 4.0,
+            tibia_cartilage: 9.0,
+            tibia_depth: 10.0,
+            femur_layer_material: Some((210_000.0, 0.3)),
+            tibia_layer_material: Some((700.0, 0.46)),
+            tibia_base_material: Some((110_000.0, 0.3)),
+            femur_cells: (320, 8, 4),
+            tibia_cells: (200, 6, 18),
+            tibia_refinement_width: 8.0,
+            search_distance: 2.0,
+            body_names: ["femur_bone", "femoral_component", "tibial_tray", "tibial_insert"],
+            ..Self::default()
+        }
+    }
+
+    /// A coarse [`Knee2d::tkr`] mesh for tests.
+    pub fn tkr_coarse() -> Self {
+        Self { femur_cells: (160, 4, 2), tibia_cells: (100, 3, 9), ..Self::tkr() }
+    }
+
     /// The condyle centre in the reference (touching) position: the femoral cartilage touches
     /// the tibial cartilage surface `y = 0` at `x = 0`.
     pub fn condyle_centre(&self) -> Point<2> {
@@ -273,7 +318,7 @@ impl Knee2d {
 
         let (nx, nyb, nyc) = self.tibia_cells;
         let l = self.tibia_half_length;
-        let gx = Grading::Refined { center: 0.0, width: 24.0, ratio: 4.0 };
+        let gx = Grading::Refined { center: 0.0, width: self.tibia_refinement_width, ratio: 4.0 };
         let tc = self.tibia_cartilage;
         let mut t_bone =
             rectangle(-l, l, -tc - self.tibia_depth, -tc, nx, nyb, gx, Grading::TowardHigh { ratio: 1.08 })?;
@@ -281,13 +326,16 @@ impl Knee2d {
         t_bone.set_part_kind("bottom", BoundaryKind::Clamped)?;
         t_cart.set_part_kind("top", BoundaryKind::Contact)?;
 
-        let cart = Arc::new(plane_strain(self.cartilage.0, self.cartilage.1)?);
-        let bone = Arc::new(plane_strain(self.bone.0, self.bone.1)?);
+        let mat = |m: Option<(Real, Real)>, d: (Real, Real)| {
+            let (e, nu) = m.unwrap_or(d);
+            plane_strain(e, nu).map(Arc::new)
+        };
+        let [n_fb, n_fc, n_tb, n_tc] = self.body_names;
         let mut model = Model::<2>::new();
-        let fb = model.add_body("femur_bone", f_bone, bone.clone())?;
-        let fc = model.add_body("femur_cartilage", f_cart, cart.clone())?;
-        let tb = model.add_body("tibia_bone", t_bone, bone)?;
-        let tcb = model.add_body("tibia_cartilage", t_cart, cart)?;
+        let fb = model.add_body(n_fb, f_bone, mat(None, self.bone)?)?;
+        let fc = model.add_body(n_fc, f_cart, mat(self.femur_layer_material, self.cartilage)?)?;
+        let tb = model.add_body(n_tb, t_bone, mat(self.tibia_base_material, self.bone)?)?;
+        let tcb = model.add_body(n_tc, t_cart, mat(self.tibia_layer_material, self.cartilage)?)?;
         model.tie(fb, "outer", fc, "inner")?;
         model.tie(tb, "top", tcb, "bottom")?;
         model.prescribe(fb, "inner", |_, d| Vector::<2>::new(0.0, -d))?;

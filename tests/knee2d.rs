@@ -1,6 +1,7 @@
 //! The sagittal knee model (`synovia::knee2d`) on a coarse mesh over the whole ISO 14243-1
 //! gait cycle (41 poses): at every step the contact resultant balances the applied load within
-//! 0.5 % and the contact solution satisfies the KKT conditions.
+//! 0.5 % and the contact solution satisfies the KKT conditions; the same for the total knee
+//! replacement variant (`Knee2d::tkr_coarse`, 21 poses).
 
 use synovia::knee2d::{cycle_times, iso14243_axial_force, iso14243_flexion, Knee2d};
 use synovia::prelude::LoadHistory;
@@ -45,4 +46,27 @@ fn knee2d_coarse_cycle_balances_load_and_satisfies_kkt() {
     let p =
         |t: f64| steps.iter().find(|s| (s.time - t).abs() < 1e-12).map(|s| s.peak_pressure).expect("step");
     assert!(p(0.13) > 3.0 * p(0.725) && p(0.5) > 3.0 * p(0.0));
+}
+
+#[test]
+fn tkr2d_coarse_cycle_balances_load_and_satisfies_kkt() {
+    let tkr = Knee2d::tkr_coarse();
+    let solver = synovia::solvers::by_name("pdas").expect("solver");
+    let times = cycle_times(20);
+    let mut kkt_checked = 0;
+    let steps = tkr
+        .run(&times, solver.as_ref(), |pose| {
+            assert!(pose.result.kkt.satisfied(1e-8), "t = {}: KKT {:?}", pose.step.time, pose.result.kkt);
+            kkt_checked += 1;
+            Ok(())
+        })
+        .expect("cycle");
+    assert_eq!(kkt_checked, times.len());
+    for s in &steps {
+        assert!(s.balance_error <= 5e-3, "t = {}: load balance error {}", s.time, s.balance_error);
+        // CoCr on UHMWPE: tens of MPa at the load peaks, several MPa in swing
+        assert!(s.peak_pressure > 3.0 && s.peak_pressure < 60.0, "t = {}: peak {}", s.time, s.peak_pressure);
+    }
+    let peak = steps.iter().map(|s| s.peak_pressure).fold(0.0, f64::max);
+    assert!(peak > 20.0 && peak < 50.0, "peak insert pressure {peak}");
 }
