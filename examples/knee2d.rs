@@ -19,8 +19,8 @@
 use std::time::Instant;
 
 mod knee_common;
-use synovia::io::{Encoding, TimeSeriesWriter};
 use knee_common::{csv_text, plot};
+use synovia::io::{Encoding, TimeSeriesWriter};
 use synovia::knee2d::{cycle_times, hertz_estimate, Knee2d, KneeError};
 
 fn main() -> Result<(), KneeError> {

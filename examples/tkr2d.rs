@@ -68,7 +68,13 @@ fn main() -> Result<(), KneeError> {
     let csv = std::path::Path::new(&out).join("tkr2d.csv");
     std::fs::write(&csv, csv_text(&steps))?;
     let svg = std::path::Path::new(&out).join("force_and_peak_pressure.svg");
-    plot(&svg, &steps, tkr.width, "tkr2d: CoCr on UHMWPE, ISO 14243-1 gait cycle", "peak insert pressure (right axis)")?;
+    plot(
+        &svg,
+        &steps,
+        tkr.width,
+        "tkr2d: CoCr on UHMWPE, ISO 14243-1 gait cycle",
+        "peak insert pressure (right axis)",
+    )?;
 
     let max_err = steps.iter().map(|s| s.balance_error).fold(0.0, f64::max);
     let peak = steps.iter().max_by(|a, b| a.peak_pressure.total_cmp(&b.peak_pressure)).ok_or("no steps")?;

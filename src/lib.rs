@@ -70,6 +70,7 @@ pub mod contact {
 }
 pub mod builder;
 pub mod hertz;
+pub mod hip3d;
 pub mod knee2d;
 pub mod output;
 pub mod solvers;

@@ -95,7 +95,12 @@ fn gmsh_cli_mesh_is_read_and_solved_with_balanced_contact_force() {
     let _ = std::fs::remove_dir_all(msh.parent().expect("dir"));
     let mesh_of = |name: &str| bodies.iter().find(|(n, _)| n == name).map(|(_, m)| m.clone()).expect(name);
     let (lower, upper) = (mesh_of("lower"), mesh_of("upper"));
-    assert!(lower.n_cells() > 100 && upper.n_cells() > 100, "{} / {} cells", lower.n_cells(), upper.n_cells());
+    assert!(
+        lower.n_cells() > 100 && upper.n_cells() > 100,
+        "{} / {} cells",
+        lower.n_cells(),
+        upper.n_cells()
+    );
 
     let mat = Arc::new(plane_strain(E, NU).expect("material"));
     let mut model = Model::<2>::new();

@@ -37,7 +37,13 @@ pub fn csv_text(steps: &[KneeStep]) -> String {
 
 /// Applied and computed contact force (N, i.e. per-mm values × width) and peak pressure (MPa,
 /// right axis) over the cycle.
-pub fn plot(path: &std::path::Path, steps: &[KneeStep], width: f64, title: &str, pressure_label: &str) -> Result<(), KneeError> {
+pub fn plot(
+    path: &std::path::Path,
+    steps: &[KneeStep],
+    width: f64,
+    title: &str,
+    pressure_label: &str,
+) -> Result<(), KneeError> {
     let root = SVGBackend::new(path, (900, 500)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let f_max = steps.iter().map(|s| s.load_n).fold(0.0, f64::max) * 1.1;
