@@ -75,6 +75,7 @@ use crate::error::ContactError;
 use crate::problem::{FrictionConstraints, NormalConstraints};
 use crate::rows::SparseRows;
 use crate::search::{area_normal, FacetSearch};
+use synovia_mesh::mesh::nodal_normals_at;
 
 /// A rigid obstacle given by a signed distance `φ` (positive in the free space outside the
 /// obstacle, negative inside) and its gradient.
@@ -496,30 +497,6 @@ impl<const D: usize> ContactNode<D> {
         }
         Some(j)
     }
-}
-
-/// Nodal normals of `facets` from the positions `pos` (the rule of
-/// [`synovia_mesh::Mesh::nodal_normals_of`]), sorted by node.
-fn nodal_normals_at<'a, const D: usize>(
-    pos: &[Point<D>],
-    facets: impl Iterator<Item = &'a [usize]>,
-) -> Vec<(usize, Vector<D>)> {
-    let mut acc: std::collections::HashMap<usize, Vector<D>> = std::collections::HashMap::new();
-    for f in facets {
-        let n = area_normal(pos, f);
-        for &i in f {
-            *acc.entry(i).or_insert_with(Vector::<D>::zeros) += n;
-        }
-    }
-    let mut out: Vec<(usize, Vector<D>)> = acc
-        .into_iter()
-        .map(|(i, n)| {
-            let len = n.norm();
-            (i, if len > 0.0 { n / len } else { n })
-        })
-        .collect();
-    out.sort_by_key(|e| e.0);
-    out
 }
 
 impl<const D: usize> ContactGeometry<D> {

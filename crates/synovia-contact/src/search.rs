@@ -345,27 +345,8 @@ impl<const D: usize> FacetSearch<D> {
     }
 }
 
-/// Area-weighted normal of a facet (the rule of [`synovia_mesh::Mesh::facet_area_normal`]).
-pub fn area_normal<const D: usize>(positions: &[Point<D>], facet: &[usize]) -> Vector<D> {
-    let mut n = Vector::<D>::zeros();
-    match D {
-        2 => {
-            let t = positions[facet[1]] - positions[facet[0]];
-            n[0] = t[1];
-            n[1] = -t[0];
-        }
-        3 => {
-            let a = positions[facet[0]];
-            let u = positions[facet[1]] - a;
-            let v = positions[facet[2]] - a;
-            n[0] = 0.5 * (u[1] * v[2] - u[2] * v[1]);
-            n[1] = 0.5 * (u[2] * v[0] - u[0] * v[2]);
-            n[2] = 0.5 * (u[0] * v[1] - u[1] * v[0]);
-        }
-        _ => {}
-    }
-    n
-}
+/// Area-weighted normal of a facet at the given positions (re-exported from synovia-mesh).
+pub use synovia_mesh::mesh::facet_area_normal_at as area_normal;
 
 #[cfg(test)]
 mod tests {

@@ -427,24 +427,7 @@ impl<const D: usize> Mesh<D> {
 
     /// Normal of a facet scaled by its measure (length in 2D, area in 3D).
     pub fn facet_area_normal(&self, facet: &[usize]) -> Vector<D> {
-        let mut n = Vector::<D>::zeros();
-        match D {
-            2 => {
-                let t = self.nodes[facet[1]] - self.nodes[facet[0]];
-                n[0] = t[1];
-                n[1] = -t[0];
-            }
-            3 => {
-                let a = self.nodes[facet[0]];
-                let u = self.nodes[facet[1]] - a;
-                let v = self.nodes[facet[2]] - a;
-                n[0] = 0.5 * (u[1] * v[2] - u[2] * v[1]);
-                n[1] = 0.5 * (u[2] * v[0] - u[0] * v[2]);
-                n[2] = 0.5 * (u[0] * v[1] - u[1] * v[0]);
-            }
-            _ => {}
-        }
-        n
+        facet_area_normal_at(&self.nodes, facet)
     }
 
     /// Measure of a facet (length in 2D, area in 3D).
@@ -576,22 +559,7 @@ impl<const D: usize> Mesh<D> {
 
     /// Outward unit nodal normals of any set of outward-oriented facets.
     pub fn nodal_normals_of<'a>(&self, facets: impl Iterator<Item = &'a [usize]>) -> Vec<(usize, Vector<D>)> {
-        let mut acc: HashMap<usize, Vector<D>> = HashMap::new();
-        for f in facets {
-            let n = self.facet_area_normal(f);
-            for &i in f {
-                *acc.entry(i).or_insert_with(Vector::<D>::zeros) += n;
-            }
-        }
-        let mut out: Vec<(usize, Vector<D>)> = acc
-            .into_iter()
-            .map(|(i, n)| {
-                let len = n.norm();
-                (i, if len > 0.0 { n / len } else { n })
-            })
-            .collect();
-        out.sort_by_key(|e| e.0);
-        out
+        nodal_normals_at(&self.nodes, facets)
     }
 
     /// Replaces nodes and cells wholesale, keeping the boundary parts given (used by
@@ -607,4 +575,53 @@ impl<const D: usize> Mesh<D> {
         }
         Ok(mesh)
     }
+}
+
+/// Normal of the facet `facet` (node indices into `positions`) scaled by its measure: in 2D
+/// `(b − a)^⊥ = (t_y, −t_x)`, in 3D `½ (b − a) × (c − a)` — outward for outward-ordered facets.
+/// Used with the reference nodes by [`Mesh::facet_area_normal`] and with deformed positions by
+/// contact search.
+pub fn facet_area_normal_at<const D: usize>(positions: &[Point<D>], facet: &[usize]) -> Vector<D> {
+    let mut n = Vector::<D>::zeros();
+    match D {
+        2 => {
+            let t = positions[facet[1]] - positions[facet[0]];
+            n[0] = t[1];
+            n[1] = -t[0];
+        }
+        3 => {
+            let a = positions[facet[0]];
+            let u = positions[facet[1]] - a;
+            let v = positions[facet[2]] - a;
+            n[0] = 0.5 * (u[1] * v[2] - u[2] * v[1]);
+            n[1] = 0.5 * (u[2] * v[0] - u[0] * v[2]);
+            n[2] = 0.5 * (u[0] * v[1] - u[1] * v[0]);
+        }
+        _ => {}
+    }
+    n
+}
+
+/// Unit nodal normals of outward-oriented facets at the given positions: for each node the
+/// normalised sum of the measure-weighted normals of its facets, sorted by node.
+pub fn nodal_normals_at<'a, const D: usize>(
+    positions: &[Point<D>],
+    facets: impl Iterator<Item = &'a [usize]>,
+) -> Vec<(usize, Vector<D>)> {
+    let mut acc: HashMap<usize, Vector<D>> = HashMap::new();
+    for f in facets {
+        let n = facet_area_normal_at(positions, f);
+        for &i in f {
+            *acc.entry(i).or_insert_with(Vector::<D>::zeros) += n;
+        }
+    }
+    let mut out: Vec<(usize, Vector<D>)> = acc
+        .into_iter()
+        .map(|(i, n)| {
+            let len = n.norm();
+            (i, if len > 0.0 { n / len } else { n })
+        })
+        .collect();
+    out.sort_by_key(|e| e.0);
+    out
 }
