@@ -154,14 +154,13 @@ fn pdas_fallback_passes_input_errors_through() {
     assert!(matches!(e, Err(ContactError::InvalidParameter(_))), "{e:?}");
 }
 
-/// Found by an exploratory property-test run with `PROPTEST_CASES=20000` (shrunk): a Tresca problem with an
-/// almost vanishing load (`|U| ≈ 4e-6`, `g_c = 0.16`, no contact). `uzawa-mprgp` stops on its
-/// absolute tangential residual (`≤ 1e-10` in `Λ_t`), which bounds the slip of the sticking
-/// cells only by `1e-10/ρ`; relative to the tiny displacement scale the KKT checker then sees
-/// a stick-slip residual of ≈ 5e-7 > 1e-7. Known limitation (docs/reliability.md); PDAS and
-/// `dual-mprgp` pass.
+/// Found by an exploratory property-test run with `PROPTEST_CASES=20000` (shrunk): a Tresca
+/// problem with an almost vanishing load (`|U| ≈ 4e-6`, `g_c = 0.16`, no contact). `uzawa-mprgp`
+/// used to stop on its absolute tangential residual (`≤ 1e-10` in `Λ_t`), which bounds the slip
+/// of the sticking cells only by `1e-10/ρ`: relative to the tiny displacement scale the KKT
+/// checker saw a stick-slip residual of ≈ 5e-7. It now also checks the KKT residuals relative to
+/// the displacement scale before stopping; all solvers must pass.
 #[test]
-#[ignore = "known limitation of uzawa-mprgp's stopping test on nearly unloaded problems"]
 fn uzawa_mprgp_kkt_on_a_nearly_unloaded_tresca_problem() {
     let b = BlockOnFoundation {
         n: 5,

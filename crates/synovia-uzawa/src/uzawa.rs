@@ -227,12 +227,18 @@ impl ContactSolver for UzawaMprgp {
                     solver: self.name().to_string(),
                     iterations: k,
                     inner_iterations,
-                    history,
+                    history: history.clone(),
                     ..SolverReport::default()
                 };
                 let mut sol = solution(&mut op, &nu, &res, report)?;
-                sol.report.time_s = t0.elapsed().as_secs_f64();
-                return Ok(sol);
+                // The multiplier-scale test above is absolute in Λ_t; on nearly unloaded
+                // problems the displacements are tiny and the stick condition must also hold
+                // relative to them (the scale of `check_kkt`): otherwise keep iterating.
+                let kkt = synovia_contact::check_kkt(problem, &sol.u, &sol.lambda_n, &sol.lambda_t);
+                if kkt.max() <= 100.0 * tol || mt == 0 {
+                    sol.report.time_s = t0.elapsed().as_secs_f64();
+                    return Ok(sol);
+                }
             }
             done = k;
             if mt == 0 && !qrep.converged {
