@@ -16,9 +16,8 @@
 use std::time::Instant;
 
 mod knee_common;
-use knee_common::{csv_text, plot};
-use synovia::io::{Encoding, TimeSeriesWriter};
-use synovia::knee2d::{cycle_times, hertz_estimate, Knee2d, KneeError};
+use knee_common::{csv_text, plot, run_cycle};
+use synovia::knee2d::{hertz_estimate, Knee2d, KneeError};
 
 fn main() -> Result<(), KneeError> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "out/tkr2d".to_string());
@@ -26,44 +25,7 @@ fn main() -> Result<(), KneeError> {
     std::fs::create_dir_all(&out)?;
     let start = Instant::now();
     let tkr = Knee2d::tkr();
-    let solver = synovia::solvers::by_name("pdas")?;
-    let times = cycle_times(n);
-    let mut series = TimeSeriesWriter::new(&out, "tkr2d", Encoding::Base64)?;
-    let mut dofs = 0;
-    println!(
-        "| step | cycle % | flexion ° | F (N) | P (N/mm) | contact (N/mm) | balance err | peak p (MPa) | contact length (mm) | δ (mm) | solves | KKT | s |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    let mut i = 0;
-    let steps = tkr.run(&times, solver.as_ref(), |pose| {
-        let s = &pose.step;
-        dofs = pose.contact.elastic().info().n_dofs;
-        println!(
-            "| {i} | {:.1} | {:.1} | {:.0} | {:.2} | {:.4} | {:.1e} | {:.2} | {:.2} | {:.5} | {} | {:.1e} | {:.2} |",
-            100.0 * s.time,
-            s.flexion_deg,
-            s.load_n,
-            s.load_per_mm,
-            s.contact_force_per_mm,
-            s.balance_error,
-            s.peak_pressure,
-            s.contact_length,
-            s.approach,
-            s.solves,
-            s.kkt,
-            s.seconds
-        );
-        if s.balance_error > 5e-3 {
-            return Err(format!("step {i}: load balance error {:.2e} > 0.5 %", s.balance_error).into());
-        }
-        if !pose.result.kkt.satisfied(1e-8) {
-            return Err(format!("step {i}: KKT violated: {:?}", pose.result.kkt).into());
-        }
-        let vtu = synovia::output::contact_vtu(&pose.model, pose.contact.geometry(), &pose.result, Encoding::Base64)?;
-        series.write_step(s.time, &vtu)?;
-        i += 1;
-        Ok(())
-    })?;
+    let (steps, dofs, series) = run_cycle(&tkr, "tkr2d", &out, n)?;
 
     let csv = std::path::Path::new(&out).join("tkr2d.csv");
     std::fs::write(&csv, csv_text(&steps))?;

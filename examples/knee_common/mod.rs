@@ -1,10 +1,62 @@
-//! Output helpers shared by the `knee2d` and `tkr2d` examples: the per-pose CSV and the SVG
-//! plot of force and peak pressure over the gait cycle.
+//! Helpers shared by the `knee2d` and `tkr2d` examples: the checked run over the gait cycle,
+//! the per-pose CSV and the SVG plot of force and peak pressure over the cycle.
 
 use std::fmt::Write as _;
 
 use plotters::prelude::*;
-use synovia::knee2d::{KneeError, KneeStep};
+use synovia::io::{Encoding, TimeSeriesWriter};
+use synovia::knee2d::{cycle_times, Knee2d, KneeError, KneeStep};
+
+/// Runs `model` over `n` poses of the ISO cycle with PDAS: prints one table row per pose, checks
+/// the load balance (≤ 0.5 %) and the KKT conditions at every pose, and writes the contact state
+/// of each pose to the PVD series `OUT/NAME.pvd`. Returns the steps, the unknowns of the last
+/// pose and the series writer.
+pub fn run_cycle(
+    model: &Knee2d,
+    name: &str,
+    out: &str,
+    n: usize,
+) -> Result<(Vec<KneeStep>, usize, TimeSeriesWriter), KneeError> {
+    let solver = synovia::solvers::by_name("pdas")?;
+    let times = cycle_times(n);
+    let mut series = TimeSeriesWriter::new(out, name, Encoding::Base64)?;
+    let mut dofs = 0;
+    println!(
+        "| step | cycle % | flexion ° | F (N) | P (N/mm) | contact (N/mm) | balance err | peak p (MPa) | contact length (mm) | δ (mm) | solves | KKT | s |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let mut i = 0;
+    let steps = model.run(&times, solver.as_ref(), |pose| {
+        let s = &pose.step;
+        dofs = pose.contact.elastic().info().n_dofs;
+        println!(
+            "| {i} | {:.1} | {:.1} | {:.0} | {:.2} | {:.4} | {:.1e} | {:.3} | {:.2} | {:.5} | {} | {:.1e} | {:.2} |",
+            100.0 * s.time,
+            s.flexion_deg,
+            s.load_n,
+            s.load_per_mm,
+            s.contact_force_per_mm,
+            s.balance_error,
+            s.peak_pressure,
+            s.contact_length,
+            s.approach,
+            s.solves,
+            s.kkt,
+            s.seconds
+        );
+        if s.balance_error > 5e-3 {
+            return Err(format!("step {i}: load balance error {:.2e} > 0.5 %", s.balance_error).into());
+        }
+        if !pose.result.kkt.satisfied(1e-8) {
+            return Err(format!("step {i}: KKT violated: {:?}", pose.result.kkt).into());
+        }
+        let vtu = synovia::output::contact_vtu(&pose.model, pose.contact.geometry(), &pose.result, Encoding::Base64)?;
+        series.write_step(s.time, &vtu)?;
+        i += 1;
+        Ok(())
+    })?;
+    Ok((steps, dofs, series))
+}
 
 /// The per-pose CSV table.
 pub fn csv_text(steps: &[KneeStep]) -> String {
