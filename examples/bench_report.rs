@@ -1,0 +1,248 @@
+//! # Contact and time-stepping benchmark report (issue 6)
+//!
+//! Prints one JSON line per case with `case`, `dofs`, `time_s`, `elastic_s` (one plain elastic
+//! factorisation + solve of the same `A`, [`ElasticSolver::new`] + [`ElasticSolver::solve`], in
+//! the same run), `ratio = time_s / elastic_s` and `peak_rss_mb` (`VmHWM` of the case's own child
+//! process: every case runs in this executable re-run as `--child CASE SCALE`). Cases:
+//!
+//! - `hertz2d_tresca`: two identical half-discs ([`hertz2d_model`], PDAS), a frictionless normal
+//!   solve (`normal_s`), then a Tresca solve with `g_c = μ p` (μ = 0.3) and a small tangential
+//!   shift of the top (`tresca_s`); `time_s = tresca_s` (the Tresca contact solve);
+//! - `resolve_new_loads`: the same model and factorisation after the Tresca solve, re-solved with
+//!   a new push (+5 %) and shift (× 1.5), warm-started from the previous solution;
+//!   `time_s` = that re-solve;
+//! - `hemisphere3d_friction`: the hemisphere of [`synovia::hertz::Hertz3d`] on a rigid flat with
+//!   friction, normal then Tresca step as above; `time_s = tresca_s`;
+//! - `knee2d_gait`: [`Knee2d`] (default mesh) over a quasi-static gait cycle of
+//!   [`cycle_times`]`(steps)` poses; `time_s` = the whole cycle, `elastic_s` = one elastic
+//!   factorisation + solve of one pose's model.
+//!
+//! Sizes at scale 1 (the defaults): 2D Hertz level 14 (169 120 DOFs), 3D hemisphere level 17
+//! (≈ 270k DOFs, extrapolated: 79 686 at level 15, ≈ × 1.85 per level), 100 knee poses of the
+//! default knee mesh (16 528 DOFs). `scale < 1` removes `round(log2(1 / scale))` refinement levels (2D, 3D) and
+//! scales the number of knee steps.
+//!
+//! ```text
+//! cargo run --release --example bench_report            # scale 1
+//! cargo run --release --example bench_report 0.25       # quick run
+//! cargo run --release --example bench_report 1 hertz2d_tresca resolve_new_loads
+//! ```
+//!
+//! Results on the project's 2-core machine are in `docs/performance.md`.
+
+use std::error::Error;
+use std::process::Command;
+use std::sync::Arc;
+use std::time::Instant;
+
+use serde_json::{json, Value};
+use synovia::contact::StaticContact;
+use synovia::contact_ops::operators::ContactPair;
+use synovia::hertz::{hertz2d_model, Hertz2d, Hertz3d};
+use synovia::knee2d::{cycle_times, Knee2d};
+use synovia::mesh::generators::hemisphere_refined;
+use synovia::prelude::*;
+
+type Res<T> = Result<T, Box<dyn Error + Send + Sync>>;
+
+const CASES: [&str; 4] = ["hertz2d_tresca", "resolve_new_loads", "hemisphere3d_friction", "knee2d_gait"];
+const MU: Real = 0.3;
+
+/// Refinement levels at `scale`: `base` minus `round(log2(1 / scale))`.
+fn levels(base: usize, scale: f64) -> usize {
+    let drop = (-scale.log2()).round().max(0.0) as usize;
+    base.saturating_sub(drop).max(2)
+}
+
+/// Peak resident set size of this process, in MB (`VmHWM`).
+fn peak_rss_mb() -> Res<f64> {
+    let status = std::fs::read_to_string("/proc/self/status")?;
+    let line =
+        status.lines().find(|l| l.starts_with("VmHWM:")).ok_or("no VmHWM line in /proc/self/status")?;
+    let kb: f64 = line.trim_start_matches("VmHWM:").trim().trim_end_matches("kB").trim().parse()?;
+    Ok(kb * 1024.0 / 1.0e6)
+}
+
+/// One plain elastic factorisation + solve of `model`, in seconds.
+fn elastic_time<const D: usize>(model: &Model<D>) -> Res<f64> {
+    let t0 = Instant::now();
+    let mut s = ElasticSolver::new(model, ElasticParams::default())?;
+    s.solve(model, 0.0)?;
+    Ok(t0.elapsed().as_secs_f64())
+}
+
+fn hertz2d_params(scale: f64, push: Real) -> Hertz2d {
+    Hertz2d { e2: Some(1.0), push, levels: levels(14, scale), ..Default::default() }
+}
+
+/// Normal then Tresca solve of a frictional pair; returns the JSON fields.
+fn normal_tresca<const D: usize>(
+    model: &Model<D>,
+    pairs: &[ContactPair<D>],
+    shift: Real,
+    resolve: Option<&Model<D>>,
+) -> Res<Value> {
+    let solver = synovia::solvers::by_name("pdas")?;
+    let elastic_s = elastic_time(model)?;
+    let t_setup = Instant::now();
+    let sc = StaticContact::new(model, pairs, ElasticParams::default())?;
+    let setup_s = t_setup.elapsed().as_secs_f64();
+    let geo = sc.geometry();
+    let t0 = Instant::now();
+    let normal = sc.solve(model, 0.0, solver.as_ref(), None, None, None)?;
+    let normal_s = t0.elapsed().as_secs_f64();
+    let gc = geo.slip_bounds_from_pressure(&normal.solution.lambda_n);
+    let t1 = Instant::now();
+    let tresca = sc.solve(model, shift, solver.as_ref(), Some(&gc), Some(&normal.displacement), None)?;
+    let tresca_s = t1.elapsed().as_secs_f64();
+    let dofs = sc.elastic().info().n_dofs;
+    let mut v = json!({
+        "dofs": dofs,
+        "contact_nodes": geo.len(),
+        "elastic_s": elastic_s,
+        "contact_setup_s": setup_s,
+        "normal_s": normal_s,
+        "tresca_s": tresca_s,
+        "normal_iterations": normal.solution.report.iterations,
+        "tresca_iterations": tresca.solution.report.iterations,
+        "kkt": tresca.kkt.max().max(normal.kkt.max()),
+    });
+    match resolve {
+        None => v["time_s"] = json!(tresca_s),
+        Some(new_model) => {
+            let t2 = Instant::now();
+            let res = sc.solve(
+                new_model,
+                1.5 * shift,
+                solver.as_ref(),
+                Some(&gc),
+                Some(&normal.displacement),
+                Some(&tresca.solution),
+            )?;
+            let resolve_s = t2.elapsed().as_secs_f64();
+            v["time_s"] = json!(resolve_s);
+            v["resolve_iterations"] = json!(res.solution.report.iterations);
+            v["kkt"] = json!(res.kkt.max());
+        }
+    }
+    Ok(v)
+}
+
+fn hertz2d_case(scale: f64, resolve: bool) -> Res<Value> {
+    let p = hertz2d_params(scale, 0.02);
+    let (model, mut pairs) = hertz2d_model(&p)?;
+    pairs[0].friction = MU;
+    let shift = 2e-4 * p.radius;
+    let mut v = if resolve {
+        // the same mesh (same dof map and `A`) with a 5 % larger push
+        let (new_model, _) = hertz2d_model(&Hertz2d { push: 1.05 * p.push, ..p })?;
+        normal_tresca(&model, &pairs, shift, Some(&new_model))?
+    } else {
+        normal_tresca(&model, &pairs, shift, None)?
+    };
+    v["levels"] = json!(p.levels);
+    Ok(v)
+}
+
+fn hemisphere_case(scale: f64) -> Res<Value> {
+    let p = Hertz3d { levels: levels(17, scale), ..Default::default() };
+    let r = p.radius;
+    let mut mesh = hemisphere_refined(
+        Point::<3>::new(0.0, 0.0, r),
+        r,
+        p.n,
+        Point::<3>::zeros(),
+        p.refine_radius * r,
+        p.levels,
+    )?;
+    mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
+    mesh.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
+    let mut model = Model::<3>::new();
+    let b = model.add_body("hemisphere", mesh, Arc::new(isotropic(p.e, p.nu)?))?;
+    let push = p.push;
+    // the time is the tangential displacement of the top
+    model.prescribe(b, "top", move |_, t| Vector::<3>::new(t, 0.0, -push))?;
+    let flat = PlaneObstacle::new(Point::<3>::zeros(), Vector::<3>::new(0.0, 0.0, 1.0))?;
+    let mut pair = ContactPair::rigid("hemisphere-flat", b, "contact", Arc::new(flat));
+    pair.friction = MU;
+    let mut v = normal_tresca(&model, &[pair], 2e-4 * r, None)?;
+    v["levels"] = json!(p.levels);
+    Ok(v)
+}
+
+fn knee_case(scale: f64) -> Res<Value> {
+    let steps = ((100.0 * scale).round() as usize).max(4);
+    let knee = Knee2d::default();
+    let times = cycle_times(steps);
+    let (model, _) = knee.model(times[0])?;
+    let elastic_s = elastic_time(&model)?;
+    let dofs = ElasticSolver::new(&model, ElasticParams::default())?.info().n_dofs;
+    drop(model);
+    let solver = synovia::solvers::by_name("pdas")?;
+    let t0 = Instant::now();
+    let out = knee.run(&times, solver.as_ref(), |_| Ok(()))?;
+    let time_s = t0.elapsed().as_secs_f64();
+    Ok(json!({
+        "dofs": dofs,
+        "steps": out.len(),
+        "elastic_s": elastic_s,
+        "time_s": time_s,
+        "solves": out.iter().map(|s| s.solves).sum::<usize>(),
+        "max_balance_error": out.iter().map(|s| s.balance_error).fold(0.0, Real::max),
+    }))
+}
+
+/// Child mode: run one case and print its JSON record on stdout.
+fn child(case: &str, scale: f64) -> Res<()> {
+    let mut v = match case {
+        "hertz2d_tresca" => hertz2d_case(scale, false)?,
+        "resolve_new_loads" => hertz2d_case(scale, true)?,
+        "hemisphere3d_friction" => hemisphere_case(scale)?,
+        "knee2d_gait" => knee_case(scale)?,
+        other => return Err(format!("unknown case `{other}` ({})", CASES.join(", ")).into()),
+    };
+    let (t, e) = (v["time_s"].as_f64().unwrap_or(f64::NAN), v["elastic_s"].as_f64().unwrap_or(f64::NAN));
+    v["problem"] = json!("bench_report");
+    v["case"] = json!(case);
+    v["scale"] = json!(scale);
+    v["ratio"] = json!(t / e);
+    v["peak_rss_mb"] = json!(peak_rss_mb()?);
+    println!("{v}");
+    Ok(())
+}
+
+/// Runs a case in a child process and parses the last line of its output.
+fn spawn_case(case: &str, scale: f64) -> Res<Value> {
+    let out = Command::new(std::env::current_exe()?)
+        .args(["--child", case, &scale.to_string()])
+        .stderr(std::process::Stdio::inherit())
+        .output()?;
+    if !out.status.success() {
+        return Err(format!("case `{case}` failed with {}", out.status).into());
+    }
+    let stdout = String::from_utf8(out.stdout)?;
+    let line = stdout.lines().last().ok_or_else(|| format!("case `{case}` printed nothing"))?;
+    Ok(serde_json::from_str(line)?)
+}
+
+fn main() -> Res<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("--child") {
+        let case = args.get(1).ok_or("--child needs a case")?;
+        let scale: f64 = args.get(2).ok_or("--child needs a scale")?.parse()?;
+        return child(case, scale);
+    }
+    let scale: f64 = match args.first() {
+        Some(s) => s.parse().map_err(|e| format!("scale `{s}`: {e}"))?,
+        None => 1.0,
+    };
+    if !(scale.is_finite() && scale > 0.0) {
+        return Err(format!("scale must be positive, got {scale}").into());
+    }
+    let cases: Vec<String> =
+        if args.len() > 1 { args[1..].to_vec() } else { CASES.iter().map(|s| s.to_string()).collect() };
+    for case in &cases {
+        println!("{}", spawn_case(case, scale)?);
+    }
+    Ok(())
+}
