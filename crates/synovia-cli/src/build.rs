@@ -64,6 +64,9 @@ const MAX_CELLS: f64 = 2.0e7;
 /// Most refinement levels of `half_disc` / `hemisphere` (the cell size halves about every two
 /// levels in 2D and three in 3D).
 const MAX_REFINE_LEVELS: usize = 30;
+/// Most steps of a quasi-static `times = { start, end, steps }` range (its levels are
+/// allocated when the model is built).
+const MAX_TIME_STEPS: usize = 10_000_000;
 
 fn key(prefix: &str, field: &str) -> String {
     if prefix.is_empty() {
@@ -1408,6 +1411,13 @@ fn analysis(cx: &Cx<'_>, a: &Sp<AnalysisSpec>) -> R<Analysis> {
                 TimesSpec::Range { start, end, steps } => {
                     if !(start.is_finite() && end.is_finite() && end > start && *steps >= 1) {
                         return Err(cx.err(tk, t.span(), "needs finite start < end and steps ≥ 1"));
+                    }
+                    if *steps > MAX_TIME_STEPS {
+                        return Err(cx.err(
+                            tk,
+                            t.span(),
+                            format!("at most {MAX_TIME_STEPS} steps, got {steps}"),
+                        ));
                     }
                     (0..=*steps).map(|i| start + (end - start) * i as f64 / *steps as f64).collect()
                 }
