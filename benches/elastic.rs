@@ -10,8 +10,9 @@
 //!   symbolic and numeric stages (AMD at full 3D size takes much longer and more memory).
 //!
 //! `SYNOVIA_BENCH_SCALE=0.25 cargo bench --bench elastic` scales every DOF count by 0.25 for a
-//! quick run. Every benchmark takes 10 samples (criterion's minimum); the 3D factorisation takes
-//! 15–20 s per iteration, so a full run lasts about ten minutes. Fixtures are built only for the
+//! quick run. Every benchmark takes 10 samples (criterion's minimum, flat sampling); the 3D
+//! factorisation takes 12–16 s per iteration, so a full run took about 5 minutes on the idle
+//! 2-core machine (9 with other builds running). Fixtures are built only for the
 //! benchmarks selected by a filter, e.g. `cargo bench --bench elastic -- 2d`.
 // `criterion_group!` generates an undocumented public function.
 #![allow(missing_docs)]

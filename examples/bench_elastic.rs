@@ -27,7 +27,8 @@
 //! ```
 //!
 //! The timings are wall-clock times on a shared machine: run it when no one else is compiling
-//! (check `uptime`), and repeat it, the spread between runs is easily 10–20 %. The last lines are
+//! (check `uptime`) and repeat it; clean runs of the 3D factorisation spread by about 20 %, and
+//! a concurrent build can make a stage 2× slower. The last lines are
 //! one JSON object per case, `{"problem":"bench_elastic","case":"2d",...}`. Results on the
 //! project's 2-core machine are in `docs/performance.md`.
 
