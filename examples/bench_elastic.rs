@@ -32,8 +32,6 @@
 //! one JSON object per case, `{"problem":"bench_elastic","case":"2d",...}`. Results on the
 //! project's 2-core machine are in `docs/performance.md`.
 
-use std::error::Error;
-use std::process::Command;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -41,7 +39,8 @@ use serde_json::{json, Value};
 use synovia::fem::OrderingChoice;
 use synovia::prelude::*;
 
-type Res<T> = Result<T, Box<dyn Error>>;
+mod bench_common;
+use bench_common::{parse_args, peak_rss_bytes, spawn_case, Invocation, Res};
 
 /// Cells per side for a DOF budget scaled by `scale` (`base` cells per side at scale 1).
 fn cells(base: usize, dim: i32, scale: f64) -> usize {
@@ -70,15 +69,6 @@ fn model_3d(scale: f64) -> Res<(Model<3>, String)> {
     let b = model.add_body("block", mesh, Arc::new(isotropic(1.0, 0.3)?))?;
     model.traction(b, "top", |x, _n, _t| Vector::<3>::new(0.01 * x[0], 0.005 * x[1], -0.02))?;
     Ok((model, format!("{n}x{n}x{n} box, P1 tetrahedra")))
-}
-
-/// Peak resident set size of this process, in bytes (`VmHWM`).
-fn peak_rss_bytes() -> Res<u64> {
-    let status = std::fs::read_to_string("/proc/self/status")?;
-    let line =
-        status.lines().find(|l| l.starts_with("VmHWM:")).ok_or("no VmHWM line in /proc/self/status")?;
-    let kb: u64 = line.trim_start_matches("VmHWM:").trim().trim_end_matches("kB").trim().parse()?;
-    Ok(kb * 1024)
 }
 
 /// Builds, factorises and solves one case in this process; returns its JSON record.
@@ -143,35 +133,11 @@ fn child(case: &str, scale: f64) -> Res<()> {
     Ok(())
 }
 
-/// Runs a case in a child process and parses the last line of its output.
-fn spawn_case(case: &str, scale: f64) -> Res<Value> {
-    let out = Command::new(std::env::current_exe()?)
-        .args(["--child", case, &scale.to_string()])
-        .stderr(std::process::Stdio::inherit())
-        .output()?;
-    if !out.status.success() {
-        return Err(format!("case `{case}` failed with {}", out.status).into());
-    }
-    let stdout = String::from_utf8(out.stdout)?;
-    let line = stdout.lines().last().ok_or_else(|| format!("case `{case}` printed nothing"))?;
-    Ok(serde_json::from_str(line)?)
-}
-
 fn main() -> Res<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.first().map(String::as_str) == Some("--child") {
-        let case = args.get(1).ok_or("--child needs a case")?;
-        let scale: f64 = args.get(2).ok_or("--child needs a scale")?.parse()?;
-        return child(case, scale);
-    }
-    let scale: f64 = match args.first() {
-        Some(s) => s.parse().map_err(|e| format!("scale `{s}`: {e}"))?,
-        None => 1.0,
+    let (scale, cases) = match parse_args(&["2d", "3d"])? {
+        Invocation::Child { case, scale } => return child(&case, scale),
+        Invocation::Parent { scale, cases } => (scale, cases),
     };
-    if !(scale.is_finite() && scale > 0.0) {
-        return Err(format!("scale must be positive, got {scale}").into());
-    }
-    let cases: Vec<String> = if args.len() > 1 { args[1..].to_vec() } else { vec!["2d".into(), "3d".into()] };
 
     println!("elastic foundation: stage timings (s) and peak RSS, scale {scale}");
     println!(

@@ -30,8 +30,6 @@
 //!
 //! Results on the project's 2-core machine are in `docs/performance.md`.
 
-use std::error::Error;
-use std::process::Command;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -43,7 +41,8 @@ use synovia::knee2d::{cycle_times, Knee2d};
 use synovia::mesh::generators::hemisphere_refined;
 use synovia::prelude::*;
 
-type Res<T> = Result<T, Box<dyn Error + Send + Sync>>;
+mod bench_common;
+use bench_common::{parse_args, peak_rss_bytes, spawn_case, Invocation, Res};
 
 const CASES: [&str; 4] = ["hertz2d_tresca", "resolve_new_loads", "hemisphere3d_friction", "knee2d_gait"];
 const MU: Real = 0.3;
@@ -52,15 +51,6 @@ const MU: Real = 0.3;
 fn levels(base: usize, scale: f64) -> usize {
     let drop = (-scale.log2()).round().max(0.0) as usize;
     base.saturating_sub(drop).max(2)
-}
-
-/// Peak resident set size of this process, in MB (`VmHWM`).
-fn peak_rss_mb() -> Res<f64> {
-    let status = std::fs::read_to_string("/proc/self/status")?;
-    let line =
-        status.lines().find(|l| l.starts_with("VmHWM:")).ok_or("no VmHWM line in /proc/self/status")?;
-    let kb: f64 = line.trim_start_matches("VmHWM:").trim().trim_end_matches("kB").trim().parse()?;
-    Ok(kb * 1024.0 / 1.0e6)
 }
 
 /// One plain elastic factorisation + solve of `model`, in seconds.
@@ -206,41 +196,16 @@ fn child(case: &str, scale: f64) -> Res<()> {
     v["case"] = json!(case);
     v["scale"] = json!(scale);
     v["ratio"] = json!(t / e);
-    v["peak_rss_mb"] = json!(peak_rss_mb()?);
+    v["peak_rss_mb"] = json!(peak_rss_bytes()? as f64 / 1.0e6);
     println!("{v}");
     Ok(())
 }
 
-/// Runs a case in a child process and parses the last line of its output.
-fn spawn_case(case: &str, scale: f64) -> Res<Value> {
-    let out = Command::new(std::env::current_exe()?)
-        .args(["--child", case, &scale.to_string()])
-        .stderr(std::process::Stdio::inherit())
-        .output()?;
-    if !out.status.success() {
-        return Err(format!("case `{case}` failed with {}", out.status).into());
-    }
-    let stdout = String::from_utf8(out.stdout)?;
-    let line = stdout.lines().last().ok_or_else(|| format!("case `{case}` printed nothing"))?;
-    Ok(serde_json::from_str(line)?)
-}
-
 fn main() -> Res<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    if args.first().map(String::as_str) == Some("--child") {
-        let case = args.get(1).ok_or("--child needs a case")?;
-        let scale: f64 = args.get(2).ok_or("--child needs a scale")?.parse()?;
-        return child(case, scale);
-    }
-    let scale: f64 = match args.first() {
-        Some(s) => s.parse().map_err(|e| format!("scale `{s}`: {e}"))?,
-        None => 1.0,
+    let (scale, cases) = match parse_args(&CASES)? {
+        Invocation::Child { case, scale } => return child(&case, scale),
+        Invocation::Parent { scale, cases } => (scale, cases),
     };
-    if !(scale.is_finite() && scale > 0.0) {
-        return Err(format!("scale must be positive, got {scale}").into());
-    }
-    let cases: Vec<String> =
-        if args.len() > 1 { args[1..].to_vec() } else { CASES.iter().map(|s| s.to_string()).collect() };
     for case in &cases {
         println!("{}", spawn_case(case, scale)?);
     }
