@@ -289,6 +289,7 @@ fn zero_result<const D: usize>(
         slip_bound: Vec::new(),
         kkt: KktReport::default(),
         coarse_iterations: 0,
+        proximal_iterations: 0,
     }
 }
 

@@ -59,14 +59,38 @@ pub struct OutputPlan {
 
 type R<T> = Result<T, ScenarioError>;
 
-/// Largest mesh a generator may make (cells, estimated from its parameters).
-const MAX_CELLS: f64 = 2.0e7;
-/// Most refinement levels of `half_disc` / `hemisphere` (the cell size halves about every two
-/// levels in 2D and three in 3D).
-const MAX_REFINE_LEVELS: usize = 30;
-/// Most steps of a quasi-static `times = { start, end, steps }` range (its levels are
-/// allocated when the model is built).
-const MAX_TIME_STEPS: usize = 10_000_000;
+/// Size guards of a scenario build: a scenario asking for more gets an error at the key.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Limits {
+    /// Largest mesh a generator may make (cells, estimated from its parameters; default 2·10⁷).
+    pub max_cells: f64,
+    /// Most refinement levels of `half_disc` / `hemisphere` (the cell size halves about every
+    /// two levels in 2D and three in 3D; default 30).
+    pub max_refine_levels: usize,
+    /// Most steps of a quasi-static `times = { start, end, steps }` range (its levels are
+    /// allocated when the model is built; default 10⁷).
+    pub max_time_steps: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self { max_cells: 2.0e7, max_refine_levels: 30, max_time_steps: 10_000_000 }
+    }
+}
+
+static LIMITS: std::sync::Mutex<Option<Limits>> = std::sync::Mutex::new(None);
+
+/// Sets the size guards of every later build in this process (e.g. smaller ones for fuzzing,
+/// where the parser and validation are under test, not the mesh generators at scale).
+pub fn set_limits(limits: Limits) {
+    let mut guard = LIMITS.lock().unwrap_or_else(|e| e.into_inner());
+    *guard = Some(limits);
+}
+
+/// The size guards in force ([`set_limits`], else [`Limits::default`]).
+pub fn limits() -> Limits {
+    LIMITS.lock().unwrap_or_else(|e| e.into_inner()).unwrap_or_default()
+}
 
 fn key(prefix: &str, field: &str) -> String {
     if prefix.is_empty() {
@@ -668,20 +692,22 @@ fn generate<const D: usize>(
         "layered_arc" => 2.0 * get(&m.n_angle) * n_layers,
         _ => 24.0 * get(&m.n_surface).powi(2) * n_layers,
     };
-    if estimate > MAX_CELLS {
+    let max_cells = limits().max_cells;
+    if estimate > max_cells {
         return Err(cx.err(
             k,
             span.clone(),
-            format!("the mesh would have about {estimate:.3e} cells, more than the limit {MAX_CELLS:e}"),
+            format!("the mesh would have about {estimate:.3e} cells, more than the limit {max_cells:e}"),
         ));
     }
     if let Some(r) = &m.refine {
         let levels = *r.get_ref().levels.get_ref();
-        if levels > MAX_REFINE_LEVELS {
+        let max_levels = limits().max_refine_levels;
+        if levels > max_levels {
             return Err(cx.err(
                 key(k, "refine.levels"),
                 r.get_ref().levels.span(),
-                format!("at most {MAX_REFINE_LEVELS} refinement levels, got {levels}"),
+                format!("at most {max_levels} refinement levels, got {levels}"),
             ));
         }
     }
@@ -1412,11 +1438,12 @@ fn analysis(cx: &Cx<'_>, a: &Sp<AnalysisSpec>) -> R<Analysis> {
                     if !(start.is_finite() && end.is_finite() && end > start && *steps >= 1) {
                         return Err(cx.err(tk, t.span(), "needs finite start < end and steps ≥ 1"));
                     }
-                    if *steps > MAX_TIME_STEPS {
+                    let max_steps = limits().max_time_steps;
+                    if *steps > max_steps {
                         return Err(cx.err(
                             tk,
                             t.span(),
-                            format!("at most {MAX_TIME_STEPS} steps, got {steps}"),
+                            format!("at most {max_steps} steps, got {steps}"),
                         ));
                     }
                     (0..=*steps).map(|i| start + (end - start) * i as f64 / *steps as f64).collect()

@@ -60,8 +60,20 @@ fn exercise(path: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
     })
 }
 
+/// Size guards for fuzzing: the parser and validation are under test, not the mesh generators
+/// at scale (with the default guards a mutation that asks for a mesh just under 2·10⁷ cells
+/// builds it, and those rare builds made the run 50 inputs/s). Every seed builds under them.
+fn fuzz_limits() {
+    synovia_cli::build::set_limits(synovia_cli::build::Limits {
+        max_cells: 5.0e5,
+        max_refine_levels: 16,
+        max_time_steps: 100_000,
+    });
+}
+
 #[test]
 fn seeds_build() {
+    fuzz_limits();
     for (p, b) in seeds() {
         let sc = Scenario::from_file(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
         check(&sc).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
@@ -78,6 +90,7 @@ proptest! {
 
     #[test]
     fn mutated_scenarios_never_panic((seed, muts) in mutated(60)) {
+        fuzz_limits();
         let seeds = seeds_cached();
         let (path, original) = &seeds[seed % seeds.len()];
         let corpus: Vec<Vec<u8>> = seeds.iter().map(|(_, b)| b.clone()).collect();

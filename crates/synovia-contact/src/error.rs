@@ -72,6 +72,18 @@ pub enum ContactError {
         /// Size of the system.
         size: usize,
     },
+    /// Bodies held only by contact (semi-coercive, spec §4) carry a load whose rigid part no
+    /// admissible contact force balances: the load pulls them away from, or slides them off,
+    /// their contact partners.
+    #[error("bodies {bodies:?} are held only by contact, and contact forces cannot balance their load (unbalanced rigid-body load {residual:.3e} of {load:.3e}): the load pulls them away or slides them off; add Dirichlet or symmetry data, friction, or change the load")]
+    Unbalanced {
+        /// The floating bodies.
+        bodies: Vec<String>,
+        /// Norm of the part of the rigid-body load that no contact force balances.
+        residual: f64,
+        /// Norm of the rigid-body load `Rᵀ F`.
+        load: f64,
+    },
     /// A parameter is out of range or vectors have inconsistent sizes.
     #[error("invalid contact parameter: {0}")]
     InvalidParameter(String),

@@ -22,6 +22,7 @@
 #![warn(missing_docs)]
 
 pub mod error;
+pub mod floating;
 pub mod friction;
 pub mod kkt;
 pub mod nested;

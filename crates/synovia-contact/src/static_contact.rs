@@ -38,16 +38,23 @@ pub struct StaticContactResult<const D: usize> {
     pub kkt: KktReport,
     /// Solver iterations spent on the coarse levels of the nested iteration (0 if none).
     pub coarse_iterations: usize,
+    /// Proximal-point iterations of a semi-coercive model ([`crate::floating`]); 0 for a
+    /// coercive one.
+    pub proximal_iterations: usize,
 }
 
 impl<const D: usize> StaticContact<D> {
     /// Factorises the model's stiffness and builds the contact nodes of `pairs`.
+    ///
+    /// Bodies that no Dirichlet or symmetry data hold (semi-coercive, spec §4) are accepted:
+    /// the factorisation is then of `A + S` ([`ElasticSolver::new_semi_coercive`]) and
+    /// [`StaticContact::solve`] runs the proximal-point iteration of [`crate::floating`].
     pub fn new(
         model: &Model<D>,
         pairs: &[ContactPair<D>],
         params: ElasticParams,
     ) -> Result<Self, ContactError> {
-        let elastic = ElasticSolver::new(model, params)?;
+        let elastic = ElasticSolver::new_semi_coercive(model, params)?;
         let geometry = ContactGeometry::new(model, pairs)?;
         Ok(Self { elastic, geometry, nested_min_rows: Some(32) })
     }
@@ -103,28 +110,95 @@ impl<const D: usize> StaticContact<D> {
         };
         let friction: Option<&FrictionConstraints> =
             friction_op.as_ref().map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0);
-        let problem = ContactProblem {
-            matrix: self.elastic.stiffness(),
-            factor: self.elastic.cholesky(),
-            load: &load,
-            normal: &normal,
-            friction,
-        };
+        let stabilisation = self.elastic.stabilisation();
+        if let Some(st) = stabilisation {
+            crate::floating::check_balance(st, &load, &normal, friction)?;
+        }
+        let (matrix, factor) = (self.elastic.system_matrix(), self.elastic.cholesky());
+        macro_rules! problem_with {
+            ($rhs:expr) => {
+                ContactProblem { matrix, factor, load: $rhs, normal: &normal, friction }
+            };
+        }
         let mut coarse_iterations = 0;
         let nested = match (warm_start, self.nested_min_rows) {
-            (None, Some(min_rows)) => {
-                crate::nested::nested_warm_start(&problem, solver, &self.geometry.adjacency, min_rows)?
-            }
+            (None, Some(min_rows)) => crate::nested::nested_warm_start(
+                &problem_with!(&load),
+                solver,
+                &self.geometry.adjacency,
+                min_rows,
+            )?,
             _ => None,
         };
         if let Some((_, it)) = &nested {
             coarse_iterations = *it;
         }
-        let warm = warm_start.or(nested.as_ref().map(|(w, _)| w));
-        let solution = solver.solve(&problem, warm)?;
-        let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
-        let displacement = dofs.expand(&solution.u, &lifts)?;
-        let has_friction = friction.is_some();
+        let mut warm = warm_start.or(nested.as_ref().map(|(w, _)| w)).cloned();
+        let Some(st) = stabilisation else {
+            let problem = problem_with!(&load);
+            let solution = solver.solve(&problem, warm.as_ref())?;
+            let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
+            return self.finish(solution, kkt, &lifts, friction_op, coarse_iterations, 0);
+        };
+        // Proximal-point iteration (crate::floating): A + S with load F + S U_k.
+        let mut u_k = match &warm {
+            Some(w) if w.u.len() == load.len() => w.u.clone(),
+            _ => vec![0.0; load.len()],
+        };
+        let mut history = Vec::new();
+        for iteration in 1..=PROXIMAL_MAX_ITERATIONS {
+            let rhs: Vec<f64> = st.spring_mul(&u_k).iter().zip(&load).map(|(s, f)| s + f).collect();
+            let problem = problem_with!(&rhs);
+            let solution = solver.solve(&problem, warm.as_ref())?;
+            let step: Vec<f64> = solution.u.iter().zip(&u_k).map(|(a, b)| a - b).collect();
+            let residual = inf_norm(&st.spring_mul(&step));
+            let mut forces = vec![0.0; load.len()];
+            let nu: Vec<f64> = solution.lambda_n.iter().zip(&normal.weights).map(|(l, k)| l * k).collect();
+            normal.rows.mul_transpose_add(&nu, &mut forces);
+            let scale = inf_norm(&load).max(inf_norm(&forces)).max(f64::MIN_POSITIVE);
+            let relative = residual / scale;
+            history.push(crate::error::IterationResidual {
+                iteration,
+                normal: relative,
+                tangential: 0.0,
+                set_changes: 0,
+            });
+            if relative <= PROXIMAL_TOLERANCE {
+                let mut kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
+                // the equilibrium residual of the original problem is −S (U_{k+1} − U_k)
+                kkt.equilibrium = kkt.equilibrium.max(relative);
+                return self.finish(solution, kkt, &lifts, friction_op, coarse_iterations, iteration);
+            }
+            // A load that contact cannot hold (e.g. a tangential load above the friction
+            // capacity) makes the body move by the same amount every iteration: stop early.
+            if iteration >= 8 && relative > 0.5 * history[iteration - 6].normal {
+                break;
+            }
+            u_k = solution.u.clone();
+            warm = Some(solution);
+        }
+        Err(ContactError::NoConvergence {
+            solver: format!(
+                "{} in the proximal iteration of the bodies held only by contact (stagnating: the load may exceed what contact and friction can hold)",
+                solver.name()
+            ),
+            iterations: history.len(),
+            history,
+        })
+    }
+
+    fn finish(
+        &self,
+        solution: ContactSolution,
+        kkt: KktReport,
+        lifts: &[Vector<D>],
+        friction_op: Option<crate::operators::FrictionOperator>,
+        coarse_iterations: usize,
+        proximal_iterations: usize,
+    ) -> Result<StaticContactResult<D>, ContactError> {
+        let dofs = self.elastic.dofs();
+        let displacement = dofs.expand(&solution.u, lifts)?;
+        let has_friction = !solution.lambda_t.is_empty();
         let (cell_node, slip) = match friction_op {
             Some(op) if has_friction => (op.cell_node, op.slip_bound),
             _ => (Vec::new(), Vec::new()),
@@ -136,8 +210,19 @@ impl<const D: usize> StaticContact<D> {
             slip_bound: slip,
             kkt,
             coarse_iterations,
+            proximal_iterations,
         })
     }
+}
+
+/// Largest number of proximal-point iterations of a semi-coercive solve.
+const PROXIMAL_MAX_ITERATIONS: usize = 60;
+/// Relative equilibrium residual `‖S (U_{k+1} − U_k)‖_∞ / max(‖F‖_∞, ‖B_hnᵀ κ Λ_n‖_∞)` at
+/// which the proximal-point iteration stops.
+const PROXIMAL_TOLERANCE: f64 = 1e-12;
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |a, b| a.max(b.abs()))
 }
 
 impl<const D: usize> StaticContactResult<D> {

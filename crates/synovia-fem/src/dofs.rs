@@ -357,13 +357,27 @@ impl<const D: usize> DofMap<D> {
     }
 
     /// Checks that no rigid motion of any connected set of bodies satisfies the homogeneous
-    /// constraints (spec §4, coercivity). A rigid motion `r(x) = a + W (x − x̄)` (`W`
-    /// skew) is unrestrained if `c_jᵀ r(x_j) = 0` for every constraint; the test is the
-    /// smallest eigenvalue of `Σ_j ρ_j ρ_jᵀ`, `ρ_j = (c_jᵀ r_m(x_j))_m` over the rigid
-    /// modes `r_m` (scaled by the component size).
+    /// constraints (spec §4, coercivity): [`DofMap::floating_components`] must be empty.
     pub fn check_coercive(&self, model: &Model<D>) -> Result<(), FemError> {
+        match self.floating_components(model).into_iter().next() {
+            None => Ok(()),
+            Some(c) => Err(FemError::SemiCoercive { bodies: c.bodies, free_modes: c.modes.len() }),
+        }
+    }
+
+    /// The rigid motions left free by the homogeneous constraints, per connected set of
+    /// bodies (bodies joined by bonded interfaces): the kernel of `K̃` (spec §4,
+    /// semi-coercive problems).
+    ///
+    /// A rigid motion `r(x) = a + W (x − x̄)` (`W` skew) is unrestrained if `c_jᵀ r(x_j) = 0`
+    /// for every constraint; with `ρ_j = (c_jᵀ r_m(x_j))_m` over the rigid modes `r_m`
+    /// (positions scaled by the component size), the free combinations are the eigenvectors
+    /// of `Σ_j ρ_j ρ_jᵀ` with eigenvalues `≤ 1e-10 ×` the largest. Each is returned as a
+    /// vector of reduced unknowns `ũ_k = N_kᵀ r(x_k)`, orthonormalised.
+    pub fn floating_components(&self, model: &Model<D>) -> Vec<FloatingComponent> {
         let nm = if D == 2 { 3 } else { 6 };
         let comps: BTreeSet<usize> = self.body_component.iter().copied().collect();
+        let mut out = Vec::new();
         for comp in comps {
             let bodies: Vec<usize> =
                 (0..self.body_component.len()).filter(|&b| self.body_component[b] == comp).collect();
@@ -383,6 +397,7 @@ impl<const D: usize> DofMap<D> {
             centre /= count.max(1.0);
             let size = (hi - lo).norm().max(Real::MIN_POSITIVE);
             let mut gram = DMatrix::<Real>::zeros(nm, nm);
+            let mut groups = Vec::new();
             let mut seen = vec![false; self.groups.len()];
             for &b in &bodies {
                 for g in self.node_offset[b]..self.node_offset[b + 1] {
@@ -391,6 +406,7 @@ impl<const D: usize> DofMap<D> {
                         continue;
                     }
                     seen[gi] = true;
+                    groups.push(gi);
                     let grp = &self.groups[gi];
                     let y = (grp.position - centre) / size;
                     for c in &grp.constraints {
@@ -403,18 +419,92 @@ impl<const D: usize> DofMap<D> {
                     }
                 }
             }
-            let eig = gram.symmetric_eigen().eigenvalues;
-            let max = eig.iter().fold(0.0_f64, |a, &b| a.max(b));
-            let free = eig.iter().filter(|&&e| e <= 1e-10 * max.max(Real::MIN_POSITIVE)).count();
-            if free > 0 {
-                return Err(FemError::SemiCoercive {
-                    bodies: bodies.iter().map(|&b| model.bodies()[b].name.clone()).collect(),
-                    free_modes: free,
-                });
+            let eig = gram.symmetric_eigen();
+            let max = eig.eigenvalues.iter().fold(0.0_f64, |a, &b| a.max(b));
+            let free: Vec<usize> = (0..nm)
+                .filter(|&i| eig.eigenvalues[i] <= 1e-10 * max.max(Real::MIN_POSITIVE))
+                .collect();
+            if free.is_empty() {
+                continue;
             }
+            let mut dofs = Vec::new();
+            for &gi in &groups {
+                let grp = &self.groups[gi];
+                dofs.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
+            }
+            let mut modes: Vec<Vec<Real>> = Vec::with_capacity(free.len());
+            for &i in &free {
+                let coeff = eig.eigenvectors.column(i);
+                let mut v = vec![0.0; self.n_dofs];
+                for &gi in &groups {
+                    let grp = &self.groups[gi];
+                    let y = (grp.position - centre) / size;
+                    let r = rigid_motion_at::<D>(coeff.as_slice(), &y);
+                    for k in 0..grp.n_dofs {
+                        v[grp.first_dof + k] = grp.basis[k].dot(&r);
+                    }
+                }
+                // Gram–Schmidt against the previous modes (twice, for round-off).
+                for _ in 0..2 {
+                    for m in &modes {
+                        let d: Real = dofs.iter().map(|&k| v[k] * m[k]).sum();
+                        for &k in &dofs {
+                            v[k] -= d * m[k];
+                        }
+                    }
+                }
+                let norm = dofs.iter().map(|&k| v[k] * v[k]).sum::<Real>().sqrt();
+                if norm > 1e-12 {
+                    for &k in &dofs {
+                        v[k] /= norm;
+                    }
+                    modes.push(v);
+                }
+            }
+            out.push(FloatingComponent {
+                bodies: bodies.iter().map(|&b| model.bodies()[b].name.clone()).collect(),
+                body_ids: bodies.iter().map(|&b| BodyId(b)).collect(),
+                modes,
+                dofs,
+            });
         }
-        Ok(())
+        out
     }
+}
+
+/// A connected set of bodies whose constraints leave rigid motions free (spec §4,
+/// semi-coercive): the kernel of `K̃` restricted to it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloatingComponent {
+    /// Names of the bodies.
+    pub bodies: Vec<String>,
+    /// Their ids.
+    pub body_ids: Vec<BodyId>,
+    /// Orthonormal kernel vectors in the reduced unknowns (zero outside [`Self::dofs`]).
+    pub modes: Vec<Vec<Real>>,
+    /// The reduced unknowns of the component's bodies.
+    pub dofs: Vec<usize>,
+}
+
+/// `r(y) = Σ_m c_m r_m(y)` for the rigid modes of [`rigid_mode_row`].
+fn rigid_motion_at<const D: usize>(c: &[Real], y: &Vector<D>) -> Vector<D> {
+    let mut r = Vector::<D>::zeros();
+    for k in 0..D {
+        r[k] = c[k];
+    }
+    if D == 2 {
+        r[0] -= c[2] * y[1];
+        r[1] += c[2] * y[0];
+    } else {
+        // c_3 e_x × y + c_4 e_y × y + c_5 e_z × y
+        r[1] += -c[3] * y[2];
+        r[2] += c[3] * y[1];
+        r[0] += c[4] * y[2];
+        r[2] += -c[4] * y[0];
+        r[0] += -c[5] * y[1];
+        r[1] += c[5] * y[0];
+    }
+    r
 }
 
 /// `(cᵀ r_m(y))_m` for the rigid modes: translations `e_k`, rotations `e_k × y` (3D) or

@@ -8,7 +8,7 @@ use nalgebra::DMatrix;
 use synovia_mesh::math::{Real, Vector};
 
 use crate::assembly::{add_loads, assemble_matrix, body_stiffnesses, pattern, subtract_lift};
-use crate::dofs::DofMap;
+use crate::dofs::{DofMap, FloatingComponent};
 use crate::element::stiffness_into;
 use crate::error::FemError;
 use crate::model::Model;
@@ -85,15 +85,61 @@ pub struct ElasticSolver<const D: usize> {
     body_c: Vec<DMatrix<Real>>,
     params: ElasticParams,
     info: ElasticInfo,
+    stabilisation: Option<Stabilisation>,
+}
+
+/// The regularisation of a semi-coercive model (spec §4): the floating components, the
+/// diagonal spring `S` on their unknowns, and `A + S` (which is what the factorisation holds).
+///
+/// `S_ii = ε A_ii` on the unknowns of every floating component (`ε` =
+/// [`Stabilisation::EPSILON`]) makes `A + S` positive definite without changing the solution
+/// of a contact problem: the contact solve iterates the proximal-point scheme
+/// `min_u L(u) + ½ (u − u_k)ᵀ S (u − u_k)`, whose fixed point is a minimiser of `L` (see
+/// `synovia_contact::StaticContact::solve`).
+#[derive(Debug, Clone)]
+pub struct Stabilisation {
+    /// The floating components (kernel of `A`).
+    pub components: Vec<FloatingComponent>,
+    /// The diagonal of `S` (one entry per reduced unknown, zero outside the components).
+    pub spring: Vec<Real>,
+    /// `A + S`.
+    pub matrix: SymmetricMatrix,
+}
+
+impl Stabilisation {
+    /// Relative spring stiffness `ε`.
+    pub const EPSILON: Real = 1e-5;
+
+    /// `S x` (diagonal).
+    pub fn spring_mul(&self, x: &[Real]) -> Vec<Real> {
+        self.spring.iter().zip(x).map(|(s, v)| s * v).collect()
+    }
 }
 
 impl<const D: usize> ElasticSolver<D> {
     /// Validates the model, builds the dofs, checks coercivity (spec §4), assembles `K̃`, and
     /// factorises it.
     pub fn new(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
+        Self::build(model, params, false)
+    }
+
+    /// Like [`ElasticSolver::new`], but a semi-coercive model (bodies whose rigid motions no
+    /// Dirichlet or symmetry data restrain, spec §4) is accepted: the factorisation is of
+    /// `A + S` with the [`Stabilisation`] spring `S` on the floating components, for contact
+    /// problems whose contact conditions hold those bodies. [`ElasticSolver::solve`] still
+    /// refuses such a model ([`FemError::SemiCoercive`]): without contact it has no unique
+    /// solution.
+    pub fn new_semi_coercive(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
+        Self::build(model, params, true)
+    }
+
+    fn build(model: &Model<D>, params: ElasticParams, allow_floating: bool) -> Result<Self, FemError> {
         let t0 = Instant::now();
         let dofs = DofMap::new(model)?;
-        dofs.check_coercive(model)?;
+        let floating = dofs.floating_components(model);
+        if let (false, Some(c)) = (allow_floating, floating.first()) {
+            return Err(FemError::SemiCoercive { bodies: c.bodies.clone(), free_modes: c.modes.len() });
+        }
         let (mut stiffness, metis) = pattern(model, &dofs)?;
         let setup_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
@@ -104,8 +150,27 @@ impl<const D: usize> ElasticSolver<D> {
             (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => Ordering::Amd,
             _ => metis,
         };
-        let mut cholesky = CholeskySolver::analyse(&stiffness, &ordering)?;
-        cholesky.factorize(&stiffness)?;
+        let stabilisation = if floating.is_empty() {
+            None
+        } else {
+            let diag = stiffness.diagonal();
+            let mut spring = vec![0.0; dofs.n_dofs()];
+            for c in &floating {
+                for &k in &c.dofs {
+                    spring[k] = Stabilisation::EPSILON * diag[k];
+                }
+            }
+            let mut matrix = stiffness.clone();
+            for (k, s) in spring.iter().enumerate() {
+                if *s != 0.0 {
+                    matrix.add(k, k, *s)?;
+                }
+            }
+            Some(Stabilisation { components: floating, spring, matrix })
+        };
+        let system = stabilisation.as_ref().map_or(&stiffness, |s| &s.matrix);
+        let mut cholesky = CholeskySolver::analyse(system, &ordering)?;
+        cholesky.factorize(system)?;
         let ci = cholesky.info();
         let info = ElasticInfo {
             n_dofs: dofs.n_dofs(),
@@ -117,7 +182,7 @@ impl<const D: usize> ElasticSolver<D> {
             numeric_s: ci.numeric_s,
             solve_s: 0.0,
         };
-        Ok(Self { dofs, stiffness, cholesky, body_c, params, info })
+        Ok(Self { dofs, stiffness, cholesky, body_c, params, info, stabilisation })
     }
 
     /// The reduced right-hand side `F̃(t) = Pᵀ (F(t) − K u_p(t))`.
@@ -132,6 +197,9 @@ impl<const D: usize> ElasticSolver<D> {
 
     /// Solves the load case at time `t` (loads `F(t)`, `P(t)`, prescribed `u₂(t)`).
     pub fn solve(&mut self, model: &Model<D>, t: Real) -> Result<ElasticSolution<D>, FemError> {
+        if let Some(c) = self.stabilisation.as_ref().and_then(|s| s.components.first()) {
+            return Err(FemError::SemiCoercive { bodies: c.bodies.clone(), free_modes: c.modes.len() });
+        }
         let t0 = Instant::now();
         let (mut x, lifts) = self.rhs(model, t)?;
         self.cholesky.solve_in_place(&mut x)?;
@@ -157,9 +225,18 @@ impl<const D: usize> ElasticSolver<D> {
     pub fn stiffness(&self) -> &SymmetricMatrix {
         &self.stiffness
     }
-    /// The factorisation of `K̃`.
+    /// The factorisation of [`ElasticSolver::system_matrix`].
     pub fn cholesky(&self) -> &CholeskySolver {
         &self.cholesky
+    }
+    /// The matrix that [`ElasticSolver::cholesky`] factorises: `K̃`, or `K̃ + S` for a
+    /// semi-coercive model ([`ElasticSolver::new_semi_coercive`]).
+    pub fn system_matrix(&self) -> &SymmetricMatrix {
+        self.stabilisation.as_ref().map_or(&self.stiffness, |s| &s.matrix)
+    }
+    /// The stabilisation of a semi-coercive model (`None` if the model is coercive).
+    pub fn stabilisation(&self) -> Option<&Stabilisation> {
+        self.stabilisation.as_ref()
     }
     /// Sizes and timings.
     pub fn info(&self) -> ElasticInfo {

@@ -26,9 +26,9 @@ pub mod quadrature;
 pub mod solver;
 pub mod sparse;
 
-pub use dofs::DofMap;
+pub use dofs::{DofMap, FloatingComponent};
 pub use elastic::{
-    solve_elastic, ElasticInfo, ElasticParams, ElasticSolution, ElasticSolver, OrderingChoice,
+    solve_elastic, ElasticInfo, ElasticParams, ElasticSolution, ElasticSolver, OrderingChoice, Stabilisation,
 };
 pub use error::FemError;
 pub use model::{Body, BodyId, ComponentMask, Model, TractionField, VectorField};

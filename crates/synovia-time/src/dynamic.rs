@@ -733,6 +733,7 @@ impl<const D: usize> DynamicStepper<D> {
                 slip_bound: slip_bound.iter().map(|g| g / dt2).collect(),
                 kkt,
                 coarse_iterations: 0,
+                proximal_iterations: 0,
             };
             record.pairs = pair_records(&self.geometry, &res);
             self.last = Some(res);
