@@ -21,10 +21,13 @@ use std::time::Instant;
 
 use synovia_contact::operators::{ContactPair, PlaneObstacle};
 use synovia_contact::{ContactError, ContactSolver};
-use synovia_fem::{ElasticParams, ElasticSolver, FemError, Model};
+use synovia_fem::{BodyId, ElasticParams, ElasticSolver, FemError, Model};
 use synovia_material::{isotropic, plane_strain};
-use synovia_mesh::generators::{half_disc_refined, hemisphere_refined, nodes_1d, rectangle, Grading};
+use synovia_mesh::generators::{
+    box_mesh, half_disc_refined, hemisphere_refined, nodes_1d, rectangle, Grading,
+};
 use synovia_mesh::math::{Point, Real, Vector};
+use synovia_mesh::refine::StraightMidpoint;
 use synovia_mesh::BoundaryKind;
 
 use crate::contact::{StaticContact, StaticContactResult};
@@ -586,6 +589,8 @@ pub struct HertzBlock2d {
     pub window: Real,
     /// `true`: the indenter's nodes are the slave nodes (block = master); `false`: the block's.
     pub slave_indenter: bool,
+    /// `true`: dual mortar ([`ContactPair::mortar`]); `false` (default): node-to-segment.
+    pub mortar: bool,
     /// Warm-start by nested iteration on the contact rows (default `true`).
     pub nested: bool,
 }
@@ -608,6 +613,7 @@ impl Default for HertzBlock2d {
             block_h_far: 0.1,
             window: 0.12,
             slave_indenter: true,
+            mortar: false,
             nested: true,
         }
     }
@@ -663,12 +669,27 @@ pub fn hertz2d_block_model(p: &HertzBlock2d) -> Result<(Model<2>, Vec<ContactPai
     model.prescribe(up, "top", move |_, t| Vector::<2>::new(t, -push)).map_err(fem)?;
     let lo =
         model.add_body("block", block, Arc::new(plane_strain(p.e2, p.nu2).map_err(fem)?)).map_err(fem)?;
-    let pair = if p.slave_indenter {
-        ContactPair::node_to_segment("indenter-block", up, "contact", lo, "top")
-    } else {
-        ContactPair::node_to_segment("block-indenter", lo, "top", up, "contact")
-    };
+    let pair = non_matching_pair(p.mortar, p.slave_indenter, (up, "contact"), (lo, "top"));
     Ok((model, vec![pair]))
+}
+
+/// The pair of an indenter–block problem: node-to-segment or mortar, either side slave.
+fn non_matching_pair<const D: usize>(
+    mortar: bool,
+    slave_indenter: bool,
+    indenter: (BodyId, &str),
+    block: (BodyId, &str),
+) -> ContactPair<D> {
+    let ((bk, pk), (bl, pl), name) = if slave_indenter {
+        (indenter, block, "indenter-block")
+    } else {
+        (block, indenter, "block-indenter")
+    };
+    if mortar {
+        ContactPair::mortar(name, bk, pk, bl, pl)
+    } else {
+        ContactPair::node_to_segment(name, bk, pk, bl, pl)
+    }
 }
 
 /// Solves [`HertzBlock2d`] with `solver` and measures `a`, `p₀` (fit of the slave nodal
@@ -687,7 +708,12 @@ pub fn hertz2d_block(p: &HertzBlock2d, solver: &dyn ContactSolver) -> Result<Con
     let e_star = 1.0 / inv_e;
     let a_exact = (4.0 * force * p.radius / (std::f64::consts::PI * e_star)).sqrt();
     let p0_exact = 2.0 * force / (std::f64::consts::PI * a_exact);
-    let name = if p.slave_indenter { "hertz2d_block_slave_indenter" } else { "hertz2d_block_slave_block" };
+    let name = match (p.mortar, p.slave_indenter) {
+        (false, true) => "hertz2d_block_slave_indenter",
+        (false, false) => "hertz2d_block_slave_block",
+        (true, true) => "hertz2d_block_mortar_slave_indenter",
+        (true, false) => "hertz2d_block_mortar_slave_block",
+    };
     let mut run = hertz_run(
         name,
         p.levels,
@@ -702,4 +728,158 @@ pub fn hertz2d_block(p: &HertzBlock2d, solver: &dyn ContactSolver) -> Result<Con
     // mesh size at the contact point of the slave side
     run.h = if p.slave_indenter { contact_h(&model) } else { p.block_h };
     Ok(run)
+}
+
+/// Parameters of the 3D Hertz problem on non-matching meshes: the hemisphere of [`Hertz3d`]
+/// (radius `R`, refined toward its pole) pressed by a prescribed displacement of its flat top
+/// onto an elastic block `[−W, W]² × [−H, 0]` clamped at its base, meshed as a coarse Kuhn box
+/// ([`box_mesh`], `block_n` hexes along `W` and `H`) refined `block_levels` times toward the
+/// ball of radius `block_refine_radius` around the contact point (bisection,
+/// [`synovia_mesh::refine::refine_toward`]): another mesh, with nodes that do not match the
+/// indenter's. The pair is node-to-facet or dual mortar.
+///
+/// Reference: the Hertz point contact of a sphere on a half-space, `1/E* = Σ (1 − ν_i²)/E_i`,
+/// `R* = R`, `a = (3 P R*/(4 E*))^{1/3}`, `p₀ = 3P/(2π a²)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HertzBlock3d {
+    /// Radius `R` of the indenter.
+    pub radius: Real,
+    /// Young's modulus of the indenter.
+    pub e1: Real,
+    /// Its Poisson ratio.
+    pub nu1: Real,
+    /// Young's modulus of the block.
+    pub e2: Real,
+    /// Its Poisson ratio.
+    pub nu2: Real,
+    /// Vertical push of the indenter's top.
+    pub push: Real,
+    /// Coarse cells of the indenter along its radius.
+    pub n: usize,
+    /// Refinement levels of the indenter toward its pole.
+    pub levels: usize,
+    /// Radius of the indenter's refined zone (multiple of `R`).
+    pub refine_radius: Real,
+    /// Half-width `W` of the block.
+    pub half_width: Real,
+    /// Depth `H` of the block.
+    pub depth: Real,
+    /// Coarse hexes of the block along `W` (and along `H`).
+    pub block_n: usize,
+    /// Refinement levels of the block toward the contact point (`h` halves about every three).
+    pub block_levels: usize,
+    /// Radius of the block's refined zone around the contact point.
+    pub block_refine_radius: Real,
+    /// `true`: the indenter's nodes are the slave nodes (block = master); `false`: the block's.
+    pub slave_indenter: bool,
+    /// `true` (default): dual mortar ([`ContactPair::mortar`]); `false`: node-to-facet.
+    pub mortar: bool,
+    /// Warm-start by nested iteration on the contact rows (default `true`).
+    pub nested: bool,
+}
+
+impl Default for HertzBlock3d {
+    fn default() -> Self {
+        Self {
+            radius: 1.0,
+            e1: 1.0,
+            nu1: 0.3,
+            e2: 1.0,
+            nu2: 0.3,
+            push: 0.01,
+            n: 4,
+            levels: 12,
+            refine_radius: 0.15,
+            half_width: 1.0,
+            depth: 1.0,
+            block_n: 3,
+            block_levels: 12,
+            block_refine_radius: 0.15,
+            slave_indenter: true,
+            mortar: true,
+            nested: true,
+        }
+    }
+}
+
+/// The model of [`HertzBlock3d`]: body 0 `"indenter"` (contact part `"contact"`: its cap below
+/// `z < 0.15 R`; its top moved by `(t, 0, −push)` at time `t`), body 1 `"block"` (contact part
+/// `"top"`), and the pair.
+pub fn hertz3d_block_model(p: &HertzBlock3d) -> Result<(Model<3>, Vec<ContactPair<3>>), ContactError> {
+    let r = p.radius;
+    let mut upper = hemisphere_refined(
+        Point::<3>::new(0.0, 0.0, r),
+        r,
+        p.n,
+        Point::<3>::zeros(),
+        p.refine_radius * r,
+        p.levels,
+    )?;
+    upper.set_part_kind("top", BoundaryKind::Prescribed)?;
+    upper.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
+    let (w, d, nb) = (p.half_width, p.depth, p.block_n.max(1));
+    let coarse = box_mesh([-w, -w, -d], [w, w, 0.0], [2 * nb, 2 * nb, nb], [Grading::Uniform; 3])?;
+    let rr = p.block_refine_radius;
+    let mut block = coarse.refined_toward(|x| x.norm() <= rr, p.block_levels, &StraightMidpoint)?;
+    block.set_part_kind("bottom", BoundaryKind::Clamped)?;
+    block.set_part_kind("top", BoundaryKind::Contact)?;
+    let mut model = Model::<3>::new();
+    let up =
+        model.add_body("indenter", upper, Arc::new(isotropic(p.e1, p.nu1).map_err(fem)?)).map_err(fem)?;
+    let push = p.push;
+    model.prescribe(up, "top", move |_, t| Vector::<3>::new(t, 0.0, -push)).map_err(fem)?;
+    let lo = model.add_body("block", block, Arc::new(isotropic(p.e2, p.nu2).map_err(fem)?)).map_err(fem)?;
+    let pair = non_matching_pair(p.mortar, p.slave_indenter, (up, "contact"), (lo, "top"));
+    Ok((model, vec![pair]))
+}
+
+/// Smallest `sqrt(area)` of the facets of part `part` of body `body`.
+fn part_h(model: &Model<3>, body: usize, part: &str) -> Real {
+    let mesh = &model.bodies()[body].mesh;
+    mesh.boundary_part(part)
+        .map(|p| p.facets().map(|f| mesh.facet_measure(f).sqrt()).fold(Real::INFINITY, Real::min))
+        .unwrap_or(Real::NAN)
+}
+
+/// Solves [`HertzBlock3d`] with `solver` and measures `a`, `p₀` (fit of the slave nodal
+/// pressures against the radius) and the pressure profile against the Hertz point contact for
+/// the computed force. Returns the run and the contact mesh sizes `(indenter h, block h)`
+/// (smallest `sqrt(facet area)`).
+pub fn hertz3d_block(
+    p: &HertzBlock3d,
+    solver: &dyn ContactSolver,
+) -> Result<(ContactRun, (Real, Real)), ContactError> {
+    let (model, pairs) = hertz3d_block_model(p)?;
+    let linear_solve_s = linear_solve_time(&model)?;
+    let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+    sc.set_nested_iteration(p.nested.then_some(32));
+    let t0 = Instant::now();
+    let res = sc.solve(&model, 0.0, solver, None, None, None)?;
+    let solve_s = t0.elapsed().as_secs_f64();
+    let geo = sc.geometry();
+    let force = res.normal_force(geo, 0..geo.len());
+    let inv_e = (1.0 - p.nu1 * p.nu1) / p.e1 + (1.0 - p.nu2 * p.nu2) / p.e2;
+    let e_star = 1.0 / inv_e;
+    let a_exact = (3.0 * force * p.radius / (4.0 * e_star)).cbrt();
+    let p0_exact = 3.0 * force / (2.0 * std::f64::consts::PI * a_exact * a_exact);
+    let name = match (p.mortar, p.slave_indenter) {
+        (false, true) => "hertz3d_block_slave_indenter",
+        (false, false) => "hertz3d_block_slave_block",
+        (true, true) => "hertz3d_block_mortar_slave_indenter",
+        (true, false) => "hertz3d_block_mortar_slave_block",
+    };
+    let mut run = hertz_run(
+        name,
+        p.levels,
+        &model,
+        &sc,
+        &res,
+        solver,
+        (solve_s, linear_solve_s),
+        (force, a_exact, p0_exact),
+        |x| (x[0] * x[0] + x[1] * x[1]).sqrt(),
+    );
+    let h = (part_h(&model, 0, "contact"), part_h(&model, 1, "top"));
+    run.h = if p.slave_indenter { h.0 } else { h.1 };
+    Ok((run, h))
 }

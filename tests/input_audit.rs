@@ -143,3 +143,222 @@ fn duplicated_node_in_a_contact_part_is_named() {
     assert_eq!(pair, "floor");
     assert!(reason.contains("nodes 1 and 4") && reason.contains("duplicated"), "{reason}");
 }
+
+/// Public constructors of meshes, generators, load histories, sparse matrices and run
+/// parameters: every bad input below is a typed error whose message names the entity (checked
+/// by a fragment of the message), never a panic and never an accepted model.
+#[test]
+fn public_constructors_reject_bad_input_with_named_errors() {
+    use std::panic::{catch_unwind, AssertUnwindSafe};
+    use synovia::time::history::Periodic;
+    let square = || {
+        vec![
+            Point::<2>::new(0.0, 0.0),
+            Point::<2>::new(1.0, 0.0),
+            Point::<2>::new(0.0, 1.0),
+            Point::<2>::new(1.0, 1.0),
+        ]
+    };
+    let triangle = || square()[..3].to_vec();
+    let tet = || {
+        vec![
+            Point::<3>::zeros(),
+            Point::<3>::new(1.0, 0.0, 0.0),
+            Point::<3>::new(0.0, 1.0, 0.0),
+            Point::<3>::new(0.0, 0.0, 1.0),
+        ]
+    };
+    let err = |r: Result<(), String>| r.err().unwrap_or_default();
+    let mesh2 = |nodes: Vec<Point<2>>, cells: Vec<usize>| {
+        Mesh::<2>::new(nodes, cells).map(|_| ()).map_err(|e| e.to_string())
+    };
+    let block_joint = || {
+        let mut j = JointModel::<2>::new();
+        let mesh = rectangle(0.0, 1.0, 0.0, 0.5, 4, 2, Grading::Uniform, Grading::Uniform).expect("mesh");
+        let b = j.add_body("block", mesh, plane_strain(1.0, 0.3).expect("m")).expect("b");
+        (j, b)
+    };
+    type Case<'a> = (&'a str, Box<dyn Fn() -> Result<(), String> + 'a>, &'a str);
+    let cases: Vec<Case> = vec![
+        ("ragged cell array", Box::new(move || mesh2(square(), vec![0, 1, 2, 3])), "3"),
+        ("repeated node in a cell", Box::new(move || mesh2(square(), vec![0, 0, 1])), "node 0"),
+        ("no cells", Box::new(move || mesh2(square(), vec![])), "no cells"),
+        ("node in no cell", Box::new(move || mesh2(square(), vec![0, 1, 2])), "node 3"),
+        ("duplicated cell", Box::new(move || mesh2(triangle(), vec![0, 1, 2, 0, 1, 2])), "cells 1 and 0"),
+        (
+            "folded (overlapping) cells",
+            Box::new(move || mesh2(square(), vec![0, 1, 2, 0, 1, 3])),
+            "cells 1 and 0",
+        ),
+        (
+            "NaN coordinate",
+            Box::new(move || {
+                mesh2(
+                    vec![
+                        Point::<2>::new(f64::NAN, 0.0),
+                        Point::<2>::new(1.0, 0.0),
+                        Point::<2>::new(0.0, 1.0),
+                    ],
+                    vec![0, 1, 2],
+                )
+            }),
+            "node 0",
+        ),
+        (
+            "zero-area triangle",
+            Box::new(move || {
+                mesh2(
+                    vec![Point::<2>::new(0.0, 0.0), Point::<2>::new(1.0, 0.0), Point::<2>::new(2.0, 0.0)],
+                    vec![0, 1, 2],
+                )
+            }),
+            "cell 0",
+        ),
+        (
+            "duplicated tetrahedron",
+            Box::new(move || {
+                Mesh::<3>::new(tet(), vec![0, 1, 2, 3, 0, 1, 2, 3]).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "cells 1 and 0",
+        ),
+        (
+            "flat tetrahedron",
+            Box::new(move || {
+                let mut n = tet();
+                n[3] = Point::<3>::new(0.3, 0.3, 0.0);
+                Mesh::<3>::new(n, vec![0, 1, 2, 3]).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "cell 0",
+        ),
+        (
+            "rectangle with 0 cells",
+            Box::new(|| {
+                rectangle(0.0, 1.0, 0.0, 1.0, 0, 2, Grading::Uniform, Grading::Uniform)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            }),
+            "number of cells",
+        ),
+        (
+            "rectangle x1 < x0",
+            Box::new(|| {
+                rectangle(1.0, 0.0, 0.0, 1.0, 2, 2, Grading::Uniform, Grading::Uniform)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            }),
+            "a < b",
+        ),
+        (
+            "grading ratio NaN",
+            Box::new(|| {
+                rectangle(0.0, 1.0, 0.0, 1.0, 2, 2, Grading::Geometric { ratio: f64::NAN }, Grading::Uniform)
+                    .map(|_| ())
+                    .map_err(|e| e.to_string())
+            }),
+            "ratio",
+        ),
+        (
+            "history times decreasing",
+            Box::new(|| {
+                PiecewiseLinear::new(&[(1.0, 0.0), (0.0, 1.0)]).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "increase",
+        ),
+        (
+            "history NaN value",
+            Box::new(|| {
+                PiecewiseLinear::new(&[(0.0, f64::NAN), (1.0, 1.0)]).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "point 0",
+        ),
+        (
+            "periodic period 0",
+            Box::new(|| Periodic::new(Constant(1.0), 0.0).map(|_| ()).map_err(|e| e.to_string())),
+            "period",
+        ),
+        (
+            "Poisson ratio ½",
+            Box::new(|| plane_strain(1.0, 0.5).map(|_| ()).map_err(|e| e.to_string())),
+            "0.5",
+        ),
+        (
+            "Young's modulus ∞",
+            Box::new(|| isotropic(f64::INFINITY, 0.3).map(|_| ()).map_err(|e| e.to_string())),
+            "Young",
+        ),
+        (
+            "sparse matrix not symmetric",
+            Box::new(|| {
+                let m = sprs::CsMat::<f64>::new((2, 2), vec![0, 1, 2], vec![1, 0], vec![1.0, 2.0]);
+                synovia::fem::SymmetricMatrix::from_sprs(&m).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "not symmetric",
+        ),
+        (
+            "sparse matrix NaN entry",
+            Box::new(|| {
+                let m = sprs::CsMat::<f64>::new((2, 2), vec![0, 1, 2], vec![0, 1], vec![f64::NAN, 2.0]);
+                synovia::fem::SymmetricMatrix::from_sprs(&m).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "(0, 0)",
+        ),
+        (
+            "negative density",
+            Box::new(move || {
+                let (mut j, b) = block_joint();
+                j.set_density(b, -1.0).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "density",
+        ),
+        (
+            "zero contact tolerance",
+            Box::new(move || {
+                let (mut j, b) = block_joint();
+                j.prescribe_field(b, "top", ComponentMask::ALL, |_, _| Vector::<2>::new(0.0, -0.01))
+                    .map_err(|e| e.to_string())?;
+                let floor = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0))
+                    .map_err(|e| e.to_string())?;
+                j.contact_rigid("floor", b, "bottom", floor, 0.0).map_err(|e| e.to_string())?;
+                j.contact_params(ContactParams { tolerance: 0.0, ..ContactParams::default() });
+                j.run_static(0.0).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "tolerance",
+        ),
+        (
+            "dynamic Δt = NaN",
+            Box::new(move || {
+                let (mut j, b) = block_joint();
+                j.set_density(b, 1.0).map_err(|e| e.to_string())?;
+                j.clamp(b, "bottom").map_err(|e| e.to_string())?;
+                j.run_dynamic(f64::NAN, 3).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "Δt",
+        ),
+        (
+            "quasi-static times decreasing",
+            Box::new(move || {
+                let (mut j, b) = block_joint();
+                j.clamp(b, "bottom").map_err(|e| e.to_string())?;
+                j.run_quasistatic(&[1.0, 0.0]).map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "increase",
+        ),
+        (
+            "unknown solver",
+            Box::new(move || {
+                let (mut j, _) = block_joint();
+                j.solver("newton-raphson").map(|_| ()).map_err(|e| e.to_string())
+            }),
+            "newton-raphson",
+        ),
+    ];
+    let mut errors = 0;
+    for (what, f, fragment) in &cases {
+        let out = catch_unwind(AssertUnwindSafe(f)).unwrap_or_else(|_| panic!("{what}: panicked"));
+        let msg = err(out);
+        assert!(!msg.is_empty(), "{what}: accepted");
+        assert!(msg.contains(fragment), "{what}: message `{msg}` does not name `{fragment}`");
+        errors += 1;
+    }
+    println!("public constructors: {} bad inputs, {errors} typed errors, 0 panics", cases.len());
+}

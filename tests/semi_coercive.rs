@@ -5,10 +5,10 @@
 //! Numbers printed with `--nocapture` are the ones in `docs/reliability.md`.
 
 use synovia::contact_ops::ContactError;
-use synovia::time::TimeError;
 use synovia::hertz::fit_elliptic;
 use synovia::prelude::*;
 use synovia::solvers::by_name;
+use synovia::time::TimeError;
 use synovia_mesh::generators::{half_disc_refined, hemisphere_refined};
 
 const E: f64 = 1.0;
@@ -77,11 +77,14 @@ fn floating_block_pressed_onto_a_flat_transmits_the_pressure_exactly() {
 
 #[test]
 fn load_pulling_a_floating_body_away_is_rejected() {
-    for (what, load) in [("pulled up", Vector::<2>::new(0.0, P)), ("pushed sideways", Vector::<2>::new(P, -P))] {
+    for (what, load) in
+        [("pulled up", Vector::<2>::new(0.0, P)), ("pushed sideways", Vector::<2>::new(P, -P))]
+    {
         let joint = floating_block(load, false, 0.0);
         match joint.run_static(0.0) {
             Err(JointError::Time(TimeError::Contact {
-                source: ContactError::Unbalanced { bodies, residual, load }, ..
+                source: ContactError::Unbalanced { bodies, residual, load },
+                ..
             })) => {
                 assert_eq!(bodies, vec!["floating".to_string()]);
                 assert!(residual > 0.1 * load, "{what}: {residual} of {load}");
@@ -112,9 +115,7 @@ fn friction_holds_a_floating_block_below_its_capacity_and_not_above() {
         let mesh = rectangle(0.0, 1.0, 0.0, 0.5, 12, 6, Grading::Uniform, Grading::Uniform).expect("mesh");
         let mut joint = JointModel::<2>::new();
         let block = joint.add_body("floating", mesh, plane_strain(E, NU).expect("m")).expect("body");
-        joint
-            .traction_field(block, "top", move |_, _, t| Vector::<2>::new(q * t, -P))
-            .expect("traction");
+        joint.traction_field(block, "top", move |_, _, t| Vector::<2>::new(q * t, -P)).expect("traction");
         let flat = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0)).expect("plane");
         joint.contact_rigid("block-flat", block, "bottom", flat, 0.3).expect("pair");
         let out = joint.run_quasistatic(&[0.0, 0.5, 1.0]);
@@ -125,7 +126,12 @@ fn friction_holds_a_floating_block_below_its_capacity_and_not_above() {
             assert!((last.normal_force - P).abs() < 1e-8 * P, "{last:?}");
             let kkt = run.contact.as_ref().expect("contact").kkt;
             assert!(kkt.satisfied(1e-7), "{kkt:?}");
-            println!("Q/μP = {:.3}: held, T = {:.6e}, KKT {:.2e}", q / (0.3 * P), last.tangential_force, kkt.max());
+            println!(
+                "Q/μP = {:.3}: held, T = {:.6e}, KKT {:.2e}",
+                q / (0.3 * P),
+                last.tangential_force,
+                kkt.max()
+            );
         } else {
             let err = out.expect_err("a tangential load above μP cannot be held");
             let msg = err.to_string();
@@ -144,9 +150,7 @@ fn floating_half_disc_pressed_onto_a_flat_matches_hertz() {
     let mut joint = JointModel::<2>::new();
     let disc = joint.add_body("indenter", mesh, plane_strain(E, NU).expect("m")).expect("body");
     joint.pressure(disc, "top", force / 2.0, Constant(1.0)).expect("pressure");
-    joint
-        .define_part(disc, "contact", |x, n| x[1] < 0.3 && n[1] < 0.0)
-        .expect("part");
+    joint.define_part(disc, "contact", |x, n| x[1] < 0.3 && n[1] < 0.0).expect("part");
     let flat = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0)).expect("plane");
     joint.contact_rigid("indenter-flat", disc, "contact", flat, 0.0).expect("pair");
     let run = joint.run_static(0.0).expect("solvable");
@@ -158,8 +162,7 @@ fn floating_half_disc_pressed_onto_a_flat_matches_hertz() {
     let a_exact = (4.0 * force / (std::f64::consts::PI * e_star)).sqrt();
     let p0_exact = 2.0 * force / (std::f64::consts::PI * a_exact);
     let geometry = contact_geometry_2d(&joint);
-    let pts: Vec<(f64, f64)> =
-        geometry.iter().zip(&res.solution.lambda_n).map(|(x, l)| (x[0], *l)).collect();
+    let pts: Vec<(f64, f64)> = geometry.iter().zip(&res.solution.lambda_n).map(|(x, l)| (x[0], *l)).collect();
     let (a, p0) = fit_elliptic(&pts);
     let (ea, ep) = ((a - a_exact).abs() / a_exact, (p0 - p0_exact).abs() / p0_exact);
     println!(
@@ -208,11 +211,13 @@ fn floating_hemisphere_pressed_onto_a_flat_matches_hertz() {
 }
 
 fn contact_geometry_2d(joint: &JointModel<2>) -> Vec<Point<2>> {
-    let geo = synovia::contact_ops::operators::ContactGeometry::new(joint.model(), joint.pairs()).expect("geo");
+    let geo =
+        synovia::contact_ops::operators::ContactGeometry::new(joint.model(), joint.pairs()).expect("geo");
     geo.nodes.iter().map(|n| n.position).collect()
 }
 
 fn contact_geometry_3d(joint: &JointModel<3>) -> Vec<Point<3>> {
-    let geo = synovia::contact_ops::operators::ContactGeometry::new(joint.model(), joint.pairs()).expect("geo");
+    let geo =
+        synovia::contact_ops::operators::ContactGeometry::new(joint.model(), joint.pairs()).expect("geo");
     geo.nodes.iter().map(|n| n.position).collect()
 }

@@ -1440,11 +1440,7 @@ fn analysis(cx: &Cx<'_>, a: &Sp<AnalysisSpec>) -> R<Analysis> {
                     }
                     let max_steps = limits().max_time_steps;
                     if *steps > max_steps {
-                        return Err(cx.err(
-                            tk,
-                            t.span(),
-                            format!("at most {max_steps} steps, got {steps}"),
-                        ));
+                        return Err(cx.err(tk, t.span(), format!("at most {max_steps} steps, got {steps}")));
                     }
                     (0..=*steps).map(|i| start + (end - start) * i as f64 / *steps as f64).collect()
                 }

@@ -11,8 +11,9 @@
 //! Λ_t − π(Λ_t + ρ B_Ht (U − U_prev))      = 0
 //! ```
 //!
-//! Contact pairs are node-to-node (matching meshes), node-to-segment / node-to-facet
-//! (non-matching meshes, with the R*-tree contact search of [`search`]) or body-to-obstacle;
+//! Contact pairs are node-to-node (matching meshes), node-to-segment / node-to-facet or dual
+//! mortar (non-matching meshes, with the R*-tree contact search of [`search`]; [`mortar`]) or
+//! body-to-obstacle;
 //! the geometry can be rebuilt at every pose ([`operators::ContactGeometry::new_deformed`],
 //! [`StaticContact::update_geometry`]).
 //!
@@ -25,6 +26,7 @@ pub mod error;
 pub mod floating;
 pub mod friction;
 pub mod kkt;
+pub mod mortar;
 pub mod nested;
 pub mod operators;
 pub mod problem;

@@ -3,7 +3,8 @@
 //! A [`ContactPair`] joins the contact part of a body `k` either to the contact part of another
 //! body `l` with nodes at matching positions (node-to-node, the conforming case of the report),
 //! to the contact part of another body `l` with an arbitrary (non-matching) mesh
-//! (node-to-segment in 2D, node-to-facet in 3D: [`Partner::Segment`]), or to a rigid obstacle
+//! (node-to-segment in 2D, node-to-facet in 3D: [`Partner::Segment`]; dual mortar:
+//! [`Partner::Mortar`]), or to a rigid obstacle
 //! described by a signed-distance function (the foundation case). For every contact node `s_r`
 //! of body `k` [`ContactGeometry`] stores
 //!
@@ -52,6 +53,15 @@
 //! uniform pressure on non-matching meshes (the slave nodal forces are passed to the master
 //! nodes by point interpolation, not by the mortar integral); see `docs/contact.md` for the
 //! measured error.
+//!
+//! # Non-matching meshes: dual mortar
+//!
+//! A [`Partner::Mortar`] pair ([`ContactPair::mortar`]) couples slave part `k` and master part
+//! `l` with Wohlmuth's dual (biorthogonal) multipliers ([`crate::mortar`]): `D` is diagonal, so
+//! each slave node `j` keeps one row of the same form, `n_j · (u_j − Σ_k w_jk u_k) ≤ d_j` with
+//! `w_jk = M_jk / D_jj` ([`ContactNode::master`]), `κ_j = D_jj` and `d_j = g̃_j / D_jj` (the
+//! weighted gap), `n_j` the slave nodal normal. Friction rows use the slave tangent basis as
+//! above. The solvers run unchanged; a uniform pressure is transmitted exactly.
 //!
 //! # Rebuilding the geometry at a pose
 //!
@@ -330,6 +340,20 @@ pub enum Partner<const D: usize> {
         /// facet).
         search_distance: Option<Real>,
     },
+    /// The contact part `part` of body `body` with any mesh, coupled by dual mortar
+    /// (Wohlmuth's biorthogonal multipliers; exact segment integration in 2D, polygon clipping
+    /// in 3D): body `k` is the slave side (it carries the multipliers), body `l` the master
+    /// side. One condensed row per slave node; see [`crate::mortar`].
+    Mortar {
+        /// The other (master) body `l`.
+        body: BodyId,
+        /// Its contact part.
+        part: String,
+        /// Largest gap (along the slave facet normal) of an integration cell; farther master
+        /// facets are not coupled (`None`: every master facet facing and overlapping a slave
+        /// facet near its closest master facet).
+        search_distance: Option<Real>,
+    },
 }
 
 /// A contact pair `Γ_c^{kl}` (spec §1, §3).
@@ -376,10 +400,25 @@ impl<const D: usize> ContactPair<D> {
             friction: 0.0,
         }
     }
-    /// Sets the search distance of a node-to-segment pair (no effect on other pairs).
+    /// Body–body pair on non-matching meshes coupled by **dual mortar** (2D and 3D; spec §5,
+    /// [`crate::mortar`]): `part_k` of body `k` is the slave side, `part_l` of body `l` the
+    /// master side; no search-distance limit (see [`ContactPair::with_search_distance`]).
+    /// Passes the contact patch test exactly on non-matching meshes.
+    pub fn mortar(name: &str, body_k: BodyId, part_k: &str, body_l: BodyId, part_l: &str) -> Self {
+        Self {
+            name: name.to_string(),
+            body: body_k,
+            part: part_k.to_string(),
+            partner: Partner::Mortar { body: body_l, part: part_l.to_string(), search_distance: None },
+            friction: 0.0,
+        }
+    }
+    /// Sets the search distance of a node-to-segment or mortar pair (no effect on other pairs).
     #[must_use]
     pub fn with_search_distance(mut self, distance: Real) -> Self {
-        if let Partner::Segment { search_distance, .. } = &mut self.partner {
+        if let Partner::Segment { search_distance, .. } | Partner::Mortar { search_distance, .. } =
+            &mut self.partner
+        {
             *search_distance = Some(distance);
         }
         self
@@ -421,7 +460,8 @@ pub struct ContactNode<const D: usize> {
     /// Partner node on body `l` (node-to-node), or `None` (rigid obstacle, node-to-segment).
     pub partner: Option<(BodyId, usize)>,
     /// Node-to-segment: the master nodes `(body l, node j, w_j)` of the master point
-    /// `Σ_j w_j x_{l,j}` (`w_j > 0`, `Σ_j w_j = 1`); empty for the other pair kinds.
+    /// `Σ_j w_j x_{l,j}` (`w_j > 0`, `Σ_j w_j = 1`); mortar: `w_j = M_rj / D_rr` (`Σ_j w_j = 1`,
+    /// some may be negative; [`crate::mortar`]); empty for the other pair kinds.
     pub master: Vec<(BodyId, usize, Real)>,
     /// Position of the node of body `k` (in the configuration the geometry was built on).
     pub position: Point<D>,
@@ -429,7 +469,7 @@ pub struct ContactNode<const D: usize> {
     pub normal: Vector<D>,
     /// Orthonormal tangents (`D − 1` used).
     pub tangents: [Vector<D>; 2],
-    /// Lumped weight `κ_r`.
+    /// Lumped weight `κ_r` (mortar: `D_rr`).
     pub weight: Real,
     /// Initial gap `d_r`.
     pub gap: Real,
@@ -752,6 +792,52 @@ impl<const D: usize> ContactGeometry<D> {
                     if nodes.len() == start {
                         return Err(invalid(format!(
                             "no node of part `{}` has a master facet of part `{pl}` (search distance {search_distance:?})",
+                            pair.part
+                        )));
+                    }
+                }
+                Partner::Mortar { body: bl, part: pl, search_distance } => {
+                    if *bl == pair.body {
+                        return Err(invalid(
+                            "self-contact (master body = slave body) is not supported".into(),
+                        ));
+                    }
+                    if let Some(s) = search_distance {
+                        if !(s.is_finite() && *s >= 0.0) {
+                            return Err(invalid(format!("search distance {s} must be finite and ≥ 0")));
+                        }
+                    }
+                    let other = model.body(*bl)?;
+                    let lfacets: Vec<Vec<usize>> =
+                        other.mesh.boundary_part(pl)?.facets().map(<[usize]>::to_vec).collect();
+                    let sfacets: Vec<Vec<usize>> = part.facets().map(<[usize]>::to_vec).collect();
+                    let rows =
+                        crate::mortar::mortar_rows(pos_k, &sfacets, &posed[bl.0], &lfacets, *search_distance);
+                    let normal_of: std::collections::HashMap<usize, Vector<D>> =
+                        normals.into_iter().collect();
+                    for row in rows {
+                        let Some(&n) = normal_of.get(&row.slave) else { continue };
+                        // total form: reference positions with the weights of the pose
+                        let xm = row
+                            .master
+                            .iter()
+                            .fold(Point::<D>::zeros(), |acc, &(j, w)| acc + other.mesh.node(j) * w);
+                        nodes.push(ContactNode {
+                            pair: pi,
+                            node: (pair.body, row.slave),
+                            partner: None,
+                            master: row.master.iter().map(|&(j, w)| (*bl, j, w)).collect(),
+                            position: pos_k[row.slave],
+                            normal: n,
+                            tangents: tangent_basis(&n),
+                            weight: row.d,
+                            gap: (xm - reference(row.slave)).dot(&n),
+                            friction: pair.friction,
+                        });
+                    }
+                    if nodes.len() == start {
+                        return Err(invalid(format!(
+                            "no node of part `{}` has enough mortar overlap with part `{pl}` (search distance {search_distance:?})",
                             pair.part
                         )));
                     }

@@ -421,9 +421,8 @@ impl<const D: usize> DofMap<D> {
             }
             let eig = gram.symmetric_eigen();
             let max = eig.eigenvalues.iter().fold(0.0_f64, |a, &b| a.max(b));
-            let free: Vec<usize> = (0..nm)
-                .filter(|&i| eig.eigenvalues[i] <= 1e-10 * max.max(Real::MIN_POSITIVE))
-                .collect();
+            let free: Vec<usize> =
+                (0..nm).filter(|&i| eig.eigenvalues[i] <= 1e-10 * max.max(Real::MIN_POSITIVE)).collect();
             if free.is_empty() {
                 continue;
             }

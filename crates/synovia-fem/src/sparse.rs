@@ -151,13 +151,40 @@ impl SymmetricMatrix {
         tri.to_csc()
     }
 
-    /// Builds from a (full or lower) `sprs` matrix; the upper triangle is ignored, so the input
-    /// must be symmetric. Errors on a non-square matrix.
+    /// Builds from a full symmetric or a lower-triangular `sprs` matrix. Errors on a
+    /// non-square matrix, non-finite entries, and a full matrix that is not symmetric (an
+    /// upper entry differing from its lower mirror by more than `1e-12 max |a_ij|`).
     pub fn from_sprs(m: &sprs::CsMat<f64>) -> Result<Self, FemError> {
         if m.rows() != m.cols() {
             return Err(FemError::Sparse(format!("matrix is {}×{}, not square", m.rows(), m.cols())));
         }
         let n = m.rows();
+        let mut upper: std::collections::HashMap<(usize, usize), f64> = std::collections::HashMap::new();
+        let mut lower: std::collections::HashMap<(usize, usize), f64> = std::collections::HashMap::new();
+        let mut amax: f64 = 0.0;
+        for (v, (i, j)) in m.iter() {
+            if !v.is_finite() {
+                return Err(FemError::Sparse(format!("entry ({i}, {j}) is {v}")));
+            }
+            amax = amax.max(v.abs());
+            match i.cmp(&j) {
+                std::cmp::Ordering::Less => *upper.entry((j, i)).or_insert(0.0) += v,
+                std::cmp::Ordering::Greater => *lower.entry((i, j)).or_insert(0.0) += v,
+                std::cmp::Ordering::Equal => {}
+            }
+        }
+        if !upper.is_empty() {
+            let tol = 1e-12 * amax;
+            for &(i, j) in lower.keys().chain(upper.keys()) {
+                let (a, b) =
+                    (lower.get(&(i, j)).copied().unwrap_or(0.0), upper.get(&(i, j)).copied().unwrap_or(0.0));
+                if (a - b).abs() > tol {
+                    return Err(FemError::Sparse(format!(
+                        "matrix is not symmetric: a[{i}][{j}] = {a:e} but a[{j}][{i}] = {b:e}"
+                    )));
+                }
+            }
+        }
         let mut cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); n];
         for (v, (i, j)) in m.iter() {
             if i >= j {

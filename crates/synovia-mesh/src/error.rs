@@ -57,6 +57,25 @@ pub enum MeshError {
         /// Relative determinant `det / h^D` (negative).
         det: f64,
     },
+    /// A node belongs to no cell (its displacement would be undetermined).
+    #[error("node {node} belongs to no cell (its displacement would be undetermined); remove it from the node list")]
+    UnusedNode {
+        /// Node index.
+        node: usize,
+    },
+    /// Two cells overlap: they share a facet on the same side of it, or a facet is shared by
+    /// more than two cells (a duplicated or folded cell).
+    #[error("cells {cell} and {other} overlap across the facet with nodes {facet:?} ({}; a facet may be shared by at most two cells, one on each side)", if *more_than_two { "the facet already has two cells" } else { "a duplicated or folded cell" })]
+    OverlappingCells {
+        /// The later cell.
+        cell: usize,
+        /// The first cell with that facet.
+        other: usize,
+        /// The shared facet's nodes (sorted).
+        facet: Vec<usize>,
+        /// `true` if the facet was already shared by two cells.
+        more_than_two: bool,
+    },
     /// The mesh has no cells.
     #[error("mesh has no cells")]
     Empty,

@@ -124,8 +124,10 @@ pub enum CellOrientation {
 impl<const D: usize> Mesh<D> {
     /// Builds a mesh from node coordinates and a flat cell array (`D + 1` node indices per cell).
     ///
-    /// Fails on non-finite coordinates, out-of-range or repeated indices, degenerate cells and
-    /// inverted cells (see [`Mesh::new_with_repair`] to flip those instead).
+    /// Fails on non-finite coordinates, out-of-range or repeated indices, nodes that belong to
+    /// no cell, degenerate cells, inverted cells (see [`Mesh::new_with_repair`] to flip those
+    /// instead), and non-conforming cells ([`Mesh::check_conformity`]: duplicated or overlapping
+    /// cells).
     pub fn new(nodes: Vec<Point<D>>, cells: Vec<usize>) -> Result<Self, MeshError> {
         let mesh = Self::unchecked(nodes, cells)?;
         for c in 0..mesh.n_cells() {
@@ -135,7 +137,62 @@ impl<const D: usize> Mesh<D> {
                 CellOrientation::Degenerate(det) => return Err(MeshError::DegenerateCell { cell: c, det }),
             }
         }
+        mesh.check_conformity()?;
         Ok(mesh)
+    }
+
+    /// Checks that the (positively oriented) cells form a conforming mesh: every facet is
+    /// shared by at most two cells, and two cells sharing a facet lie on opposite sides of it
+    /// (they induce opposite orientations on it). A duplicated cell, or two cells folded over
+    /// each other, fail with [`MeshError::OverlappingCells`] naming both cells and the facet.
+    pub fn check_conformity(&self) -> Result<(), MeshError> {
+        let per = D + 1;
+        // facet → (first cell, its induced parity, already shared by two cells)
+        let mut seen: HashMap<[usize; 3], (usize, bool, bool)> = HashMap::with_capacity(self.n_cells() * per);
+        for (c, cell) in self.cells.chunks_exact(per).enumerate() {
+            for skip in 0..per {
+                // the facet opposite local vertex `skip`, in the cell's order
+                let mut facet = [usize::MAX; 3];
+                let mut k = 0;
+                for (i, &n) in cell.iter().enumerate() {
+                    if i != skip {
+                        facet[k] = n;
+                        k += 1;
+                    }
+                }
+                // orientation of the facet induced by the cell: (−1)^skip times the parity of
+                // the permutation sorting the facet's nodes
+                let mut parity = skip % 2 == 1;
+                let f = &mut facet[..D];
+                for i in 0..f.len() {
+                    for j in 0..f.len() - 1 - i {
+                        if f[j] > f[j + 1] {
+                            f.swap(j, j + 1);
+                            parity = !parity;
+                        }
+                    }
+                }
+                match seen.get_mut(&facet) {
+                    None => {
+                        seen.insert(facet, (c, parity, false));
+                    }
+                    Some(entry) => {
+                        let (other, other_parity, interior) = *entry;
+                        if interior || other_parity == parity {
+                            let nodes = facet[..D].to_vec();
+                            return Err(MeshError::OverlappingCells {
+                                cell: c,
+                                other,
+                                facet: nodes,
+                                more_than_two: interior,
+                            });
+                        }
+                        entry.2 = true;
+                    }
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Like [`Mesh::new`], but flips inverted cells (swapping their last two nodes) instead of
@@ -144,6 +201,7 @@ impl<const D: usize> Mesh<D> {
     pub fn new_with_repair(nodes: Vec<Point<D>>, cells: Vec<usize>) -> Result<(Self, usize), MeshError> {
         let mut mesh = Self::unchecked(nodes, cells)?;
         let flipped = mesh.repair_orientation()?;
+        mesh.check_conformity()?;
         Ok((mesh, flipped))
     }
 
@@ -170,6 +228,13 @@ impl<const D: usize> Mesh<D> {
                     return Err(MeshError::RepeatedNode { cell, node });
                 }
             }
+        }
+        let mut used = vec![false; nodes.len()];
+        for &n in &cells {
+            used[n] = true;
+        }
+        if let Some(node) = used.iter().position(|u| !u) {
+            return Err(MeshError::UnusedNode { node });
         }
         Ok(Self { nodes, cells, parts: Vec::new(), facet_index: FacetIndex::default() })
     }
