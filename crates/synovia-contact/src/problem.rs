@@ -205,7 +205,14 @@ pub struct Interface<'a> {
     columns: Vec<Option<Vec<f64>>>,
     solves: usize,
     solve_s: f64,
+    /// The rows of `C` in the positions of the factor's trailing block, when every row lives
+    /// on the trailing dofs ([`synovia_fem::TrailingBlock`]): columns of `S` then cost two
+    /// dense triangular solves with `L₂₂` instead of a solve with the whole factor.
+    trailing: Option<(std::sync::Arc<synovia_fem::TrailingBlock>, TrailingRows)>,
 }
+
+/// Rows of `C` as `(trailing position, value)` lists.
+type TrailingRows = Vec<Vec<(usize, f64)>>;
 
 impl<'a> Interface<'a> {
     /// Validates the problem and computes `w = C A⁻¹ F` (one solve).
@@ -216,7 +223,34 @@ impl<'a> Interface<'a> {
         problem.factor.solve_in_place(&mut x)?;
         let w = problem.apply(&x);
         let m = problem.n_rows();
-        Ok(Self { problem, w, columns: vec![None; m], solves: 1, solve_s: t0.elapsed().as_secs_f64() })
+        let trailing = problem.factor.trailing().and_then(|block| {
+            let mut rows = Vec::with_capacity(m);
+            for r in 0..m {
+                let mut row = Vec::new();
+                for (i, v) in problem.row(r) {
+                    let p = block.position.get(i).copied().unwrap_or(usize::MAX);
+                    if p == usize::MAX {
+                        return None;
+                    }
+                    row.push((p, v));
+                }
+                rows.push(row);
+            }
+            Some((block.clone(), rows))
+        });
+        Ok(Self {
+            problem,
+            w,
+            columns: vec![None; m],
+            solves: 1,
+            solve_s: t0.elapsed().as_secs_f64(),
+            trailing,
+        })
+    }
+
+    /// `true` if the columns of `S` come from the trailing block of the factor.
+    pub fn uses_trailing_block(&self) -> bool {
+        self.trailing.is_some()
     }
 
     /// The problem.
@@ -253,6 +287,15 @@ impl<'a> Interface<'a> {
             return Ok(());
         }
         let t0 = Instant::now();
+        if let Some((block, rows)) = &self.trailing {
+            let computed = trailing_columns(block, rows, &missing);
+            self.solves += computed.len();
+            for (j, col) in computed {
+                self.columns[j] = Some(col);
+            }
+            self.solve_s += t0.elapsed().as_secs_f64();
+            return Ok(());
+        }
         let problem = self.problem;
         // Two worker threads on the two halves when there is enough work: triangular solves
         // with many right-hand sides do not parallelise well inside faer (notes: faer-0.24.md),
@@ -315,6 +358,55 @@ impl<'a> Interface<'a> {
         self.solves += 1;
         self.solve_s += t0.elapsed().as_secs_f64();
         Ok(rhs)
+    }
+}
+
+/// Columns `j ∈ cols` of `S = C_c L₂₂⁻ᵀ L₂₂⁻¹ C_cᵀ` from the trailing block (`rows`: the
+/// rows of `C` in trailing positions): dense triangular solves with all right-hand sides at
+/// once, split over two threads when there are many.
+fn trailing_columns(
+    block: &synovia_fem::TrailingBlock,
+    rows: &[Vec<(usize, f64)>],
+    cols: &[usize],
+) -> Vec<(usize, Vec<f64>)> {
+    let k = block.dofs.len();
+    let run = |cols: &[usize]| -> Vec<(usize, Vec<f64>)> {
+        let mut rhs = faer::Mat::<f64>::zeros(k, cols.len());
+        for (c, &j) in cols.iter().enumerate() {
+            for &(p, v) in &rows[j] {
+                rhs[(p, c)] += v;
+            }
+        }
+        block.solve_in_place(rhs.as_mut());
+        cols.iter()
+            .enumerate()
+            .map(|(c, &j)| {
+                let x = rhs.col(c);
+                let col: Vec<f64> = rows.iter().map(|row| row.iter().map(|&(p, v)| v * x[p]).sum()).collect();
+                (j, col)
+            })
+            .collect()
+    };
+    if cols.len() >= 64 && k >= 256 {
+        let (a, b) = cols.split_at(cols.len() / 2);
+        let (mut ra, rb) = std::thread::scope(|scope| {
+            let ha = scope.spawn(|| run(a));
+            let rb = run(b);
+            (ha.join(), rb)
+        });
+        match &mut ra {
+            Ok(ra) => {
+                ra.extend(rb);
+                std::mem::take(ra)
+            }
+            Err(_) => {
+                let mut all = run(a);
+                all.extend(rb);
+                all
+            }
+        }
+    } else {
+        run(cols)
     }
 }
 

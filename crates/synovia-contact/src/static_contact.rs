@@ -54,8 +54,8 @@ impl<const D: usize> StaticContact<D> {
         pairs: &[ContactPair<D>],
         params: ElasticParams,
     ) -> Result<Self, ContactError> {
-        let elastic = ElasticSolver::new_semi_coercive(model, params)?;
         let geometry = ContactGeometry::new(model, pairs)?;
+        let elastic = ElasticSolver::new_for_contact(model, params, &interface_nodes(model, pairs)?)?;
         Ok(Self { elastic, geometry, nested_min_rows: Some(32) })
     }
 
@@ -213,6 +213,38 @@ impl<const D: usize> StaticContact<D> {
             proximal_iterations,
         })
     }
+}
+
+/// Every node of the contact parts of `pairs` (both sides), each once: the dofs that
+/// [`ElasticSolver::new_for_contact`] orders last.
+fn interface_nodes<const D: usize>(
+    model: &Model<D>,
+    pairs: &[ContactPair<D>],
+) -> Result<Vec<(synovia_fem::BodyId, usize)>, ContactError> {
+    use crate::operators::Partner;
+    let mut out = Vec::new();
+    let mut seen = std::collections::HashSet::new();
+    let mut add = |body: synovia_fem::BodyId, part: &str| -> Result<(), ContactError> {
+        let mesh = &model.body(body)?.mesh;
+        for f in mesh.boundary_part(part)?.facets() {
+            for &i in f {
+                if seen.insert((body.0, i)) {
+                    out.push((body, i));
+                }
+            }
+        }
+        Ok(())
+    };
+    for pair in pairs {
+        add(pair.body, &pair.part)?;
+        match &pair.partner {
+            Partner::Body { body, part, .. }
+            | Partner::Segment { body, part, .. }
+            | Partner::Mortar { body, part, .. } => add(*body, part)?,
+            Partner::Rigid(_) => {}
+        }
+    }
+    Ok(out)
 }
 
 /// Largest number of proximal-point iterations of a semi-coercive solve.

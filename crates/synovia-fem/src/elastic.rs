@@ -120,8 +120,26 @@ impl<const D: usize> ElasticSolver<D> {
     /// Validates the model, builds the dofs, checks coercivity (spec §4), assembles `K̃`, and
     /// factorises it.
     pub fn new(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
-        Self::build(model, params, false)
+        Self::build(model, params, false, &[])
     }
+
+    /// The factorisation for contact problems: like [`ElasticSolver::new_semi_coercive`], and
+    /// the reduced dofs of the `interface` nodes (the nodes of the contact parts) are ordered
+    /// last ([`Ordering::Trailing`]) when there are at most [`Self::MAX_TRAILING_DOFS`] of them,
+    /// so that the interface Schur complement `S = C A⁻¹ Cᵀ` is evaluated with the dense
+    /// trailing block `L₂₂` of the factor, `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4), instead of
+    /// solves with the whole factor ([`CholeskySolver::trailing`]).
+    pub fn new_for_contact(
+        model: &Model<D>,
+        params: ElasticParams,
+        interface: &[(crate::model::BodyId, usize)],
+    ) -> Result<Self, FemError> {
+        Self::build(model, params, true, interface)
+    }
+
+    /// Largest number of interface dofs ordered last by [`ElasticSolver::new_for_contact`]:
+    /// the trailing block is dense (`k²` entries, `k³/3` flops to factorise).
+    pub const MAX_TRAILING_DOFS: usize = 4000;
 
     /// Like [`ElasticSolver::new`], but a semi-coercive model (bodies whose rigid motions no
     /// Dirichlet or symmetry data restrain, spec §4) is accepted: the factorisation is of
@@ -130,10 +148,15 @@ impl<const D: usize> ElasticSolver<D> {
     /// refuses such a model ([`FemError::SemiCoercive`]): without contact it has no unique
     /// solution.
     pub fn new_semi_coercive(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
-        Self::build(model, params, true)
+        Self::build(model, params, true, &[])
     }
 
-    fn build(model: &Model<D>, params: ElasticParams, allow_floating: bool) -> Result<Self, FemError> {
+    fn build(
+        model: &Model<D>,
+        params: ElasticParams,
+        allow_floating: bool,
+        interface: &[(crate::model::BodyId, usize)],
+    ) -> Result<Self, FemError> {
         let t0 = Instant::now();
         let dofs = DofMap::new(model)?;
         let floating = dofs.floating_components(model);
@@ -146,10 +169,31 @@ impl<const D: usize> ElasticSolver<D> {
         let body_c = body_stiffnesses(model)?;
         assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| stiffness_into(geo, &body_c[b], out))?;
         let assembly_s = t1.elapsed().as_secs_f64();
-        let ordering = match (params.ordering, D) {
+        let mut ordering = match (params.ordering, D) {
             (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => Ordering::Amd,
             _ => metis,
         };
+        if !interface.is_empty() {
+            let mut last = Vec::new();
+            let mut seen = vec![false; dofs.groups().len()];
+            for &(b, i) in interface {
+                let n_nodes = model.body(b)?.mesh.n_nodes();
+                if i >= n_nodes {
+                    return Err(FemError::InvalidParameter(format!(
+                        "interface node {i} of body #{} is out of range (it has {n_nodes} nodes)",
+                        b.0
+                    )));
+                }
+                let g = dofs.group_of(b, i);
+                if !std::mem::replace(&mut seen[g], true) {
+                    let grp = &dofs.groups()[g];
+                    last.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
+                }
+            }
+            if !last.is_empty() && last.len() <= Self::MAX_TRAILING_DOFS && last.len() < dofs.n_dofs() {
+                ordering = Ordering::Trailing { base: Box::new(ordering), last };
+            }
+        }
         let stabilisation = if floating.is_empty() {
             None
         } else {

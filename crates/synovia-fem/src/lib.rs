@@ -34,5 +34,5 @@ pub use error::FemError;
 pub use model::{Body, BodyId, ComponentMask, Model, TractionField, VectorField};
 pub use post::BodyFields;
 pub use quadrature::QuadratureRule;
-pub use solver::{CholeskyInfo, CholeskySolver, Ordering};
+pub use solver::{CholeskyInfo, CholeskySolver, Ordering, TrailingBlock};
 pub use sparse::SymmetricMatrix;

@@ -11,6 +11,7 @@ use std::time::Instant;
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::perm::PermRef;
+use faer::reborrow::ReborrowMut;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering,
 };
@@ -36,6 +37,45 @@ pub enum Ordering {
     },
     /// A given forward permutation of the dofs.
     Custom(Vec<usize>),
+    /// The `base` ordering with the dofs `last` moved (in their `base` order) to the end, so
+    /// that the trailing block `L₂₂` of the factor belongs to them
+    /// ([`CholeskySolver::trailing`]).
+    Trailing {
+        /// Ordering of everything else.
+        base: Box<Ordering>,
+        /// Dofs to eliminate last (distinct, `< n`).
+        last: Vec<usize>,
+    },
+}
+
+/// The trailing block of a factorisation with [`Ordering::Trailing`]: with the dofs `c` ordered
+/// last, `P A Pᵀ = L Lᵀ` gives `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4: the interface Schur
+/// complement needs no solve with the whole factor).
+#[derive(Debug, Clone)]
+pub struct TrailingBlock {
+    /// The trailing dofs, in factor order.
+    pub dofs: Vec<usize>,
+    /// `position[dof]` = index of `dof` in [`Self::dofs`], or `usize::MAX`.
+    pub position: Vec<usize>,
+    /// `L₂₂` (dense, lower triangular, `k × k`).
+    pub factor: faer::Mat<f64>,
+}
+
+impl TrailingBlock {
+    /// Solves `(A⁻¹)_cc`-products in place: `X ← L₂₂⁻ᵀ L₂₂⁻¹ X` for the `k × r` block `x`
+    /// (rows in the order of [`Self::dofs`]).
+    pub fn solve_in_place(&self, mut x: MatMut<'_, f64>) {
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+            self.factor.as_ref(),
+            x.rb_mut(),
+            Par::Seq,
+        );
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            self.factor.as_ref().transpose(),
+            x.rb_mut(),
+            Par::Seq,
+        );
+    }
 }
 
 /// Timings of the stages of a factorisation, in seconds.
@@ -56,6 +96,8 @@ pub struct CholeskySolver {
     factor: Vec<f64>,
     factorized: bool,
     info: CholeskyInfo,
+    trailing_dofs: Option<Vec<usize>>,
+    trailing: Option<Arc<TrailingBlock>>,
 }
 
 impl CholeskySolver {
@@ -63,10 +105,47 @@ impl CholeskySolver {
     pub fn analyse(a: &SymmetricMatrix, ordering: &Ordering) -> Result<Self, FemError> {
         let t0 = Instant::now();
         let n = a.n();
+        let mut trailing_dofs = None;
         let perm: Option<Vec<usize>> = match ordering {
             Ordering::Amd => None,
             Ordering::Custom(p) => Some(p.clone()),
             Ordering::Metis { blocks, adjacency } => Some(metis_order(n, blocks, adjacency)?),
+            Ordering::Trailing { base, last } => {
+                let base_perm: Vec<usize> = match base.as_ref() {
+                    Ordering::Trailing { .. } => {
+                        return Err(FemError::InvalidParameter("nested trailing orderings".into()))
+                    }
+                    Ordering::Custom(p) => p.clone(),
+                    Ordering::Metis { blocks, adjacency } => metis_order(n, blocks, adjacency)?,
+                    Ordering::Amd => {
+                        let sym = factorize_symbolic_cholesky(
+                            a.pattern().as_ref(),
+                            Side::Lower,
+                            SymmetricOrdering::Amd,
+                            CholeskySymbolicParams::default(),
+                        )
+                        .map_err(|e| FemError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
+                        match sym.perm() {
+                            Some(p) => p.arrays().0.to_vec(),
+                            None => (0..n).collect(),
+                        }
+                    }
+                };
+                let mut is_last = vec![false; n];
+                for &d in last {
+                    if d >= n || is_last[d] {
+                        return Err(FemError::InvalidParameter(format!(
+                            "trailing dofs must be distinct and < {n} (dof {d})"
+                        )));
+                    }
+                    is_last[d] = true;
+                }
+                let mut fwd: Vec<usize> = base_perm.iter().copied().filter(|&d| !is_last[d]).collect();
+                let tail: Vec<usize> = base_perm.iter().copied().filter(|&d| is_last[d]).collect();
+                fwd.extend_from_slice(&tail);
+                trailing_dofs = Some(tail);
+                Some(fwd)
+            }
         };
         let symbolic = match &perm {
             None => factorize_symbolic_cholesky(
@@ -98,7 +177,14 @@ impl CholeskySolver {
         .map_err(|e| FemError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
         let len = symbolic.len_val();
         let info = CholeskyInfo { symbolic_s: t0.elapsed().as_secs_f64(), numeric_s: 0.0, factor_nnz: len };
-        Ok(Self { symbolic: Arc::new(symbolic), factor: Vec::new(), factorized: false, info })
+        Ok(Self {
+            symbolic: Arc::new(symbolic),
+            factor: Vec::new(),
+            factorized: false,
+            info,
+            trailing_dofs,
+            trailing: None,
+        })
     }
 
     /// Numeric factorisation of `a` (same pattern as analysed), reusing the symbolic analysis.
@@ -134,8 +220,72 @@ impl CholeskySolver {
                 }
             })?;
         self.factorized = true;
+        self.trailing = match &self.trailing_dofs {
+            Some(dofs) if !dofs.is_empty() => Some(Arc::new(self.extract_trailing(dofs)?)),
+            _ => None,
+        };
         self.info.numeric_s = t0.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// The trailing block `L₂₂` of an [`Ordering::Trailing`] factorisation (after
+    /// [`CholeskySolver::factorize`]).
+    pub fn trailing(&self) -> Option<&Arc<TrailingBlock>> {
+        self.trailing.as_ref()
+    }
+
+    /// Copies the last `k = dofs.len()` columns of `L` (rows ≥ `n − k`) into a dense `L₂₂`.
+    fn extract_trailing(&self, dofs: &[usize]) -> Result<TrailingBlock, FemError> {
+        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+        let n = self.symbolic.nrows();
+        let k = dofs.len();
+        let t0 = n - k;
+        let mut l22 = faer::Mat::<f64>::zeros(k, k);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(sym) => {
+                let col_ptr = sym.col_ptr();
+                let row_idx = sym.row_idx();
+                for j in t0..n {
+                    let range = col_ptr[j]..col_ptr[j + 1];
+                    for (&i, &v) in row_idx[range.clone()].iter().zip(&self.factor[range]) {
+                        if i >= j {
+                            l22[(i - t0, j - t0)] = v;
+                        }
+                    }
+                }
+            }
+            SymbolicCholeskyRaw::Supernodal(sym) => {
+                let llt = SupernodalLltRef::new(sym, &self.factor);
+                for s in 0..sym.n_supernodes() {
+                    let node = llt.supernode(s);
+                    let start = node.start();
+                    let val = node.val();
+                    let ncols = val.ncols();
+                    let end = start + ncols;
+                    if end <= t0 {
+                        continue;
+                    }
+                    let pattern = node.pattern();
+                    for c in 0..ncols {
+                        let j = start + c;
+                        if j < t0 {
+                            continue;
+                        }
+                        for r in c..ncols {
+                            l22[(start + r - t0, j - t0)] = val[(r, c)];
+                        }
+                        for (pi, &i) in pattern.iter().enumerate() {
+                            l22[(i - t0, j - t0)] = val[(ncols + pi, c)];
+                        }
+                    }
+                }
+            }
+        }
+        let mut position = vec![usize::MAX; n];
+        for (p, &d) in dofs.iter().enumerate() {
+            position[d] = p;
+        }
+        Ok(TrailingBlock { dofs: dofs.to_vec(), position, factor: l22 })
     }
 
     /// Solves `A x = b` in place for one right-hand side.
