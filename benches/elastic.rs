@@ -22,8 +22,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, SamplingMode};
-use synovia::fem::assembly::{add_loads, assemble_matrix, body_stiffnesses, pattern};
-use synovia::fem::element::stiffness_into;
+use synovia::fem::assembly::{add_loads, assemble_matrix, assemble_matrix_with, body_stiffnesses, pattern};
+use synovia::fem::element::{stiffness_into, SimplexGeometry};
 use synovia::fem::{CholeskySolver, DofMap, Ordering, SymmetricMatrix};
 use synovia::prelude::*;
 
@@ -79,10 +79,69 @@ fn assemble<const D: usize>(model: &Model<D>, dofs: &DofMap<D>, k: &mut Symmetri
     assemble_matrix(model, dofs, k, |b, _, geo, out| stiffness_into(geo, &c[b], out)).expect("assembly");
 }
 
-/// A problem with everything up to the factorisation done, and its right-hand side.
-struct Fixture<const D: usize> {
+/// The sequential assembly as it was before the parallel column blocks (entry by entry
+/// through `SymmetricMatrix::add`, one binary search per entry), kept as the baseline of
+/// `assembly/*/assemble-before`.
+fn assemble_before<const D: usize>(model: &Model<D>, dofs: &DofMap<D>, matrix: &mut SymmetricMatrix) {
+    let body_c = body_stiffnesses(model).expect("stiffnesses");
+    matrix.zero();
+    let n = D * (D + 1);
+    let mut ke = vec![0.0; n * n];
+    let groups = dofs.groups();
+    for (bi, body) in model.bodies().iter().enumerate() {
+        for c in 0..body.mesh.n_cells() {
+            let pts = body.mesh.cell_points(c);
+            let geo = SimplexGeometry::new(&pts).expect("geometry");
+            stiffness_into(&geo, &body_c[bi], &mut ke);
+            let cell = body.mesh.cell(c);
+            for (a, &na) in cell.iter().enumerate() {
+                let ga = &groups[dofs.group_of(BodyId(bi), na)];
+                for (b, &nb) in cell.iter().enumerate() {
+                    let gb = &groups[dofs.group_of(BodyId(bi), nb)];
+                    for k in 0..ga.n_dofs {
+                        let r = ga.first_dof + k;
+                        for l in 0..gb.n_dofs {
+                            let col = gb.first_dof + l;
+                            if r < col {
+                                continue;
+                            }
+                            let v = if ga.free && gb.free {
+                                ke[(D * a + k) * n + D * b + l]
+                            } else {
+                                let mut v = 0.0;
+                                for i in 0..D {
+                                    for j in 0..D {
+                                        v +=
+                                            ga.basis[k][i] * ke[(D * a + i) * n + D * b + j] * gb.basis[l][j];
+                                    }
+                                }
+                                v
+                            };
+                            matrix.add(r, col, v).expect("in pattern");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A problem with its dof map and (empty) stiffness pattern, for the assembly benchmarks.
+struct AssemblyFixture<const D: usize> {
     model: Model<D>,
     dofs: DofMap<D>,
+    k: SymmetricMatrix,
+}
+
+impl<const D: usize> AssemblyFixture<D> {
+    fn new(model: Model<D>) -> Self {
+        let (dofs, k, _) = setup(&model);
+        Self { model, dofs, k }
+    }
+}
+
+/// A problem with everything up to the factorisation done, and its right-hand side.
+struct Fixture<const D: usize> {
     k: SymmetricMatrix,
     ordering: Ordering,
     solver: CholeskySolver,
@@ -104,7 +163,7 @@ impl<const D: usize> Fixture<D> {
             k.nnz(),
             solver.info().factor_nnz
         );
-        Self { model, dofs, k, ordering, solver, rhs }
+        Self { k, ordering, solver, rhs }
     }
 }
 
@@ -129,29 +188,80 @@ fn elastic(c: &mut Criterion) {
     let fx3s_amd = || f3s_amd.get_or_init(|| Fixture::new(model_3d(n3s), amd));
     let fx3s_metis = || f3s_metis.get_or_init(|| Fixture::new(model_3d(n3s), metis));
 
-    // ## Pattern (dof map + coercivity check + pattern) and stiffness assembly
+    // ## Pattern (dof map + coercivity check + pattern) and stiffness assembly (fixtures
+    // without factorisation, so that `-- assembly` runs quickly)
+    let a2: OnceCell<AssemblyFixture<2>> = OnceCell::new();
+    let a3: OnceCell<AssemblyFixture<3>> = OnceCell::new();
+    let ax2 = || a2.get_or_init(|| AssemblyFixture::new(model_2d(n2)));
+    let ax3 = || a3.get_or_init(|| AssemblyFixture::new(model_3d(n3)));
     let mut g = c.benchmark_group("assembly");
     g.sample_size(10)
         .sampling_mode(SamplingMode::Flat)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3));
     g.bench_function("2d/pattern", |b| {
-        let f = fx2();
+        let f = ax2();
         b.iter(|| setup(&f.model))
     });
     g.bench_function("2d/assemble", |b| {
-        let f = fx2();
+        let f = ax2();
         let mut k = f.k.clone();
         b.iter(|| assemble(&f.model, &f.dofs, &mut k))
     });
+    for blocks in [2, 4, 8] {
+        g.bench_function(format!("2d/assemble-blocks{blocks}"), |b| {
+            let f = ax2();
+            let mut k = f.k.clone();
+            let c = body_stiffnesses(&f.model).expect("stiffnesses");
+            b.iter(|| {
+                assemble_matrix_with(&f.model, &f.dofs, &mut k, blocks, |b, _, geo, out| {
+                    stiffness_into(geo, &c[b], out)
+                })
+                .expect("assembly")
+            })
+        });
+    }
+    g.bench_function("2d/assemble-before", |b| {
+        let f = ax2();
+        let mut k = f.k.clone();
+        b.iter(|| assemble_before(&f.model, &f.dofs, &mut k))
+    });
+    g.bench_function("2d/loads", |b| {
+        let f = ax2();
+        let mut rhs = vec![0.0; f.dofs.n_dofs()];
+        b.iter(|| add_loads(&f.model, &f.dofs, 0.0, 2, &mut rhs).expect("loads"))
+    });
     g.bench_function("3d/pattern", |b| {
-        let f = fx3();
+        let f = ax3();
         b.iter(|| setup(&f.model))
     });
     g.bench_function("3d/assemble", |b| {
-        let f = fx3();
+        let f = ax3();
         let mut k = f.k.clone();
         b.iter(|| assemble(&f.model, &f.dofs, &mut k))
+    });
+    for blocks in [2, 4, 8] {
+        g.bench_function(format!("3d/assemble-blocks{blocks}"), |b| {
+            let f = ax3();
+            let mut k = f.k.clone();
+            let c = body_stiffnesses(&f.model).expect("stiffnesses");
+            b.iter(|| {
+                assemble_matrix_with(&f.model, &f.dofs, &mut k, blocks, |b, _, geo, out| {
+                    stiffness_into(geo, &c[b], out)
+                })
+                .expect("assembly")
+            })
+        });
+    }
+    g.bench_function("3d/assemble-before", |b| {
+        let f = ax3();
+        let mut k = f.k.clone();
+        b.iter(|| assemble_before(&f.model, &f.dofs, &mut k))
+    });
+    g.bench_function("3d/loads", |b| {
+        let f = ax3();
+        let mut rhs = vec![0.0; f.dofs.n_dofs()];
+        b.iter(|| add_loads(&f.model, &f.dofs, 0.0, 2, &mut rhs).expect("loads"))
     });
     g.finish();
 

@@ -26,7 +26,10 @@
 //! * [`JointModel::run_dynamic`]: the semi-implicit Kelvin–Voigt scheme with `dt` and `steps`
 //!   (every body needs a density: a [`KelvinVoigt`] material, [`JointModel::set_density`] or
 //!   [`JointModel::set_dynamic`]);
-//! * [`JointModel::run`] runs the [`Analysis`] set with [`JointModel::set_analysis`].
+//! * [`JointModel::run`] runs the [`Analysis`] set with [`JointModel::set_analysis`];
+//! * [`JointModel::prepare`] factorises once and returns a [`JointSession`] that re-solves
+//!   the static problem or advances the quasi-static scheme level by level with new loads,
+//!   warm-started, without refactorising (navigation; see [`crate::session`]).
 //!
 //! Every run returns a [`RunResult`] (one [`StepRecord`] per step, the final displacements, the
 //! last contact solution). The `*_with` variants call an observer after every step with a
@@ -55,6 +58,8 @@ use synovia_time::history::{pressure, scaled, scaled_traction, LoadHistory, Rigi
 use synovia_time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
 use synovia_time::results::StepRecord;
 use synovia_time::TimeError;
+
+use crate::session::JointSession;
 
 /// Everything that can go wrong while building or running a [`JointModel`].
 #[derive(Debug, thiserror::Error)]
@@ -273,7 +278,7 @@ impl<const D: usize> Default for JointModel<D> {
 }
 
 /// A contact result without contact forces (`n_contact` zero pressures).
-fn zero_result<const D: usize>(
+pub(crate) fn zero_result<const D: usize>(
     displacement: Vec<Vec<Vector<D>>>,
     n_contact: usize,
 ) -> StaticContactResult<D> {
@@ -830,6 +835,55 @@ impl<const D: usize> JointModel<D> {
         observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
         self.run_levels(times, observer)
+    }
+
+    /// Prepares the model for repeated solves (navigation, interactive tools): validates it,
+    /// assembles and factorises the stiffness and builds the contact geometry once, and
+    /// returns a [`JointSession`] whose [`JointSession::solve_static`] (the problem of
+    /// [`JointModel::run_static`]) and [`JointSession::step`] (one quasi-static level with the
+    /// friction state) reuse that factorisation and warm-start from the previous solution.
+    ///
+    /// New loads or prescribed displacements are given between solves through the model's
+    /// closures: build it with [`SharedValue`](synovia_time::history::SharedValue) histories
+    /// and set them, or solve at another time `t` of its histories (see
+    /// [`crate::session`]).
+    ///
+    /// ```
+    /// use synovia::prelude::*;
+    ///
+    /// let mesh = rectangle(-1.0, 1.0, 0.0, 1.0, 8, 4, Grading::Uniform, Grading::Uniform)?;
+    /// let mut joint = JointModel::<2>::new();
+    /// let block = joint.add_body("block", mesh, plane_strain(1.0e3, 0.3)?)?;
+    /// // the tool: the top is pushed down by a depth the user changes between frames
+    /// let depth = SharedValue::new(0.005);
+    /// joint.prescribe(block, "top", Vector::<2>::new(0.0, -1.0), depth.clone())?;
+    /// let ball = SphereObstacle::new(Point::<2>::new(0.0, -2.0), 2.0, false)?;
+    /// joint.contact_rigid("ball", block, "bottom", ball, 0.0)?;
+    ///
+    /// let mut session = joint.prepare()?; // factorises once
+    /// let first = session.solve_static(0.0)?;
+    /// assert!(!first.warm_started);
+    /// let f1 = session.record().map(|r| r.pairs[0].normal_force).unwrap_or(0.0);
+    ///
+    /// depth.set(0.01); // next frame: deeper push, no rebuild
+    /// let second = session.solve_static(0.0)?;
+    /// assert!(second.warm_started && second.kkt < 1e-8);
+    /// let f2 = session.record().map(|r| r.pairs[0].normal_force).unwrap_or(0.0);
+    /// assert!(f2 > f1 && f1 > 0.0);
+    /// assert_eq!(session.factorizations(), 1);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    ///
+    /// # Errors
+    /// As [`JointModel::run_static`] for the set-up: invalid model, contact set-up, unknown
+    /// solver.
+    pub fn prepare(&self) -> Result<JointSession<'_, D>, JointError> {
+        JointSession::new(self)
+    }
+
+    /// The parameters a [`JointSession`] needs (elastic, quasi-static, nested iteration).
+    pub(crate) fn session_params(&self) -> (ElasticParams, QuasiStaticParams, Option<usize>) {
+        (self.elastic_params, self.quasistatic_params, self.nested)
     }
 
     /// The dynamic scheme: `steps` steps of `dt` (records: the initial state and each step).

@@ -73,12 +73,14 @@ pub mod hertz;
 pub mod hip3d;
 pub mod knee2d;
 pub mod output;
+pub mod session;
 pub mod solvers;
 pub mod verification;
 
 /// The types most programs need.
 pub mod prelude {
     pub use crate::builder::{Analysis, BodyMaterial, BodyRef, JointError, JointModel, RunResult, StepView};
+    pub use crate::session::{JointSession, SolveReport};
     pub use synovia_contact::operators::{CylinderObstacle, FnObstacle, PlaneObstacle, SphereObstacle};
     pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction};
     pub use synovia_fem::{
@@ -92,6 +94,8 @@ pub mod prelude {
     pub use synovia_mesh::generators::{box_mesh, rectangle, Grading};
     pub use synovia_mesh::math::{Point, Real, Vector};
     pub use synovia_mesh::{BoundaryKind, Mesh, MeshError};
-    pub use synovia_time::history::{Constant, LoadHistory, Periodic, PiecewiseLinear, RigidMotion};
+    pub use synovia_time::history::{
+        Constant, LoadHistory, Periodic, PiecewiseLinear, RigidMotion, SharedValue,
+    };
     pub use synovia_time::results::StepRecord;
 }

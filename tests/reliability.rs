@@ -44,6 +44,7 @@ impl Synthetic {
             load: &self.load,
             normal: &self.normal,
             friction: None,
+            schur_cache: None,
         }
     }
 }

@@ -15,8 +15,9 @@ use synovia::fem::{BodyId, ComponentMask, ElasticParams, ElasticSolver, Ordering
 use synovia::material::Material;
 use synovia::mesh::math::{Point, Real, Vector};
 use synovia::mesh::{BoundaryKind, Mesh};
-use synovia::time::quasistatic::{warm_start, QuasiStaticParams};
-use synovia::time::results::{pair_records, PairRecord};
+use synovia::time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
+use synovia::time::results::{PairRecord, StepRecord};
+use synovia::time::TimeError;
 use synovia_cli::scenario::Scenario;
 
 use crate::{Fail, SynStatus};
@@ -70,10 +71,12 @@ impl Default for Params {
     }
 }
 
-/// Factorised operator, kept while the model's structure does not change.
+/// Factorised operator, kept while the model's structure does not change. With contact pairs
+/// it is the quasi-static stepper, which also carries the friction state from one step to the
+/// next.
 enum Solver<const D: usize> {
     Elastic(Box<ElasticSolver<D>>),
-    Contact(Box<StaticContact<D>>),
+    Contact(Box<QuasiStaticStepper<D>>),
 }
 
 /// The last solution.
@@ -536,7 +539,9 @@ impl<const D: usize> State<D> {
             let mut c = StaticContact::new(model, self.joint.pairs(), self.params.elastic)
                 .map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?;
             c.set_nested_iteration(self.params.nested);
-            Solver::Contact(Box::new(c))
+            let stepper = QuasiStaticStepper::from_contact(model, c, self.params.quasistatic)
+                .map_err(|e| Fail::new(SynStatus::InvalidArgument, e.to_string()))?;
+            Solver::Contact(Box::new(stepper))
         };
         self.solver = Some(solver);
         Ok(())
@@ -564,30 +569,10 @@ impl<const D: usize> State<D> {
                     pairs: Vec::new(),
                 }
             }
-            Some(Solver::Contact(c)) => {
-                let fail =
-                    |e: synovia::contact_ops::ContactError| Fail::new(SynStatus::SolveFailed, e.to_string());
-                let pre = c.solve(model, t, cs.as_ref(), None, None, None).map_err(fail)?;
-                let mut its = pre.solution.report.iterations + pre.coarse_iterations;
-                let has_friction = c.geometry().nodes.iter().any(|n| n.friction > 0.0);
-                let result = if self.params.quasistatic.initial_friction && has_friction {
-                    let g = c.geometry().slip_bounds_from_pressure(&pre.solution.lambda_n);
-                    let (res, more) =
-                        tresca_level(c, &self.params.quasistatic, model, t, cs.as_ref(), g, None, &pre)?;
-                    its += more;
-                    res
-                } else {
-                    pre
-                };
-                let pairs = pair_records(c.geometry(), &result);
-                Solved {
-                    time: t,
-                    step: 0,
-                    iterations: its,
-                    displacement: result.displacement.clone(),
-                    result: Some(result),
-                    pairs,
-                }
+            Some(Solver::Contact(stepper)) => {
+                // a new sequence, cold-started; a failure keeps the previous one
+                let (record, result) = stepper.restart(model, t, cs.as_ref(), false).map_err(solve_failed)?;
+                solved_from(record, result)
             }
             None => return Err(Fail::new(SynStatus::Panic, "no solver after build")),
         };
@@ -636,24 +621,12 @@ impl<const D: usize> State<D> {
                     pairs: Vec::new(),
                 })
             }
-            Some(Solver::Contact(c)) => {
-                let q = self.params.quasistatic;
-                let prev_result = prev.result.as_ref().ok_or_else(|| {
-                    Fail::new(SynStatus::NoSolution, "the last solution has no contact state")
-                })?;
-                let g = c.geometry().slip_bounds_from_pressure(&prev_result.solution.lambda_n);
-                let origin = q.incremental_slip.then_some(prev_result.displacement.as_slice());
-                let (result, iterations) =
-                    tresca_level(c, &q, model, t, cs.as_ref(), g, origin, prev_result)?;
-                let pairs = pair_records(c.geometry(), &result);
-                Ok(Solved {
-                    time: t,
-                    step: prev.step + 1,
-                    iterations,
-                    displacement: result.displacement.clone(),
-                    result: Some(result),
-                    pairs,
-                })
+            Some(Solver::Contact(stepper)) => {
+                if prev.result.is_none() || stepper.last_result().is_none() {
+                    return Err(Fail::new(SynStatus::NoSolution, "the last solution has no contact state"));
+                }
+                let (record, result) = stepper.step(model, t, cs.as_ref()).map_err(solve_failed)?;
+                Ok(solved_from(record, result))
             }
             None => Err(Fail::new(SynStatus::Panic, "no solver after build")),
         }
@@ -685,7 +658,7 @@ impl<const D: usize> State<D> {
 
     fn contact(&self) -> Option<&StaticContact<D>> {
         match &self.solver {
-            Some(Solver::Contact(c)) => Some(c),
+            Some(Solver::Contact(c)) => Some(c.contact()),
             _ => None,
         }
     }
@@ -748,7 +721,7 @@ impl<const D: usize> State<D> {
         let s = self.solved()?;
         let n_dofs = match &self.solver {
             Some(Solver::Elastic(e)) => e.info().n_dofs,
-            Some(Solver::Contact(c)) => c.elastic().info().n_dofs,
+            Some(Solver::Contact(c)) => c.contact().elastic().info().n_dofs,
             None => 0,
         };
         Ok(Info {
@@ -766,56 +739,19 @@ fn part_name(tag: i32) -> String {
     format!("tag_{tag}")
 }
 
-/// One Tresca level with the optional Coulomb fixed point, as
-/// `synovia::time::quasistatic::QuasiStaticStepper` does it.
-#[allow(clippy::too_many_arguments)]
-fn tresca_level<const D: usize>(
-    contact: &StaticContact<D>,
-    params: &QuasiStaticParams,
-    model: &synovia::fem::Model<D>,
-    t: Real,
-    solver: &dyn ContactSolver,
-    slip_bound: Vec<Real>,
-    origin: Option<&[Vec<Vector<D>>]>,
-    warm_from: &StaticContactResult<D>,
-) -> Result<(StaticContactResult<D>, usize), Fail> {
-    let geometry = contact.geometry();
-    let coulomb = params.coulomb_fixed_point;
-    let max = if coulomb { params.max_fixed_point } else { 1 };
-    let mut g = slip_bound;
-    let mut warm = warm_start(geometry, warm_from, &g);
-    let mut iterations = 0;
-    let mut change = Real::INFINITY;
-    for _ in 0..max {
-        let res = contact
-            .solve(model, t, solver, Some(&g), origin, Some(&warm))
-            .map_err(|e| Fail::new(SynStatus::SolveFailed, e.to_string()))?;
-        iterations += res.solution.report.iterations + res.coarse_iterations;
-        if !coulomb {
-            return Ok((res, iterations));
-        }
-        let g_new = geometry.slip_bounds_from_pressure(&res.solution.lambda_n);
-        change = relative_change(&g, &g_new);
-        if change <= params.fixed_point_tolerance {
-            return Ok((res, iterations));
-        }
-        warm = warm_start(geometry, &res, &g_new);
-        g = g_new;
-    }
-    Err(Fail::new(
-        SynStatus::SolveFailed,
-        format!("the Coulomb fixed point did not converge in {max} solves (change {change:e})"),
-    ))
+/// A solve failure of the quasi-static stepper.
+fn solve_failed(e: TimeError) -> Fail {
+    Fail::new(SynStatus::SolveFailed, e.to_string())
 }
 
-fn relative_change(a: &[Real], b: &[Real]) -> Real {
-    let diff = a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
-    let scale = b.iter().fold(0.0_f64, |m, y| m.max(y.abs()));
-    if diff == 0.0 {
-        0.0
-    } else if scale > 0.0 {
-        diff / scale
-    } else {
-        Real::INFINITY
+/// The last solution from a level of the quasi-static stepper.
+fn solved_from<const D: usize>(record: StepRecord, result: &StaticContactResult<D>) -> Solved<D> {
+    Solved {
+        time: record.time,
+        step: record.step,
+        iterations: record.iterations,
+        displacement: result.displacement.clone(),
+        result: Some(result.clone()),
+        pairs: record.pairs,
     }
 }

@@ -39,7 +39,7 @@ pub mod testing;
 pub use error::{ContactError, IterationResidual};
 pub use friction::{ConstantFriction, ExponentialFriction, FrictionLaw};
 pub use kkt::{check_kkt, KktReport};
-pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
+pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints, SchurCache};
 pub use rows::SparseRows;
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};
 pub use static_contact::{StaticContact, StaticContactResult};

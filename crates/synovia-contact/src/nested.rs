@@ -145,7 +145,7 @@ pub fn nested_warm_start(
             gap.push(problem.normal.gap[r]);
         }
         let normal = NormalConstraints { rows, weights: weight, gap };
-        let sub = ContactProblem { normal: &normal, friction: None, ..*problem };
+        let sub = ContactProblem { normal: &normal, friction: None, schur_cache: None, ..*problem };
         let ws = warm.take().map(|ln| ContactSolution {
             u: Vec::new(),
             lambda_n: ln,

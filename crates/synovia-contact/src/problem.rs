@@ -65,9 +65,75 @@ pub struct ContactProblem<'a> {
     pub normal: &'a NormalConstraints,
     /// Friction constraints (`None`: frictionless).
     pub friction: Option<&'a FrictionConstraints>,
+    /// Columns of `S` kept from an earlier [`Interface`] of the same `A` and the same rows
+    /// (e.g. a re-solve with new loads, or the next time level on an unchanged geometry);
+    /// `None`: no reuse.
+    pub schur_cache: Option<&'a SchurCache>,
+}
+
+/// Columns of the interface Schur complement `S = C A⁻¹ Cᵀ` kept between solves that share
+/// `A` and `C` (only `F` and the gaps change). An [`Interface`] takes the columns when the
+/// rows of `C` are identical to those they were computed for (compared by a fingerprint of
+/// `C`'s entries) and hands them back, with any new ones, when it is dropped.
+#[derive(Debug, Default)]
+pub struct SchurCache {
+    inner: std::sync::Mutex<Option<(u64, ColumnStore)>>,
+}
+
+/// Columns of `S` by row index (`None`: not computed).
+type ColumnStore = Vec<Option<Vec<f64>>>;
+
+impl SchurCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Forgets every column (e.g. after the geometry or `A` changed).
+    pub fn clear(&self) {
+        *self.inner.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    }
+    /// Number of columns held.
+    pub fn len(&self) -> usize {
+        self.inner
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .as_ref()
+            .map_or(0, |(_, c)| c.iter().filter(|c| c.is_some()).count())
+    }
+    /// `true` if no column is held.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    fn take(&self, fingerprint: u64, m: usize) -> Vec<Option<Vec<f64>>> {
+        let mut guard = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+        match guard.take() {
+            Some((f, cols)) if f == fingerprint && cols.len() == m => cols,
+            _ => vec![None; m],
+        }
+    }
+    fn put(&self, fingerprint: u64, columns: Vec<Option<Vec<f64>>>) {
+        *self.inner.lock().unwrap_or_else(|e| e.into_inner()) = Some((fingerprint, columns));
+    }
 }
 
 impl<'a> ContactProblem<'a> {
+    /// A fingerprint of the rows of `C = [B_hn; B_Ht]` and the size of `A` (for [`SchurCache`]).
+    pub fn rows_fingerprint(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        self.matrix.n().hash(&mut h);
+        (self.factor as *const CholeskySolver as usize).hash(&mut h);
+        self.n_rows().hash(&mut h);
+        for r in 0..self.n_rows() {
+            for (i, v) in self.row(r) {
+                i.hash(&mut h);
+                v.to_bits().hash(&mut h);
+            }
+            usize::MAX.hash(&mut h);
+        }
+        h.finish()
+    }
+
     /// Checks sizes and finiteness.
     pub fn validate(&self) -> Result<(), ContactError> {
         let n = self.matrix.n();
@@ -209,6 +275,16 @@ pub struct Interface<'a> {
     /// on the trailing dofs ([`synovia_fem::TrailingBlock`]): columns of `S` then cost two
     /// dense triangular solves with `L₂₂` instead of a solve with the whole factor.
     trailing: Option<(std::sync::Arc<synovia_fem::TrailingBlock>, TrailingRows)>,
+    /// Where the columns go back when the interface is dropped.
+    cache: Option<(&'a SchurCache, u64)>,
+}
+
+impl Drop for Interface<'_> {
+    fn drop(&mut self) {
+        if let Some((cache, fingerprint)) = self.cache {
+            cache.put(fingerprint, std::mem::take(&mut self.columns));
+        }
+    }
 }
 
 /// Rows of `C` as `(trailing position, value)` lists.
@@ -238,14 +314,12 @@ impl<'a> Interface<'a> {
             }
             Some((block.clone(), rows))
         });
-        Ok(Self {
-            problem,
-            w,
-            columns: vec![None; m],
-            solves: 1,
-            solve_s: t0.elapsed().as_secs_f64(),
-            trailing,
-        })
+        let cache = problem.schur_cache.map(|c| (c, problem.rows_fingerprint()));
+        let columns = match cache {
+            Some((c, f)) => c.take(f, m),
+            None => vec![None; m],
+        };
+        Ok(Self { problem, w, columns, solves: 1, solve_s: t0.elapsed().as_secs_f64(), trailing, cache })
     }
 
     /// `true` if the columns of `S` come from the trailing block of the factor.

@@ -12,7 +12,7 @@ use synovia_mesh::math::{Real, Vector};
 use crate::error::ContactError;
 use crate::kkt::{check_kkt, KktReport};
 use crate::operators::{ContactGeometry, ContactPair};
-use crate::problem::{ContactProblem, FrictionConstraints};
+use crate::problem::{ContactProblem, FrictionConstraints, SchurCache};
 use crate::solver::{ContactSolution, ContactSolver};
 
 /// A factorised model with its contact geometry.
@@ -21,6 +21,8 @@ pub struct StaticContact<const D: usize> {
     elastic: ElasticSolver<D>,
     geometry: ContactGeometry<D>,
     nested_min_rows: Option<usize>,
+    /// Columns of `S` kept between solves on the same geometry ([`SchurCache`]).
+    schur_cache: SchurCache,
 }
 
 /// The result of one static contact solve.
@@ -56,7 +58,7 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<Self, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
         let elastic = ElasticSolver::new_for_contact(model, params, &interface_nodes(model, pairs)?)?;
-        Ok(Self { elastic, geometry, nested_min_rows: Some(32) })
+        Ok(Self { elastic, geometry, nested_min_rows: Some(32), schur_cache: SchurCache::new() })
     }
 
     /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
@@ -70,6 +72,7 @@ impl<const D: usize> StaticContact<D> {
         displacement: &[Vec<Vector<D>>],
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new_deformed(model, pairs, displacement)?;
+        self.schur_cache.clear();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -117,7 +120,14 @@ impl<const D: usize> StaticContact<D> {
         let (matrix, factor) = (self.elastic.system_matrix(), self.elastic.cholesky());
         macro_rules! problem_with {
             ($rhs:expr) => {
-                ContactProblem { matrix, factor, load: $rhs, normal: &normal, friction }
+                ContactProblem {
+                    matrix,
+                    factor,
+                    load: $rhs,
+                    normal: &normal,
+                    friction,
+                    schur_cache: Some(&self.schur_cache),
+                }
             };
         }
         let mut coarse_iterations = 0;

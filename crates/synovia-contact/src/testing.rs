@@ -42,6 +42,7 @@ impl OwnedProblem {
             load: &self.load,
             normal: &self.normal,
             friction: self.friction.as_ref(),
+            schur_cache: None,
         }
     }
 }

@@ -35,11 +35,16 @@ pub struct ElasticParams {
     pub ordering: OrderingChoice,
     /// Quadrature degree of the load integrals (default: 2).
     pub load_degree: usize,
+    /// Largest number of contact-interface dofs that [`ElasticSolver::new_for_contact`] orders
+    /// last (default 8000; 0 switches the condensed interface off). The trailing block is dense:
+    /// `k²` entries (512 MB at 8000) and `k³/3` flops in the factorisation; measured in
+    /// `docs/performance.md`.
+    pub max_trailing_dofs: usize,
 }
 
 impl Default for ElasticParams {
     fn default() -> Self {
-        Self { ordering: OrderingChoice::Auto, load_degree: 2 }
+        Self { ordering: OrderingChoice::Auto, load_degree: 2, max_trailing_dofs: 8000 }
     }
 }
 
@@ -125,7 +130,7 @@ impl<const D: usize> ElasticSolver<D> {
 
     /// The factorisation for contact problems: like [`ElasticSolver::new_semi_coercive`], and
     /// the reduced dofs of the `interface` nodes (the nodes of the contact parts) are ordered
-    /// last ([`Ordering::Trailing`]) when there are at most [`Self::MAX_TRAILING_DOFS`] of them,
+    /// last ([`Ordering::Trailing`]) when there are at most [`ElasticParams::max_trailing_dofs`] of them,
     /// so that the interface Schur complement `S = C A⁻¹ Cᵀ` is evaluated with the dense
     /// trailing block `L₂₂` of the factor, `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4), instead of
     /// solves with the whole factor ([`CholeskySolver::trailing`]).
@@ -136,10 +141,6 @@ impl<const D: usize> ElasticSolver<D> {
     ) -> Result<Self, FemError> {
         Self::build(model, params, true, interface)
     }
-
-    /// Largest number of interface dofs ordered last by [`ElasticSolver::new_for_contact`]:
-    /// the trailing block is dense (`k²` entries, `k³/3` flops to factorise).
-    pub const MAX_TRAILING_DOFS: usize = 4000;
 
     /// Like [`ElasticSolver::new`], but a semi-coercive model (bodies whose rigid motions no
     /// Dirichlet or symmetry data restrain, spec §4) is accepted: the factorisation is of
@@ -190,7 +191,7 @@ impl<const D: usize> ElasticSolver<D> {
                     last.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
                 }
             }
-            if !last.is_empty() && last.len() <= Self::MAX_TRAILING_DOFS && last.len() < dofs.n_dofs() {
+            if !last.is_empty() && last.len() <= params.max_trailing_dofs && last.len() < dofs.n_dofs() {
                 ordering = Ordering::Trailing { base: Box::new(ordering), last };
             }
         }

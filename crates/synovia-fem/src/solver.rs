@@ -118,17 +118,20 @@ impl CholeskySolver {
                     Ordering::Custom(p) => p.clone(),
                     Ordering::Metis { blocks, adjacency } => metis_order(n, blocks, adjacency)?,
                     Ordering::Amd => {
-                        let sym = factorize_symbolic_cholesky(
+                        use faer::sparse::linalg::amd;
+                        let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+                        let req = amd::order_scratch::<usize>(n, a.nnz());
+                        let mut mem = MemBuffer::try_new(req)
+                            .map_err(|_| FemError::Sparse("out of memory (AMD scratch)".into()))?;
+                        amd::order(
+                            &mut fwd,
+                            &mut inv,
                             a.pattern().as_ref(),
-                            Side::Lower,
-                            SymmetricOrdering::Amd,
-                            CholeskySymbolicParams::default(),
+                            amd::Control::default(),
+                            MemStack::new(&mut mem),
                         )
-                        .map_err(|e| FemError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
-                        match sym.perm() {
-                            Some(p) => p.arrays().0.to_vec(),
-                            None => (0..n).collect(),
-                        }
+                        .map_err(|e| FemError::Sparse(format!("AMD ordering: {e:?}")))?;
+                        fwd
                     }
                 };
                 let mut is_last = vec![false; n];
@@ -200,7 +203,10 @@ impl CholeskySolver {
             .try_reserve_exact(len)
             .map_err(|_| FemError::Sparse(format!("out of memory for a Cholesky factor of {len} entries")))?;
         self.factor.resize(len, 0.0);
-        let par = faer::get_global_parallelism();
+        // Threads pay only for large factors: below `nnz(L)² / n = 1e10` (≈ flops / 2) the
+        // sequential factorisation is faster (docs/performance.md, "Parallel assembly").
+        let work = (len as f64) * (len as f64) / (a.n().max(1) as f64);
+        let par = if work < 1e10 { Par::Seq } else { faer::get_global_parallelism() };
         let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
         let mut mem =
             MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;

@@ -799,6 +799,7 @@ impl<const D: usize> DynamicStepper<D> {
                 load: rhs,
                 normal: &normal,
                 friction,
+                schur_cache: None,
             };
             let (cell_node, slip_bound) = match (&friction_op, friction.is_some()) {
                 (Some(op), true) => (op.cell_node.clone(), op.slip_bound.clone()),

@@ -19,13 +19,15 @@
 //!
 //! Implementations: [`Constant`], [`PiecewiseLinear`] (a table with linear interpolation and
 //! constant extrapolation), [`FnHistory`] (any closure), [`Periodic`] (wraps another history
-//! with period `T`). `Arc<H>`, `Box<H>` and `&H` of a history are histories too.
+//! with period `T`), [`SharedValue`] (a value set between solves, for interactive use).
+//! `Arc<H>`, `Box<H>` and `&H` of a history are histories too.
 //!
 //! [`RigidMotion`] prescribes the exact rigid displacement of a boundary part (a rotation by
 //! `θ(t)` about a centre plus a translation `T(t)`), for use with
 //! [`Model::prescribe`](synovia_fem::Model::prescribe).
 
 use std::fmt;
+use std::sync::atomic::{AtomicU64, Ordering as AtomicOrdering};
 use std::sync::Arc;
 
 use synovia_mesh::math::{Point, Real, Vector};
@@ -63,6 +65,54 @@ pub struct Constant(pub Real);
 impl LoadHistory for Constant {
     fn value(&self, _t: Real) -> Real {
         self.0
+    }
+}
+
+/// A settable amplitude shared between clones: `h(t) = v`, the value last stored with
+/// [`SharedValue::set`] (independent of `t`).
+///
+/// This is the history for interactive use (navigation): build the model with `SharedValue`
+/// histories, keep clones of them, and change the loads or prescribed displacements between
+/// solves with [`SharedValue::set`] — the model reads the current value at every solve, so
+/// nothing is rebuilt or refactorised. The value is stored in an `Arc<AtomicU64>` (bit pattern
+/// of the `f64`), so a clone may be set from another thread.
+///
+/// ```
+/// use synovia_time::history::{LoadHistory, SharedValue};
+///
+/// let force = SharedValue::new(10.0);
+/// let in_model = force.clone(); // e.g. given to JointModel::traction
+/// force.set(25.0);
+/// assert_eq!(in_model.value(0.0), 25.0);
+/// assert_eq!(in_model.value(7.0), 25.0); // independent of t
+/// ```
+#[derive(Clone, Default)]
+pub struct SharedValue(Arc<AtomicU64>);
+
+impl SharedValue {
+    /// A shared value, initially `v`.
+    pub fn new(v: Real) -> Self {
+        Self(Arc::new(AtomicU64::new(v.to_bits())))
+    }
+    /// Stores `v` (seen by every clone).
+    pub fn set(&self, v: Real) {
+        self.0.store(v.to_bits(), AtomicOrdering::Relaxed);
+    }
+    /// The current value.
+    pub fn get(&self) -> Real {
+        Real::from_bits(self.0.load(AtomicOrdering::Relaxed))
+    }
+}
+
+impl fmt::Debug for SharedValue {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_tuple("SharedValue").field(&self.get()).finish()
+    }
+}
+
+impl LoadHistory for SharedValue {
+    fn value(&self, _t: Real) -> Real {
+        self.get()
     }
 }
 

@@ -37,6 +37,15 @@
 //! The factorisation of `A` is done once, in [`QuasiStaticStepper::new`], and reused at every
 //! level and fixed-point iteration (spec §7).
 //!
+//! # One level at a time
+//!
+//! [`QuasiStaticStepper::step`] advances the scheme by one level (step 0 if no sequence is
+//! under way) and keeps the friction state (`Λ_n` for `g_c`, the slip origin, the warm start)
+//! for the next call; [`QuasiStaticStepper::run`] is `step` over a list of times, so both give
+//! the same results. [`QuasiStaticStepper::restart`] starts a new sequence with step 0 at a
+//! given time, optionally warm-started from the last solution (re-solve with new loads, e.g.
+//! `synovia::session::JointSession`), and [`QuasiStaticStepper::reset`] forgets the sequence.
+//!
 //! # Re-pairing at every level (sliding contact)
 //!
 //! With [`QuasiStaticStepper::set_repairing`] the contact geometry is rebuilt before every level
@@ -147,6 +156,12 @@ pub struct QuasiStaticStepper<const D: usize> {
     body_nodes: Vec<usize>,
     last: Option<StaticContactResult<D>>,
     repair: Option<Vec<ContactPair<D>>>,
+    /// Index of the next level of the current sequence (0: none solved yet).
+    next_step: usize,
+    /// Time of the last level of the current sequence.
+    last_time: Option<Real>,
+    /// Friction dissipation summed over the current sequence.
+    cumulative: Real,
 }
 
 impl<const D: usize> QuasiStaticStepper<D> {
@@ -164,7 +179,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
     ) -> Result<Self, TimeError> {
         params.validate()?;
         let contact = StaticContact::new(model, pairs, elastic)?;
-        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None, repair: None })
+        Ok(Self::assemble(contact, params, body_nodes(model)))
     }
 
     /// Wraps an existing [`StaticContact`] of `model` (e.g. with nested iteration switched off).
@@ -177,7 +192,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
         params: QuasiStaticParams,
     ) -> Result<Self, TimeError> {
         params.validate()?;
-        Ok(Self { contact, params, body_nodes: body_nodes(model), last: None, repair: None })
+        Ok(Self::assemble(contact, params, body_nodes(model)))
     }
 
     /// Re-pair every level `i ≥ 1` from the configuration of level `i − 1` with the contact
@@ -212,15 +227,112 @@ impl<const D: usize> QuasiStaticStepper<D> {
         self.params = params;
         Ok(())
     }
-    /// The contact solution of the last level of the last [`QuasiStaticStepper::run`] (`None`
-    /// before any run and after a run that failed).
+    /// The contact solution of the last level solved ([`QuasiStaticStepper::step`],
+    /// [`QuasiStaticStepper::restart`], or the last level of [`QuasiStaticStepper::run`]);
+    /// `None` before any level, after [`QuasiStaticStepper::reset`] and after a run that failed.
     pub fn last_result(&self) -> Option<&StaticContactResult<D>> {
         self.last.as_ref()
+    }
+    /// Time of the last level of the current sequence (`None` if none was solved).
+    pub fn last_time(&self) -> Option<Real> {
+        self.last_time
+    }
+    /// Index of the level that the next [`QuasiStaticStepper::step`] solves (0: the initial
+    /// state).
+    pub fn next_step(&self) -> usize {
+        self.next_step
+    }
+
+    /// Forgets the current sequence (friction state, last solution, cumulative dissipation):
+    /// the next [`QuasiStaticStepper::step`] solves the initial state (step 0). The
+    /// factorisation and the contact geometry (with re-pairing: of the last level) are kept.
+    pub fn reset(&mut self) {
+        self.last = None;
+        self.next_step = 0;
+        self.last_time = None;
+        self.cumulative = 0.0;
+    }
+
+    /// Whether [`QuasiStaticStepper::restart`] with `warm = true` would be warm-started: there
+    /// is a last solution and it fits the current contact geometry.
+    pub fn has_warm_start(&self) -> bool {
+        self.last.as_ref().is_some_and(|r| r.solution.lambda_n.len() == self.contact.geometry().len())
+    }
+
+    /// Advances the scheme by one time level to `t` (see the [module documentation](self)):
+    /// without a current sequence (new stepper, after [`QuasiStaticStepper::reset`] or a failed
+    /// run) the initial state at `t` (step 0), otherwise the Tresca problem at `t` with `g_c`
+    /// and the slip origin of the last level, warm-started from it (with re-pairing: after
+    /// rebuilding the geometry from the last level's configuration). Returns the level's
+    /// record and contact solution (also [`QuasiStaticStepper::last_result`]).
+    ///
+    /// [`QuasiStaticStepper::run`] is this method called for every time level, so stepping
+    /// one level at a time gives the same records and solutions as one run.
+    ///
+    /// If the solve fails, the sequence keeps its last level (with re-pairing: carried to the
+    /// rebuilt geometry), so the step can be retried, e.g. with other loads.
+    ///
+    /// # Errors
+    /// [`TimeError::InvalidParameter`] for a `t` that is not finite or not later than the last
+    /// level, or a `model` whose bodies differ from the one the stepper was built with;
+    /// [`TimeError::Contact`] (with the step and time) when a contact solve fails;
+    /// [`TimeError::FixedPoint`] when the Coulomb fixed point does not converge;
+    /// [`TimeError::Fem`] from the post-processing.
+    pub fn step(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+    ) -> Result<(StepRecord, &StaticContactResult<D>), TimeError> {
+        self.check_model(model)?;
+        if !t.is_finite() {
+            return Err(TimeError::InvalidParameter(format!("time level {} is {t}", self.next_step)));
+        }
+        if let Some(last) = self.last_time.filter(|&l| t <= l) {
+            return Err(TimeError::InvalidParameter(format!(
+                "time levels must increase strictly: t_{} = {t} ≤ t_{} = {last}",
+                self.next_step,
+                self.next_step.saturating_sub(1)
+            )));
+        }
+        self.level(model, t, solver, None)
+    }
+
+    /// Starts a new sequence with the initial state at `t` (step 0, as the first level of
+    /// [`QuasiStaticStepper::run`]); with `warm = true` its frictionless solve is warm-started
+    /// from the last solution (`U`, `Λ_n`; see [`QuasiStaticStepper::has_warm_start`])
+    /// instead of the cold start (nested iteration) — the re-solve of the same model with new
+    /// loads or prescribed displacements. The factorisation is reused. If the solve fails, the
+    /// previous sequence is kept.
+    ///
+    /// # Errors
+    /// As [`QuasiStaticStepper::step`] (any finite `t` is accepted).
+    pub fn restart(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        warm: bool,
+    ) -> Result<(StepRecord, &StaticContactResult<D>), TimeError> {
+        self.check_model(model)?;
+        if !t.is_finite() {
+            return Err(TimeError::InvalidParameter(format!("time level 0 is {t}")));
+        }
+        let warm = match &self.last {
+            Some(last) if warm && self.has_warm_start() => {
+                let none = vec![0.0; self.contact.geometry().len()];
+                Some(warm_start(self.contact.geometry(), last, &none))
+            }
+            _ => None,
+        };
+        self.level(model, t, solver, Some(warm))
     }
 
     /// Runs the levels `times` (finite, strictly increasing, at least one): step 0 is the
     /// initial state at `times[0]`, step `i` the Tresca problem at `times[i]` with `g_c` and
-    /// the slip origin from step `i − 1` (see the [module documentation](self)).
+    /// the slip origin from step `i − 1` (see the [module documentation](self)). Starts a new
+    /// sequence ([`QuasiStaticStepper::reset`]) and calls [`QuasiStaticStepper::step`] for
+    /// every level.
     ///
     /// `observer` is called after every level with its record and contact solution (write
     /// output, check KKT, collect figures…); an error from it stops the run and is returned.
@@ -239,54 +351,92 @@ impl<const D: usize> QuasiStaticStepper<D> {
     ) -> Result<Vec<StepRecord>, TimeError> {
         self.check_model(model)?;
         check_times(times)?;
-        self.last = None;
+        self.reset();
         let mut records: Vec<StepRecord> = Vec::with_capacity(times.len());
-        let mut cumulative = 0.0;
-        let mut previous: Option<StaticContactResult<D>> = None;
-        for (step, &t) in times.iter().enumerate() {
-            let start = Instant::now();
-            if let (Some(pairs), Some(prev)) = (&self.repair, previous.as_mut()) {
+        for &t in times {
+            let outcome = match self.step(model, t, solver) {
+                Ok((record, result)) => observer(&record, result).map(|()| record),
+                Err(e) => Err(e),
+            };
+            match outcome {
+                Ok(record) => records.push(record),
+                Err(e) => {
+                    self.reset();
+                    return Err(e);
+                }
+            }
+        }
+        Ok(records)
+    }
+
+    fn assemble(contact: StaticContact<D>, params: QuasiStaticParams, body_nodes: Vec<usize>) -> Self {
+        Self {
+            contact,
+            params,
+            body_nodes,
+            last: None,
+            repair: None,
+            next_step: 0,
+            last_time: None,
+            cumulative: 0.0,
+        }
+    }
+
+    /// One level at `t`: the next level of the current sequence (`restart = None`; step 0 if
+    /// there is none), or step 0 of a new sequence warm-started from the given solution
+    /// (`restart = Some(warm)`). Commits the state only on success.
+    fn level(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        restart: Option<Option<ContactSolution>>,
+    ) -> Result<(StepRecord, &StaticContactResult<D>), TimeError> {
+        let start = Instant::now();
+        let (step, base, initial_warm) = match restart {
+            Some(warm) => (0, 0.0, warm),
+            None => (self.next_step, self.cumulative, None),
+        };
+        if step > 0 {
+            if let (Some(pairs), Some(prev)) = (&self.repair, self.last.as_mut()) {
                 let old = self
                     .contact
                     .update_geometry(model, pairs, &prev.displacement)
                     .map_err(|source| TimeError::Contact { step, time: t, source })?;
                 *prev = transfer_result(&old, self.contact.geometry(), prev);
             }
-            let (result, iterations) = match &previous {
-                None => self.initial(model, t, solver)?,
-                Some(prev) => {
-                    let g = self.contact.geometry().slip_bounds_from_pressure(&prev.solution.lambda_n);
-                    let origin = self.params.incremental_slip.then_some(prev.displacement.as_slice());
-                    self.tresca_level(model, step, t, solver, g, origin, Some(prev))?
-                }
-            };
-            let geometry = self.contact.geometry();
-            let dissipation = friction_dissipation(
-                geometry,
-                &result,
-                previous.as_ref().map(|p| p.displacement.as_slice()),
-            )?;
-            cumulative += dissipation;
-            let strain_energy =
-                body_fields(model, &result.displacement)?.iter().map(|f| f.strain_energy).sum();
-            let record = StepRecord {
-                step,
-                time: t,
-                pairs: pair_records(geometry, &result),
-                friction_dissipation: dissipation,
-                cumulative_friction_dissipation: cumulative,
-                kinetic_energy: 0.0,
-                strain_energy,
-                viscous_dissipation: 0.0,
-                iterations,
-                step_s: start.elapsed().as_secs_f64(),
-            };
-            observer(&record, &result)?;
-            records.push(record);
-            previous = Some(result);
         }
-        self.last = previous;
-        Ok(records)
+        let previous = if step > 0 { self.last.as_ref() } else { None };
+        let (result, iterations) = match previous {
+            None => self.initial(model, t, solver, initial_warm.as_ref())?,
+            Some(prev) => {
+                let g = self.contact.geometry().slip_bounds_from_pressure(&prev.solution.lambda_n);
+                let origin = self.params.incremental_slip.then_some(prev.displacement.as_slice());
+                self.tresca_level(model, step, t, solver, g, origin, Some(prev))?
+            }
+        };
+        let geometry = self.contact.geometry();
+        let dissipation =
+            friction_dissipation(geometry, &result, previous.map(|p| p.displacement.as_slice()))?;
+        let cumulative = base + dissipation;
+        let strain_energy = body_fields(model, &result.displacement)?.iter().map(|f| f.strain_energy).sum();
+        let record = StepRecord {
+            step,
+            time: t,
+            pairs: pair_records(geometry, &result),
+            friction_dissipation: dissipation,
+            cumulative_friction_dissipation: cumulative,
+            kinetic_energy: 0.0,
+            strain_energy,
+            viscous_dissipation: 0.0,
+            iterations,
+            step_s: start.elapsed().as_secs_f64(),
+        };
+        self.cumulative = cumulative;
+        self.next_step = step + 1;
+        self.last_time = Some(t);
+        let result = &*self.last.insert(result);
+        Ok((record, result))
     }
 
     fn check_model(&self, model: &Model<D>) -> Result<(), TimeError> {
@@ -300,17 +450,18 @@ impl<const D: usize> QuasiStaticStepper<D> {
         Ok(())
     }
 
-    /// Step 0: frictionless solve at `t_0`, optionally followed by a Tresca solve with `g_c`
+    /// Step 0: frictionless solve at `t_0` (warm-started from `warm` if given), optionally followed by a Tresca solve with `g_c`
     /// from it (slip from the reference state).
     fn initial(
         &self,
         model: &Model<D>,
         t: Real,
         solver: &dyn ContactSolver,
+        warm: Option<&ContactSolution>,
     ) -> Result<(StaticContactResult<D>, usize), TimeError> {
         let pre = self
             .contact
-            .solve(model, t, solver, None, None, None)
+            .solve(model, t, solver, None, None, warm)
             .map_err(|source| TimeError::Contact { step: 0, time: t, source })?;
         let its = pre.solution.report.iterations + pre.coarse_iterations;
         let has_friction = self.contact.geometry().nodes.iter().any(|n| n.friction > 0.0);

@@ -626,3 +626,87 @@ fn slip_origin_and_initial_friction_options() {
     // nothing slips any more (without it, the lagged g_c of step 0 lets the edges slip a bit)
     assert!(records[1].friction_dissipation < 1e-6 * records[0].friction_dissipation);
 }
+
+/// Records without the wall time (`step_s`), for bit-exact comparisons.
+fn timeless(rec: &StepRecord) -> StepRecord {
+    StepRecord { step_s: 0.0, ..rec.clone() }
+}
+
+fn assert_same_result(a: &StaticContactResult<2>, b: &StaticContactResult<2>) {
+    assert_eq!(a.displacement, b.displacement);
+    assert_eq!(a.solution.u, b.solution.u);
+    assert_eq!(a.solution.lambda_n, b.solution.lambda_n);
+    assert_eq!(a.solution.lambda_t, b.solution.lambda_t);
+    assert_eq!(a.cell_node, b.cell_node);
+    assert_eq!(a.slip_bound, b.slip_bound);
+}
+
+#[test]
+fn stepping_one_level_at_a_time_is_bit_identical_to_run() {
+    // push, then shear into partial slip and back: friction state carried from level to level
+    let push = PiecewiseLinear::new(&[(0.0, 0.0), (1.0, 0.02)]).expect("push");
+    let shift = PiecewiseLinear::new(&[(1.0, 0.0), (2.0, 0.004), (3.0, -0.002)]).expect("shift");
+    let (model, pairs) = half_discs(1, push, shift, true, 0.3);
+    let times = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0];
+    for params in [
+        QuasiStaticParams::default(),
+        QuasiStaticParams { coulomb_fixed_point: true, initial_friction: true, ..Default::default() },
+        QuasiStaticParams { incremental_slip: false, ..Default::default() },
+    ] {
+        let solver = pdas();
+        let mut runner =
+            QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), params).expect("new");
+        let mut run_results = Vec::new();
+        let records = runner
+            .run(&model, &times, &solver, |_, res| {
+                run_results.push(res.clone());
+                Ok(())
+            })
+            .expect("run");
+        let mut stepper =
+            QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), params).expect("new");
+        for (i, &t) in times.iter().enumerate() {
+            assert_eq!(stepper.next_step(), i);
+            let (rec, res) = stepper.step(&model, t, &solver).expect("step");
+            assert_eq!(timeless(&rec), timeless(&records[i]), "{params:?} level {i}");
+            assert_same_result(res, &run_results[i]);
+            assert_eq!(stepper.last_time(), Some(t));
+        }
+        assert!(records.iter().skip(2).any(|r| r.friction_dissipation > 0.0), "{params:?}: no slip");
+        // time must increase; a failed step keeps the sequence
+        assert!(matches!(stepper.step(&model, 3.0, &solver), Err(TimeError::InvalidParameter(_))));
+        assert!(stepper.step(&model, Real::NAN, &solver).is_err());
+        assert_eq!(stepper.next_step(), times.len());
+        // restart: step 0 again, cold or warm, equal to the first level of the run
+        let (rec, _) = stepper.restart(&model, times[0], &solver, false).expect("restart");
+        assert_eq!(timeless(&rec), timeless(&records[0]));
+        assert_eq!(stepper.next_step(), 1);
+        stepper.reset();
+        assert!(stepper.last_result().is_none() && stepper.next_step() == 0);
+    }
+}
+
+#[test]
+fn warm_restart_matches_a_cold_static_solve() {
+    let depth = synovia_time::history::SharedValue::new(0.01);
+    let (model, pairs) = half_discs(1, depth.clone(), Constant(0.0), false, 0.0);
+    let solver = pdas();
+    let mut stepper =
+        QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), QuasiStaticParams::default())
+            .expect("new");
+    assert!(!stepper.has_warm_start());
+    stepper.restart(&model, 0.0, &solver, true).expect("first");
+    assert!(stepper.has_warm_start());
+    depth.set(0.015);
+    let (warm_rec, warm) = stepper.restart(&model, 0.0, &solver, true).expect("warm");
+    let warm = warm.clone();
+    let mut cold_stepper =
+        QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), QuasiStaticParams::default())
+            .expect("new");
+    let (cold_rec, cold) = cold_stepper.step(&model, 0.0, &solver).expect("cold");
+    let du: Vec<Real> = warm.solution.u.iter().zip(&cold.solution.u).map(|(a, b)| a - b).collect();
+    assert!(max_abs(&du) <= 1e-10 * max_abs(&cold.solution.u), "{}", max_abs(&du));
+    assert!(rel_diff(&warm.solution.lambda_n, &cold.solution.lambda_n) <= 1e-10);
+    assert!(warm.kkt.max() < 1e-8, "{:?}", warm.kkt);
+    assert!(warm_rec.iterations <= cold_rec.iterations, "{} > {}", warm_rec.iterations, cold_rec.iterations);
+}
