@@ -20,9 +20,10 @@ use synovia::time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
 /// upper's top moved down by `delta` (`u_x = 0`): the exact solution is the uniaxial strain
 /// state with the uniform contact pressure `p = δ / (H₁/M₁ + H₂/M₂)`, `M = λ + 2μ`.
 ///
-/// The upper block needs a Dirichlet condition in y: with a traction on its top it would be
-/// semi-coercive (only the contact holds it), which synovia-fem rejects; the applied force is
-/// then the reaction at the top, computed from the stresses.
+/// The upper block is driven by a prescribed displacement (with a traction on its top it would be
+/// semi-coercive, held only by the contact — solvable since issue 7, see `tests/semi_coercive.rs`,
+/// but the displacement-driven form was written first); the applied force is then the reaction
+/// at the top, computed from the stresses.
 fn stacked_blocks(n_lower: usize, n_upper: usize, upper_is_slave: bool) -> (Model<2>, Vec<ContactPair<2>>) {
     let mut model = Model::<2>::new();
     let mut lower = rectangle(0.0, 1.0, -0.5, 0.0, n_lower, n_lower / 2, Grading::Uniform, Grading::Uniform)

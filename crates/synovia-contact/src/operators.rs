@@ -450,6 +450,17 @@ impl<const D: usize> ContactPair<D> {
     }
 }
 
+/// The master side of a node-to-segment or mortar pair: another body, a valid search distance.
+fn check_master(slave: BodyId, master: BodyId, search_distance: Option<Real>) -> Result<(), String> {
+    if master == slave {
+        return Err("self-contact (master body = slave body) is not supported".into());
+    }
+    match search_distance {
+        Some(s) if !(s.is_finite() && s >= 0.0) => Err(format!("search distance {s} must be finite and ≥ 0")),
+        _ => Ok(()),
+    }
+}
+
 /// One contact node `s_r`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactNode<const D: usize> {
@@ -752,16 +763,7 @@ impl<const D: usize> ContactGeometry<D> {
                     }
                 }
                 Partner::Segment { body: bl, part: pl, search_distance } => {
-                    if *bl == pair.body {
-                        return Err(invalid(
-                            "self-contact (master body = slave body) is not supported".into(),
-                        ));
-                    }
-                    if let Some(s) = search_distance {
-                        if !(s.is_finite() && *s >= 0.0) {
-                            return Err(invalid(format!("search distance {s} must be finite and ≥ 0")));
-                        }
-                    }
+                    check_master(pair.body, *bl, *search_distance).map_err(invalid)?;
                     let other = model.body(*bl)?;
                     let lpart = other.mesh.boundary_part(pl)?;
                     let lfacets: Vec<Vec<usize>> = lpart.facets().map(<[usize]>::to_vec).collect();
@@ -797,16 +799,7 @@ impl<const D: usize> ContactGeometry<D> {
                     }
                 }
                 Partner::Mortar { body: bl, part: pl, search_distance } => {
-                    if *bl == pair.body {
-                        return Err(invalid(
-                            "self-contact (master body = slave body) is not supported".into(),
-                        ));
-                    }
-                    if let Some(s) = search_distance {
-                        if !(s.is_finite() && *s >= 0.0) {
-                            return Err(invalid(format!("search distance {s} must be finite and ≥ 0")));
-                        }
-                    }
+                    check_master(pair.body, *bl, *search_distance).map_err(invalid)?;
                     let other = model.body(*bl)?;
                     let lfacets: Vec<Vec<usize>> =
                         other.mesh.boundary_part(pl)?.facets().map(<[usize]>::to_vec).collect();
