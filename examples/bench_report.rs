@@ -30,15 +30,13 @@
 //!
 //! Results on the project's 2-core machine are in `docs/performance.md`.
 
-use std::sync::Arc;
 use std::time::Instant;
 
 use serde_json::{json, Value};
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::ContactPair;
-use synovia::hertz::{hertz2d_model, Hertz2d, Hertz3d};
+use synovia::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 use synovia::knee2d::{cycle_times, Knee2d};
-use synovia::mesh::generators::hemisphere_refined;
 use synovia::prelude::*;
 
 mod bench_common;
@@ -139,26 +137,10 @@ fn hertz2d_case(scale: f64, resolve: bool) -> Res<Value> {
 
 fn hemisphere_case(scale: f64) -> Res<Value> {
     let p = Hertz3d { levels: levels(17, scale), ..Default::default() };
-    let r = p.radius;
-    let mut mesh = hemisphere_refined(
-        Point::<3>::new(0.0, 0.0, r),
-        r,
-        p.n,
-        Point::<3>::zeros(),
-        p.refine_radius * r,
-        p.levels,
-    )?;
-    mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
-    mesh.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
-    let mut model = Model::<3>::new();
-    let b = model.add_body("hemisphere", mesh, Arc::new(isotropic(p.e, p.nu)?))?;
-    let push = p.push;
     // the time is the tangential displacement of the top
-    model.prescribe(b, "top", move |_, t| Vector::<3>::new(t, 0.0, -push))?;
-    let flat = PlaneObstacle::new(Point::<3>::zeros(), Vector::<3>::new(0.0, 0.0, 1.0))?;
-    let mut pair = ContactPair::rigid("hemisphere-flat", b, "contact", Arc::new(flat));
-    pair.friction = MU;
-    let mut v = normal_tresca(&model, &[pair], 2e-4 * r, None)?;
+    let (model, mut pairs) = hertz3d_model(&p)?;
+    pairs[0].friction = MU;
+    let mut v = normal_tresca(&model, &pairs, 2e-4 * p.radius, None)?;
     v["levels"] = json!(p.levels);
     Ok(v)
 }

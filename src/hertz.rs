@@ -28,7 +28,7 @@ use synovia_mesh::generators::{
 };
 use synovia_mesh::math::{Point, Real, Vector};
 use synovia_mesh::refine::StraightMidpoint;
-use synovia_mesh::BoundaryKind;
+use synovia_mesh::{BoundaryKind, Mesh};
 
 use crate::contact::{StaticContact, StaticContactResult};
 
@@ -186,15 +186,55 @@ fn fem(e: impl Into<FemError>) -> ContactError {
     ContactError::Fem(e.into())
 }
 
+/// The half-disc indenter of radius `r` above `y = 0` (touching it at the origin), refined
+/// `levels` times toward the origin within `refine_radius · r`, its flat top `"top"` of kind
+/// `Prescribed` (the caller adds its contact part).
+fn half_disc_indenter(
+    r: Real,
+    n: usize,
+    refine_radius: Real,
+    levels: usize,
+) -> Result<Mesh<2>, ContactError> {
+    let mut mesh = half_disc_refined(
+        Point::<2>::new(0.0, r),
+        r,
+        n,
+        Point::<2>::new(0.0, 0.0),
+        refine_radius * r,
+        levels,
+    )?;
+    mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
+    Ok(mesh)
+}
+
+/// The hemisphere indenter of radius `r` above `z = 0` (touching it at the origin), refined
+/// `levels` times toward the origin within `refine_radius · r`: flat top `"top"` of kind
+/// `Prescribed`, contact part `"contact"` = its cap below `z < 0.15 r`.
+fn hemisphere_indenter(
+    r: Real,
+    n: usize,
+    refine_radius: Real,
+    levels: usize,
+) -> Result<Mesh<3>, ContactError> {
+    let mut mesh = hemisphere_refined(
+        Point::<3>::new(0.0, 0.0, r),
+        r,
+        n,
+        Point::<3>::zeros(),
+        refine_radius * r,
+        levels,
+    )?;
+    mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
+    mesh.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
+    Ok(mesh)
+}
+
 /// Builds the model of a 2D Hertz problem: the upper half-disc `"indenter"` (contact part
 /// `"contact"`: its arc below `y < 0.3 R`), and either a rigid flat `y = 0` or the mirrored
 /// lower half-disc `"base"`.
 pub fn hertz2d_model(p: &Hertz2d) -> Result<(Model<2>, Vec<ContactPair<2>>), ContactError> {
     let r = p.radius;
-    let centre = Point::<2>::new(0.0, r);
-    let mut upper =
-        half_disc_refined(centre, r, p.n, Point::<2>::new(0.0, 0.0), p.refine_radius * r, p.levels)?;
-    upper.set_part_kind("top", BoundaryKind::Prescribed)?;
+    let mut upper = half_disc_indenter(r, p.n, p.refine_radius, p.levels)?;
     let sel = move |x: &Point<2>, n: &Vector<2>| x[1] < 0.3 * r && n[1] < 0.0;
     let mut model = Model::<2>::new();
     let mut pairs = Vec::new();
@@ -388,25 +428,23 @@ impl Default for Hertz3d {
     }
 }
 
-/// Solves the 3D Hertz problem with `solver`.
-pub fn hertz3d(p: &Hertz3d, solver: &dyn ContactSolver) -> Result<ContactRun, ContactError> {
-    let r = p.radius;
-    let mut mesh = hemisphere_refined(
-        Point::<3>::new(0.0, 0.0, r),
-        r,
-        p.n,
-        Point::<3>::zeros(),
-        p.refine_radius * r,
-        p.levels,
-    )?;
-    mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
-    mesh.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
+/// Builds the model of the 3D Hertz problem: the hemisphere `"hemisphere"` (contact part
+/// `"contact"`: its cap below `z < 0.15 R`) on the rigid flat `z = 0`; its top moves down by
+/// `push` and sideways (x) by the time `t`.
+pub fn hertz3d_model(p: &Hertz3d) -> Result<(Model<3>, Vec<ContactPair<3>>), ContactError> {
+    let mesh = hemisphere_indenter(p.radius, p.n, p.refine_radius, p.levels)?;
     let mut model = Model::<3>::new();
     let b = model.add_body("hemisphere", mesh, Arc::new(isotropic(p.e, p.nu).map_err(fem)?)).map_err(fem)?;
     let push = p.push;
-    model.prescribe(b, "top", move |_, _| Vector::<3>::new(0.0, 0.0, -push)).map_err(fem)?;
+    model.prescribe(b, "top", move |_, t| Vector::<3>::new(t, 0.0, -push)).map_err(fem)?;
     let flat = PlaneObstacle::new(Point::<3>::zeros(), Vector::<3>::new(0.0, 0.0, 1.0))?;
-    let pairs = vec![ContactPair::rigid("hemisphere-flat", b, "contact", Arc::new(flat))];
+    Ok((model, vec![ContactPair::rigid("hemisphere-flat", b, "contact", Arc::new(flat))]))
+}
+
+/// Solves the 3D Hertz problem with `solver`.
+pub fn hertz3d(p: &Hertz3d, solver: &dyn ContactSolver) -> Result<ContactRun, ContactError> {
+    let r = p.radius;
+    let (model, pairs) = hertz3d_model(p)?;
     let linear_solve_s = linear_solve_time(&model)?;
     let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
     sc.set_nested_iteration(p.nested.then_some(32));
@@ -647,15 +685,7 @@ pub fn refined_axis(
 /// `y < 0.3 R`), body 1 `"block"` (contact part `"top"`), and the node-to-segment pair.
 pub fn hertz2d_block_model(p: &HertzBlock2d) -> Result<(Model<2>, Vec<ContactPair<2>>), ContactError> {
     let r = p.radius;
-    let mut upper = half_disc_refined(
-        Point::<2>::new(0.0, r),
-        r,
-        p.n,
-        Point::<2>::new(0.0, 0.0),
-        p.refine_radius * r,
-        p.levels,
-    )?;
-    upper.set_part_kind("top", BoundaryKind::Prescribed)?;
+    let mut upper = half_disc_indenter(r, p.n, p.refine_radius, p.levels)?;
     upper.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[1] < 0.3 * r && n[1] < 0.0)?;
     let (gx, nx) = refined_axis(-p.half_width, p.half_width, 0.0, 2.0 * p.window, p.block_h, p.block_h_far)?;
     let (gy, ny) = refined_axis(-p.depth, 0.0, 0.0, p.window, p.block_h, p.block_h_far)?;
@@ -806,17 +836,7 @@ impl Default for HertzBlock3d {
 /// `z < 0.15 R`; its top moved by `(t, 0, −push)` at time `t`), body 1 `"block"` (contact part
 /// `"top"`), and the pair.
 pub fn hertz3d_block_model(p: &HertzBlock3d) -> Result<(Model<3>, Vec<ContactPair<3>>), ContactError> {
-    let r = p.radius;
-    let mut upper = hemisphere_refined(
-        Point::<3>::new(0.0, 0.0, r),
-        r,
-        p.n,
-        Point::<3>::zeros(),
-        p.refine_radius * r,
-        p.levels,
-    )?;
-    upper.set_part_kind("top", BoundaryKind::Prescribed)?;
-    upper.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
+    let upper = hemisphere_indenter(p.radius, p.n, p.refine_radius, p.levels)?;
     let (w, d, nb) = (p.half_width, p.depth, p.block_n.max(1));
     let coarse = box_mesh([-w, -w, -d], [w, w, 0.0], [2 * nb, 2 * nb, nb], [Grading::Uniform; 3])?;
     let rr = p.block_refine_radius;
