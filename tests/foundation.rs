@@ -221,3 +221,20 @@ fn trailing_block_of_the_factor_gives_the_interface_inverse() {
     }
     assert_eq!(layouts, vec![false, true], "both faer layouts must be exercised");
 }
+
+/// A trailing ordering over a base that is not a permutation is an error, not a panic.
+#[test]
+fn trailing_ordering_over_a_bad_base_permutation_is_an_error() {
+    use synovia::fem::{CholeskySolver, Ordering};
+    let solver = ElasticSolver::new(&cantilever(), ElasticParams::default()).expect("factor");
+    let a = solver.stiffness();
+    let n = a.n();
+    let mut too_big: Vec<usize> = (0..n).collect();
+    too_big[1] = n + 7;
+    for base in [vec![0; n], too_big, (0..n - 1).collect()] {
+        let ordering = Ordering::Trailing { base: Box::new(Ordering::Custom(base)), last: vec![0, 1] };
+        assert!(CholeskySolver::analyse(a, &ordering).is_err());
+    }
+    let ok = Ordering::Trailing { base: Box::new(Ordering::Custom((0..n).collect())), last: vec![0, 1] };
+    assert!(CholeskySolver::analyse(a, &ok).is_ok());
+}

@@ -44,7 +44,8 @@ impl KktReport {
     }
 }
 
-fn inf_norm(v: &[f64]) -> f64 {
+/// `‖v‖_∞`.
+pub(crate) fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |a, b| a.max(b.abs()))
 }
 

@@ -361,32 +361,12 @@ impl<'a> Interface<'a> {
             return Ok(());
         }
         let t0 = Instant::now();
-        if let Some((block, rows)) = &self.trailing {
-            let computed = trailing_columns(block, rows, &missing);
-            self.solves += computed.len();
-            for (j, col) in computed {
-                self.columns[j] = Some(col);
-            }
-            self.solve_s += t0.elapsed().as_secs_f64();
-            return Ok(());
-        }
         let problem = self.problem;
-        // Two worker threads on the two halves when there is enough work: triangular solves
-        // with many right-hand sides do not parallelise well inside faer (notes: faer-0.24.md),
-        // so the right-hand sides are split instead.
-        let computed: Vec<(usize, Vec<f64>)> = if missing.len() >= 64 {
-            let (a, b) = missing.split_at(missing.len() / 2);
-            let (ra, rb) = std::thread::scope(|scope| {
-                let ha = scope.spawn(|| schur_columns(&problem, a));
-                let rb = schur_columns(&problem, b);
-                (ha.join(), rb)
-            });
-            let mut ra =
-                ra.map_err(|_| ContactError::InvalidParameter("a column worker panicked".into()))??;
-            ra.extend(rb?);
-            ra
-        } else {
-            schur_columns(&problem, &missing)?
+        let computed = match &self.trailing {
+            Some((block, rows)) => in_two_halves(&missing, block.dofs.len() >= 256, |cols| {
+                Ok(trailing_columns(block, rows, cols))
+            })?,
+            None => in_two_halves(&missing, true, |cols| schur_columns(&problem, cols))?,
         };
         self.solves += computed.len();
         for (j, col) in computed {
@@ -435,53 +415,50 @@ impl<'a> Interface<'a> {
     }
 }
 
+/// Runs `columns` on the two halves of `cols` on two threads when there is enough work (at
+/// least 64 columns and `worth_splitting`), else on all of them at once: triangular solves with
+/// many right-hand sides do not parallelise well inside faer (notes: faer-0.24.md), so the
+/// right-hand sides are split instead.
+fn in_two_halves(
+    cols: &[usize],
+    worth_splitting: bool,
+    columns: impl Fn(&[usize]) -> Result<Vec<(usize, Vec<f64>)>, ContactError> + Sync,
+) -> Result<Vec<(usize, Vec<f64>)>, ContactError> {
+    if cols.len() < 64 || !worth_splitting {
+        return columns(cols);
+    }
+    let (a, b) = cols.split_at(cols.len() / 2);
+    let (ra, rb) = std::thread::scope(|scope| {
+        let ha = scope.spawn(|| columns(a));
+        let rb = columns(b);
+        (ha.join(), rb)
+    });
+    let mut ra = ra.map_err(|_| ContactError::InvalidParameter("a column worker panicked".into()))??;
+    ra.extend(rb?);
+    Ok(ra)
+}
+
 /// Columns `j ∈ cols` of `S = C_c L₂₂⁻ᵀ L₂₂⁻¹ C_cᵀ` from the trailing block (`rows`: the
-/// rows of `C` in trailing positions): dense triangular solves with all right-hand sides at
-/// once, split over two threads when there are many.
+/// rows of `C` in trailing positions): dense triangular solves with all right-hand sides at once.
 fn trailing_columns(
     block: &synovia_fem::TrailingBlock,
     rows: &[Vec<(usize, f64)>],
     cols: &[usize],
 ) -> Vec<(usize, Vec<f64>)> {
-    let k = block.dofs.len();
-    let run = |cols: &[usize]| -> Vec<(usize, Vec<f64>)> {
-        let mut rhs = faer::Mat::<f64>::zeros(k, cols.len());
-        for (c, &j) in cols.iter().enumerate() {
-            for &(p, v) in &rows[j] {
-                rhs[(p, c)] += v;
-            }
+    let mut rhs = faer::Mat::<f64>::zeros(block.dofs.len(), cols.len());
+    for (c, &j) in cols.iter().enumerate() {
+        for &(p, v) in &rows[j] {
+            rhs[(p, c)] += v;
         }
-        block.solve_in_place(rhs.as_mut());
-        cols.iter()
-            .enumerate()
-            .map(|(c, &j)| {
-                let x = rhs.col(c);
-                let col: Vec<f64> = rows.iter().map(|row| row.iter().map(|&(p, v)| v * x[p]).sum()).collect();
-                (j, col)
-            })
-            .collect()
-    };
-    if cols.len() >= 64 && k >= 256 {
-        let (a, b) = cols.split_at(cols.len() / 2);
-        let (mut ra, rb) = std::thread::scope(|scope| {
-            let ha = scope.spawn(|| run(a));
-            let rb = run(b);
-            (ha.join(), rb)
-        });
-        match &mut ra {
-            Ok(ra) => {
-                ra.extend(rb);
-                std::mem::take(ra)
-            }
-            Err(_) => {
-                let mut all = run(a);
-                all.extend(rb);
-                all
-            }
-        }
-    } else {
-        run(cols)
     }
+    block.solve_in_place(rhs.as_mut());
+    cols.iter()
+        .enumerate()
+        .map(|(c, &j)| {
+            let x = rhs.col(c);
+            (j, rows.iter().map(|row| row.iter().map(|&(p, v)| v * x[p]).sum()).collect())
+        })
+        .collect()
 }
 
 /// Columns `j ∈ cols` of `S = C A⁻¹ Cᵀ`: batched solves, 32 right-hand sides at a time.

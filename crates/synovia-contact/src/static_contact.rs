@@ -10,7 +10,7 @@ use synovia_fem::{ElasticParams, ElasticSolver, Model};
 use synovia_mesh::math::{Real, Vector};
 
 use crate::error::ContactError;
-use crate::kkt::{check_kkt, KktReport};
+use crate::kkt::{check_kkt, inf_norm, KktReport};
 use crate::operators::{ContactGeometry, ContactPair};
 use crate::problem::{ContactProblem, FrictionConstraints, SchurCache};
 use crate::solver::{ContactSolution, ContactSolver};
@@ -262,10 +262,6 @@ const PROXIMAL_MAX_ITERATIONS: usize = 60;
 /// Relative equilibrium residual `‖S (U_{k+1} − U_k)‖_∞ / max(‖F‖_∞, ‖B_hnᵀ κ Λ_n‖_∞)` at
 /// which the proximal-point iteration stops.
 const PROXIMAL_TOLERANCE: f64 = 1e-12;
-
-fn inf_norm(v: &[f64]) -> f64 {
-    v.iter().fold(0.0, |a, b| a.max(b.abs()))
-}
 
 impl<const D: usize> StaticContactResult<D> {
     /// Total normal contact force `Σ_r κ_r Λ_n,r` of the nodes in `range`.

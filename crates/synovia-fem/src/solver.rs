@@ -105,35 +105,18 @@ impl CholeskySolver {
     pub fn analyse(a: &SymmetricMatrix, ordering: &Ordering) -> Result<Self, FemError> {
         let t0 = Instant::now();
         let n = a.n();
-        let mut trailing_dofs = None;
-        let perm: Option<Vec<usize>> = match ordering {
-            Ordering::Amd => None,
-            Ordering::Custom(p) => Some(p.clone()),
-            Ordering::Metis { blocks, adjacency } => Some(metis_order(n, blocks, adjacency)?),
+        let (perm, trailing_dofs) = match ordering {
             Ordering::Trailing { base, last } => {
-                let base_perm: Vec<usize> = match base.as_ref() {
+                let base_perm = match base.as_ref() {
                     Ordering::Trailing { .. } => {
                         return Err(FemError::InvalidParameter("nested trailing orderings".into()))
                     }
-                    Ordering::Custom(p) => p.clone(),
-                    Ordering::Metis { blocks, adjacency } => metis_order(n, blocks, adjacency)?,
-                    Ordering::Amd => {
-                        use faer::sparse::linalg::amd;
-                        let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
-                        let req = amd::order_scratch::<usize>(n, a.nnz());
-                        let mut mem = MemBuffer::try_new(req)
-                            .map_err(|_| FemError::Sparse("out of memory (AMD scratch)".into()))?;
-                        amd::order(
-                            &mut fwd,
-                            &mut inv,
-                            a.pattern().as_ref(),
-                            amd::Control::default(),
-                            MemStack::new(&mut mem),
-                        )
-                        .map_err(|e| FemError::Sparse(format!("AMD ordering: {e:?}")))?;
-                        fwd
-                    }
+                    other => match explicit_order(n, other)? {
+                        Some(p) => p,
+                        None => amd_order(a)?,
+                    },
                 };
+                inverse_permutation(&base_perm, n)?;
                 let mut is_last = vec![false; n];
                 for &d in last {
                     if d >= n || is_last[d] {
@@ -143,12 +126,11 @@ impl CholeskySolver {
                     }
                     is_last[d] = true;
                 }
-                let mut fwd: Vec<usize> = base_perm.iter().copied().filter(|&d| !is_last[d]).collect();
-                let tail: Vec<usize> = base_perm.iter().copied().filter(|&d| is_last[d]).collect();
+                let (mut fwd, tail): (Vec<usize>, Vec<usize>) = base_perm.iter().partition(|&&d| !is_last[d]);
                 fwd.extend_from_slice(&tail);
-                trailing_dofs = Some(tail);
-                Some(fwd)
+                (Some(fwd), Some(tail))
             }
+            other => (explicit_order(n, other)?, None),
         };
         let symbolic = match &perm {
             None => factorize_symbolic_cholesky(
@@ -158,16 +140,7 @@ impl CholeskySolver {
                 CholeskySymbolicParams::default(),
             ),
             Some(fwd) => {
-                if fwd.len() != n {
-                    return Err(FemError::Length { what: "ordering", expected: n, got: fwd.len() });
-                }
-                let mut inv = vec![usize::MAX; n];
-                for (i, &p) in fwd.iter().enumerate() {
-                    if p >= n || inv[p] != usize::MAX {
-                        return Err(FemError::InvalidParameter("ordering is not a permutation".into()));
-                    }
-                    inv[p] = i;
-                }
+                let inv = inverse_permutation(fwd, n)?;
                 let perm = PermRef::new_checked(fwd, &inv, n);
                 factorize_symbolic_cholesky(
                     a.pattern().as_ref(),
@@ -337,6 +310,44 @@ impl CholeskySolver {
     pub fn symbolic(&self) -> &Arc<SymbolicCholesky<usize>> {
         &self.symbolic
     }
+}
+
+/// The forward permutation of an ordering that is given or computed outside faer (`None`:
+/// faer's AMD inside the symbolic analysis). Not for [`Ordering::Trailing`].
+fn explicit_order(n: usize, ordering: &Ordering) -> Result<Option<Vec<usize>>, FemError> {
+    match ordering {
+        Ordering::Amd | Ordering::Trailing { .. } => Ok(None),
+        Ordering::Custom(p) => Ok(Some(p.clone())),
+        Ordering::Metis { blocks, adjacency } => Ok(Some(metis_order(n, blocks, adjacency)?)),
+    }
+}
+
+/// faer's AMD ordering of the pattern of `a`, as a forward permutation.
+fn amd_order(a: &SymmetricMatrix) -> Result<Vec<usize>, FemError> {
+    use faer::sparse::linalg::amd;
+    let n = a.n();
+    let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+    let req = amd::order_scratch::<usize>(n, a.nnz());
+    let mut mem =
+        MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (AMD scratch)".into()))?;
+    amd::order(&mut fwd, &mut inv, a.pattern().as_ref(), amd::Control::default(), MemStack::new(&mut mem))
+        .map_err(|e| FemError::Sparse(format!("AMD ordering: {e:?}")))?;
+    Ok(fwd)
+}
+
+/// The inverse of the forward permutation `fwd` of `0..n`; an error if it is not one.
+fn inverse_permutation(fwd: &[usize], n: usize) -> Result<Vec<usize>, FemError> {
+    if fwd.len() != n {
+        return Err(FemError::Length { what: "ordering", expected: n, got: fwd.len() });
+    }
+    let mut inv = vec![usize::MAX; n];
+    for (i, &p) in fwd.iter().enumerate() {
+        if p >= n || inv[p] != usize::MAX {
+            return Err(FemError::InvalidParameter("ordering is not a permutation".into()));
+        }
+        inv[p] = i;
+    }
+    Ok(inv)
 }
 
 /// METIS nested-dissection ordering of a block graph, expanded to a dof permutation.
