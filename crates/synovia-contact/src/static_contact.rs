@@ -156,6 +156,7 @@ impl<const D: usize> StaticContact<D> {
             _ => vec![0.0; load.len()],
         };
         let mut history = Vec::new();
+        let load_norm = inf_norm(&load);
         for iteration in 1..=PROXIMAL_MAX_ITERATIONS {
             let rhs: Vec<f64> = st.spring_mul(&u_k).iter().zip(&load).map(|(s, f)| s + f).collect();
             let problem = problem_with!(&rhs);
@@ -165,7 +166,7 @@ impl<const D: usize> StaticContact<D> {
             let mut forces = vec![0.0; load.len()];
             let nu: Vec<f64> = solution.lambda_n.iter().zip(&normal.weights).map(|(l, k)| l * k).collect();
             normal.rows.mul_transpose_add(&nu, &mut forces);
-            let scale = inf_norm(&load).max(inf_norm(&forces)).max(f64::MIN_POSITIVE);
+            let scale = load_norm.max(inf_norm(&forces)).max(f64::MIN_POSITIVE);
             let relative = residual / scale;
             history.push(crate::error::IterationResidual {
                 iteration,

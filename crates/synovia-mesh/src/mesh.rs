@@ -146,53 +146,65 @@ impl<const D: usize> Mesh<D> {
     /// (they induce opposite orientations on it). A duplicated cell, or two cells folded over
     /// each other, fail with [`MeshError::OverlappingCells`] naming both cells and the facet.
     pub fn check_conformity(&self) -> Result<(), MeshError> {
-        let per = D + 1;
         // facet → (first cell, its induced parity, already shared by two cells)
-        let mut seen: HashMap<[usize; 3], (usize, bool, bool)> = HashMap::with_capacity(self.n_cells() * per);
+        let mut seen: HashMap<[usize; 3], (usize, bool, bool)> =
+            HashMap::with_capacity(self.n_cells() * (D + 1));
+        let mut overlap = None;
+        self.for_each_facet(|c, _, facet, parity| {
+            if overlap.is_some() {
+                return;
+            }
+            match seen.get_mut(&facet) {
+                None => {
+                    seen.insert(facet, (c, parity, false));
+                }
+                Some(entry) => {
+                    let (other, other_parity, interior) = *entry;
+                    if interior || other_parity == parity {
+                        overlap = Some(MeshError::OverlappingCells {
+                            cell: c,
+                            other,
+                            facet: facet[..D].to_vec(),
+                            more_than_two: interior,
+                        });
+                    }
+                    entry.2 = true;
+                }
+            }
+        });
+        overlap.map_or(Ok(()), Err)
+    }
+
+    /// Calls `f(cell, opposite, key, parity)` for the facet of every cell opposite each of its
+    /// local vertices: `key` = the facet's nodes sorted (first `D` entries used), `parity` = the
+    /// orientation the cell induces on it, `(−1)^opposite` times the parity of the permutation
+    /// that sorts the facet's nodes (two cells on opposite sides of a facet induce opposite
+    /// parities).
+    fn for_each_facet(&self, mut f: impl FnMut(usize, usize, [usize; 3], bool)) {
+        let per = D + 1;
         for (c, cell) in self.cells.chunks_exact(per).enumerate() {
-            for skip in 0..per {
-                // the facet opposite local vertex `skip`, in the cell's order
+            for opposite in 0..per {
                 let mut facet = [usize::MAX; 3];
                 let mut k = 0;
                 for (i, &n) in cell.iter().enumerate() {
-                    if i != skip {
+                    if i != opposite {
                         facet[k] = n;
                         k += 1;
                     }
                 }
-                // orientation of the facet induced by the cell: (−1)^skip times the parity of
-                // the permutation sorting the facet's nodes
-                let mut parity = skip % 2 == 1;
-                let f = &mut facet[..D];
-                for i in 0..f.len() {
-                    for j in 0..f.len() - 1 - i {
-                        if f[j] > f[j + 1] {
-                            f.swap(j, j + 1);
+                let mut parity = opposite % 2 == 1;
+                let sorted = &mut facet[..D];
+                for i in 0..sorted.len() {
+                    for j in 0..sorted.len() - 1 - i {
+                        if sorted[j] > sorted[j + 1] {
+                            sorted.swap(j, j + 1);
                             parity = !parity;
                         }
                     }
                 }
-                match seen.get_mut(&facet) {
-                    None => {
-                        seen.insert(facet, (c, parity, false));
-                    }
-                    Some(entry) => {
-                        let (other, other_parity, interior) = *entry;
-                        if interior || other_parity == parity {
-                            let nodes = facet[..D].to_vec();
-                            return Err(MeshError::OverlappingCells {
-                                cell: c,
-                                other,
-                                facet: nodes,
-                                more_than_two: interior,
-                            });
-                        }
-                        entry.2 = true;
-                    }
-                }
+                f(c, opposite, facet, parity);
             }
         }
-        Ok(())
     }
 
     /// Like [`Mesh::new`], but flips inverted cells (swapping their last two nodes) instead of
@@ -441,15 +453,10 @@ impl<const D: usize> Mesh<D> {
 
     /// All boundary facets: faces of exactly one cell, oriented outward.
     pub fn boundary_facets(&self) -> Vec<BoundaryFacet> {
-        let mut count: HashMap<Vec<usize>, (usize, usize, u32)> = HashMap::new();
-        for c in 0..self.n_cells() {
-            let cell = self.cell(c);
-            for opp in 0..=D {
-                let mut key: Vec<usize> = (0..=D).filter(|&k| k != opp).map(|k| cell[k]).collect();
-                key.sort_unstable();
-                count.entry(key).and_modify(|e| e.2 += 1).or_insert((c, opp, 1));
-            }
-        }
+        let mut count: HashMap<[usize; 3], (usize, usize, u32)> = HashMap::new();
+        self.for_each_facet(|c, opp, key, _| {
+            count.entry(key).and_modify(|e| e.2 += 1).or_insert((c, opp, 1));
+        });
         let mut out: Vec<BoundaryFacet> = count
             .into_values()
             .filter(|e| e.2 == 1)
