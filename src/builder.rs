@@ -299,7 +299,7 @@ pub(crate) fn zero_result<const D: usize>(
 }
 
 fn empty_geometry<const D: usize>() -> ContactGeometry<D> {
-    ContactGeometry { pairs: Vec::new(), nodes: Vec::new(), adjacency: Vec::new() }
+    ContactGeometry::default()
 }
 
 /// Message of an observer failure carried through the stepper's error type.

@@ -18,20 +18,29 @@
 //! # Kinematics per pose
 //!
 //! The flexion angle `θ(t)` is a rotation of the femur about the condyle centre
-//! ([`RigidMotion`], a rotation). Since linear (small-strain) elasticity cannot carry a 58°
-//! rigid rotation as a displacement (the linearised strain of a rotation is `cos θ − 1`, 47 % at
-//! 58°), each pose is a separate small-deformation problem: the femur mesh is placed in the
-//! pose `R(θ(t))(x − c) + c` and the elastic deformation is measured from there. For a
-//! frictionless contact the solution of a pose does not depend on the path, so no state is
-//! carried between steps. With flexion the contact moves over the femoral cartilage (toward the
-//! posterior condyle), i.e. over different elements of the femur mesh.
+//! ([`RigidMotion`], a rotation). Linear (small-strain) elasticity cannot carry a 58° rigid
+//! rotation as a displacement (the linearised strain of a rotation is `cos θ − 1`, 47 % at
+//! 58°), so each pose is a separate small-deformation problem measured from the femur in its
+//! posed orientation. The femur is modelled in its **body frame** ([`BodyPlacement`]): its
+//! mesh and stiffness stay those of the reference pose, the contact geometry is built with
+//! the femur placed at `R(θ(t))(x − c) + c` ([`StaticContact::place_bodies`]) and the rows of
+//! the femoral nodes act on displacements in the femur frame (`R(θ)ᵀ n`), and the prescribed
+//! motion of the driven arc is rotated into that frame. The stiffness is therefore factorised
+//! **once for the whole cycle** ([`KneeCycle`]); only the contact rows change from pose to
+//! pose. This is the same problem as re-meshing the femur in each pose ([`Knee2d::model`],
+//! kept as the reference; `tests/knee2d.rs` compares the two). For a frictionless contact the
+//! solution of a pose does not depend on the path, so no state is carried between steps. With
+//! flexion the contact moves over the femoral cartilage (toward the posterior condyle), i.e.
+//! over different elements of the femur mesh. Femoral displacements of a [`KneePose`] are in
+//! the femur frame ([`BodyPlacement::to_global`] turns them into space);
+//! [`crate::output::contact_vtu`] writes the posed configuration.
 //!
 //! # Load control
 //!
 //! The ISO axial force `F(t)` (N) is applied per unit slice thickness, `P(t) = F(t) / w` with
 //! the effective condyle width `w` ([`Knee2d::width`], 30 mm). The vertical translation `δ` of
 //! the femur's driven arc that makes the contact resultant equal `P(t)` is found per step by a
-//! secant iteration on `δ` (one factorisation per pose, one contact solve per iterate, warm
+//! secant iteration on `δ` (one contact solve per iterate on the cycle's factorisation, warm
 //! started), to the relative tolerance [`Knee2d::tolerance`].
 
 use std::error::Error;
@@ -39,14 +48,14 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 use std::time::Instant;
 
-use synovia_contact::operators::{ContactGeometry, ContactPair};
-use synovia_contact::{ContactSolver, StaticContact, StaticContactResult};
-use synovia_fem::{ElasticParams, Model};
+use synovia_contact::operators::{BodyPlacement, ContactGeometry, ContactPair};
+use synovia_contact::{ContactSolution, ContactSolver, SolverReport, StaticContact, StaticContactResult};
+use synovia_fem::{BodyId, ElasticParams, Model};
 use synovia_material::plane_strain;
 use synovia_mesh::generators::{layered_arc_2d, rectangle, Grading};
 use synovia_mesh::math::{Point, Real, Vector};
 use synovia_mesh::BoundaryKind;
-use synovia_time::history::{LoadHistory, PiecewiseLinear, RigidMotion};
+use synovia_time::history::{LoadHistory, PiecewiseLinear, RigidMotion, SharedValue};
 
 /// Errors of the knee model (mesh, model, contact and iteration failures).
 pub type KneeError = Box<dyn Error + Send + Sync>;
@@ -230,17 +239,40 @@ pub struct KneeStep {
     pub seconds: Real,
 }
 
-/// One solved pose: the figures, the model in that pose, its contact problem and the solution.
+/// One solved pose of a [`KneeCycle`]: the figures, the cycle's model and contact problem (its
+/// geometry placed at this pose) and the solution.
 #[derive(Debug)]
-pub struct KneePose {
+pub struct KneePose<'a> {
     /// Figures of the pose.
     pub step: KneeStep,
-    /// The model (femur mesh in the pose).
-    pub model: Model<2>,
-    /// The contact problem (factorisation, geometry).
-    pub contact: StaticContact<2>,
-    /// The accepted contact solution.
+    /// The model: the femur in its body frame (reference pose), shared by every pose.
+    pub model: &'a Model<2>,
+    /// The contact problem (the cycle's one factorisation; the geometry of this pose).
+    pub contact: &'a StaticContact<2>,
+    /// The accepted contact solution (femoral displacements in the femur frame).
     pub result: StaticContactResult<2>,
+}
+
+/// A knee model set up for a sequence of poses: the femur in its body frame, the stiffness
+/// factorised once ([`Knee2d::cycle`]); each [`KneeCycle::solve_pose`] places the femur and
+/// rebuilds the contact rows only (see the [module documentation](self)).
+#[derive(Debug)]
+pub struct KneeCycle {
+    knee: Knee2d,
+    model: Model<2>,
+    pairs: Vec<ContactPair<2>>,
+    contact: StaticContact<2>,
+    /// Flexion angle of the current pose, read by the prescribed motion of the driven arc.
+    angle: SharedValue,
+    femur: [BodyId; 2],
+    force: PiecewiseLinear,
+    flexion: PiecewiseLinear,
+    /// `Λ_n` of the last accepted pose, the warm start of the next pose's first solve.
+    last_pressure: Option<Vec<Real>>,
+    /// `dP/dδ` of the last pose's final secant step and its load `P`: the predictor of the
+    /// next pose's approach.
+    last_slope: Option<Real>,
+    last_target: Option<Real>,
 }
 
 impl Knee2d {
@@ -290,13 +322,38 @@ impl Knee2d {
         Ok(RigidMotion::<2>::rotation(self.condyle_centre(), iso14243_flexion()?))
     }
 
-    /// The model in the pose of cycle fraction `time`: bodies 0 `femur_bone`, 1
-    /// `femur_cartilage`, 2 `tibia_bone`, 3 `tibia_cartilage`; the femur's inner arc moves down
-    /// by the model time `δ` (the "time" argument of the solves is the approach `δ`).
+    /// The model **re-meshed** in the pose of cycle fraction `time`: bodies 0 `femur_bone`, 1
+    /// `femur_cartilage`, 2 `tibia_bone`, 3 `tibia_cartilage`; the femur mesh is placed in the
+    /// pose and its inner arc moves down by the model time `δ` (the "time" argument of the
+    /// solves is the approach `δ`). One factorisation per pose; the cycle itself uses the body
+    /// frame instead ([`Knee2d::cycle`]), and this model is the reference it is tested against.
     ///
     /// # Errors
     /// Mesh, material or model errors.
     pub fn model(&self, time: Real) -> Result<(Model<2>, Vec<ContactPair<2>>), KneeError> {
+        let (model, pairs, _) = self.build_model(Some(time), None)?;
+        Ok((model, pairs))
+    }
+
+    /// The model with the femur in its body frame (the reference pose, θ = 0): the driven arc
+    /// moves by `δ` downward **in space**, i.e. by `R(θ)ᵀ (0, −δ)` in the femur frame, with `θ`
+    /// read from `angle` at every solve. Returns the model, the contact pair and the femur's
+    /// two bodies (bone, layer).
+    ///
+    /// # Errors
+    /// Mesh, material or model errors.
+    pub fn body_frame_model(
+        &self,
+        angle: SharedValue,
+    ) -> Result<(Model<2>, Vec<ContactPair<2>>, [BodyId; 2]), KneeError> {
+        self.build_model(None, Some(angle))
+    }
+
+    fn build_model(
+        &self,
+        posed_at: Option<Real>,
+        frame_angle: Option<SharedValue>,
+    ) -> Result<(Model<2>, Vec<ContactPair<2>>, [BodyId; 2]), KneeError> {
         let c = self.condyle_centre();
         let (na, nb, nc) = self.femur_cells;
         // body-frame arc: the contact point of flexion θ is at the body angle −90° − θ
@@ -307,9 +364,11 @@ impl Knee2d {
             self.condyle_bone_radius + self.femur_cartilage,
         ];
         let mut layers = layered_arc_2d(c, &radii, range, na, &[nb, nc])?;
-        let motion = self.flexion_motion()?;
-        for m in &mut layers {
-            m.map_nodes(|x| motion.position(x, time))?;
+        if let Some(time) = posed_at {
+            let motion = self.flexion_motion()?;
+            for m in &mut layers {
+                m.map_nodes(|x| motion.position(x, time))?;
+            }
         }
         let mut f_cart = layers.pop().ok_or("layered_arc_2d returned no layers")?;
         let mut f_bone = layers.pop().ok_or("layered_arc_2d returned one layer")?;
@@ -338,10 +397,92 @@ impl Knee2d {
         let tcb = model.add_body(n_tc, t_cart, mat(self.tibia_layer_material, self.cartilage)?)?;
         model.tie(fb, "outer", fc, "inner")?;
         model.tie(tb, "top", tcb, "bottom")?;
-        model.prescribe(fb, "inner", |_, d| Vector::<2>::new(0.0, -d))?;
+        match frame_angle {
+            // R(θ)ᵀ (0, −δ) = (−δ sin θ, −δ cos θ)
+            Some(angle) => model.prescribe(fb, "inner", move |_, d| {
+                let (s, c) = angle.get().sin_cos();
+                Vector::<2>::new(-d * s, -d * c)
+            })?,
+            None => model.prescribe(fb, "inner", |_, d| Vector::<2>::new(0.0, -d))?,
+        };
         let pair = ContactPair::node_to_segment("tibia-femur", tcb, "top", fc, "outer")
             .with_search_distance(self.search_distance);
-        Ok((model, vec![pair]))
+        Ok((model, vec![pair], [fb, fc]))
+    }
+
+    /// Sets the model up for a sequence of poses: the femur in its body frame
+    /// ([`Knee2d::body_frame_model`]) and one factorisation of the stiffness with the contact
+    /// parts' dofs ordered last ([`StaticContact::new`]).
+    ///
+    /// # Errors
+    /// Model or factorisation errors.
+    pub fn cycle(&self) -> Result<KneeCycle, KneeError> {
+        let angle = SharedValue::new(0.0);
+        let (model, pairs, femur) = self.body_frame_model(angle.clone())?;
+        let contact = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+        Ok(KneeCycle {
+            knee: self.clone(),
+            model,
+            pairs,
+            contact,
+            angle,
+            femur,
+            force: iso14243_axial_force()?,
+            flexion: iso14243_flexion()?,
+            last_pressure: None,
+            last_slope: None,
+            last_target: None,
+        })
+    }
+
+    /// Solves the poses `times` in order on one [`KneeCycle`] (one factorisation; each pose
+    /// started from the previous approach), calling `each` after every pose.
+    ///
+    /// # Errors
+    /// From [`KneeCycle::solve_pose`] or `each`.
+    pub fn run(
+        &self,
+        times: &[Real],
+        solver: &dyn ContactSolver,
+        mut each: impl FnMut(&KneePose<'_>) -> Result<(), KneeError>,
+    ) -> Result<Vec<KneeStep>, KneeError> {
+        let mut cycle = self.cycle()?;
+        let mut guess = None;
+        let mut steps = Vec::with_capacity(times.len());
+        for &t in times {
+            let pose = cycle.solve_pose(t, solver, guess)?;
+            guess = Some(pose.step.approach);
+            each(&pose)?;
+            steps.push(pose.step);
+        }
+        Ok(steps)
+    }
+}
+
+impl KneeCycle {
+    /// The model (femur in its body frame).
+    pub fn model(&self) -> &Model<2> {
+        &self.model
+    }
+    /// The contact problem (factorisation and the geometry of the last pose).
+    pub fn contact(&self) -> &StaticContact<2> {
+        &self.contact
+    }
+    /// The knee parameters.
+    pub fn knee(&self) -> &Knee2d {
+        &self.knee
+    }
+
+    /// The placement of every body at the flexion angle `theta` (radians): the femur's two
+    /// bodies rotated about the condyle centre, the tibia where its mesh is.
+    ///
+    /// # Errors
+    /// If `theta` is not finite.
+    pub fn placements(&self, theta: Real) -> Result<Vec<BodyPlacement<2>>, KneeError> {
+        let femur = BodyPlacement::planar_rotation(self.knee.condyle_centre(), theta)?;
+        Ok((0..self.model.bodies().len())
+            .map(|b| if self.femur.iter().any(|f| f.0 == b) { femur } else { BodyPlacement::identity() })
+            .collect())
     }
 
     /// Solves the pose of cycle fraction `time` under the ISO load: secant iteration on the
@@ -351,56 +492,82 @@ impl Knee2d {
     /// # Errors
     /// Model or contact failures, or no convergence of the secant iteration in 40 solves.
     pub fn solve_pose(
-        &self,
+        &mut self,
         time: Real,
         solver: &dyn ContactSolver,
         guess: Option<Real>,
-    ) -> Result<KneePose, KneeError> {
+    ) -> Result<KneePose<'_>, KneeError> {
         let start = Instant::now();
-        let load_n = iso14243_axial_force()?.value(time);
-        let target = load_n / self.width;
-        let (model, pairs) = self.model(time)?;
-        let contact = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+        let load_n = self.force.value(time);
+        let theta = self.flexion.value(time);
+        let target = load_n / self.knee.width;
+        self.angle.set(theta);
+        let placements = self.placements(theta)?;
+        let previous = self.contact.place_bodies(&self.model, &self.pairs, &placements)?;
+        // warm start: the last pose's pressures carried to this pose's contact nodes
+        let carried = self.last_pressure.take().map(|l| ContactSolution {
+            u: Vec::new(),
+            lambda_n: self.contact.geometry().transfer(&previous, &l),
+            lambda_t: Vec::new(),
+            report: SolverReport::default(),
+        });
+        let (model, contact) = (&self.model, &self.contact);
         let mut solves = 0;
         let mut its = 0;
-        let mut solve = |d: Real,
-                         warm: Option<&StaticContactResult<2>>|
-         -> Result<(Real, StaticContactResult<2>), KneeError> {
-            let res = contact.solve(&model, d, solver, None, None, warm.map(|w| &w.solution))?;
-            solves += 1;
-            its += res.solution.report.iterations + res.coarse_iterations;
-            let f = resultant(contact.geometry(), &res)[1].abs();
-            Ok((f, res))
-        };
-        // bracket from below: a positive force
+        let mut solve =
+            |d: Real, warm: Option<&ContactSolution>| -> Result<(Real, StaticContactResult<2>), KneeError> {
+                let res = contact.solve(model, d, solver, None, None, warm)?;
+                solves += 1;
+                its += res.solution.report.iterations + res.coarse_iterations;
+                let f = resultant(contact.geometry(), &res)[1].abs();
+                Ok((f, res))
+            };
+        let tolerance = self.knee.tolerance * target;
+        // predictor: the last pose's approach moved along its force slope to this pose's load
+        let slope_prev = self.last_slope.filter(|s| *s > 0.0 && s.is_finite());
         let mut d0 = guess.filter(|g| *g > 0.0).unwrap_or(0.05);
-        let (mut f0, mut r0) = solve(d0, None)?;
+        if let (Some(slope), Some(last_target)) = (slope_prev, self.last_target) {
+            d0 = (d0 + (target - last_target) / slope).clamp(0.5 * d0, 2.0 * d0);
+        }
+        // bracket from below: a positive force
+        let (mut f0, mut r0) = solve(d0, carried.as_ref())?;
         while f0 <= 0.0 {
             d0 *= 2.0;
-            (f0, r0) = solve(d0, Some(&r0))?;
+            (f0, r0) = solve(d0, Some(&r0.solution))?;
             if d0 > 10.0 {
                 return Err(format!("t = {time}: no contact up to an approach of {d0} mm").into());
             }
         }
-        // contact force ~ δ^(3/2) for a thin layer, roughly: first step by that power law
-        let mut d1 = d0 * (target / f0).powf(2.0 / 3.0).clamp(0.3, 3.0);
-        let (mut f1, mut r1) = solve(d1, Some(&r0))?;
-        let mut iter = 0;
-        while (f1 - target).abs() > self.tolerance * target {
-            iter += 1;
-            if iter > 40 {
-                return Err(format!("t = {time}: load balance not reached: {f1} vs {target} N/mm").into());
+        let (d1, r1, slope) = if (f0 - target).abs() <= tolerance {
+            (d0, r0, slope_prev)
+        } else {
+            // first step: the last pose's slope, or (first pose) the power law of a thin layer,
+            // contact force ~ δ^(3/2) roughly
+            let mut d1 = match slope_prev {
+                Some(slope) => (d0 + (target - f0) / slope).clamp(0.3 * d0, 3.0 * d0),
+                None => d0 * (target / f0).powf(2.0 / 3.0).clamp(0.3, 3.0),
+            };
+            let (mut f1, mut r1) = solve(d1, Some(&r0.solution))?;
+            let mut slope = (f1 - f0) / (d1 - d0);
+            let mut iter = 0;
+            while (f1 - target).abs() > tolerance {
+                iter += 1;
+                if iter > 40 {
+                    return Err(format!("t = {time}: load balance not reached: {f1} vs {target} N/mm").into());
+                }
+                let mut d2 =
+                    if slope > 0.0 && slope.is_finite() { d1 + (target - f1) / slope } else { 1.5 * d1 };
+                if d2 <= 0.0 {
+                    d2 = 0.5 * d1;
+                }
+                let (f2, r2) = solve(d2, Some(&r1.solution))?;
+                slope = (f2 - f1) / (d2 - d1);
+                (d0, f0) = (d1, f1);
+                (d1, f1, r1) = (d2, f2, r2);
             }
-            let slope = (f1 - f0) / (d1 - d0);
-            let mut d2 = if slope > 0.0 && slope.is_finite() { d1 + (target - f1) / slope } else { 1.5 * d1 };
-            if d2 <= 0.0 {
-                d2 = 0.5 * d1;
-            }
-            let (f2, r2) = solve(d2, Some(&r1))?;
-            (d0, f0, r0) = (d1, f1, r1);
-            (d1, f1, r1) = (d2, f2, r2);
-        }
-        drop(r0);
+            let _ = (d0, f0);
+            (d1, r1, Some(slope).filter(|s| *s > 0.0 && s.is_finite()).or(slope_prev))
+        };
         let geo = contact.geometry();
         let force = resultant(geo, &r1);
         let active: Vec<usize> = (0..geo.len()).filter(|&r| r1.solution.lambda_n[r] > 0.0).collect();
@@ -416,7 +583,7 @@ impl Knee2d {
             .fold((0, 0.0), |(ri, m), (r, l)| if l > m { (r, l) } else { (ri, m) });
         let step = KneeStep {
             time,
-            flexion_deg: iso14243_flexion()?.value(time).to_degrees(),
+            flexion_deg: theta.to_degrees(),
             load_n,
             load_per_mm: target,
             contact_force_per_mm: force[1].abs(),
@@ -431,29 +598,10 @@ impl Knee2d {
             kkt: r1.kkt.max(),
             seconds: start.elapsed().as_secs_f64(),
         };
+        self.last_pressure = Some(r1.solution.lambda_n.clone());
+        self.last_slope = slope;
+        self.last_target = Some(target);
         Ok(KneePose { step, model, contact, result: r1 })
-    }
-
-    /// Solves the poses `times` in order (each started from the previous approach), calling
-    /// `each` after every pose.
-    ///
-    /// # Errors
-    /// From [`Knee2d::solve_pose`] or `each`.
-    pub fn run(
-        &self,
-        times: &[Real],
-        solver: &dyn ContactSolver,
-        mut each: impl FnMut(&KneePose) -> Result<(), KneeError>,
-    ) -> Result<Vec<KneeStep>, KneeError> {
-        let mut guess = None;
-        let mut steps = Vec::with_capacity(times.len());
-        for &t in times {
-            let pose = self.solve_pose(t, solver, guess)?;
-            guess = Some(pose.step.approach);
-            each(&pose)?;
-            steps.push(pose.step);
-        }
-        Ok(steps)
     }
 }
 

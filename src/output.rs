@@ -46,6 +46,10 @@ pub fn elastic_vtu<const D: usize>(
 /// `displacement`, `contact_pressure` (`Λ_n` at the contact nodes of body `k`, 0 elsewhere),
 /// `contact_active` (1 where `Λ_n > 0`), `friction_traction` (the tangential traction
 /// `−g_c Λ_t T` at the nodes of friction cells) and `stick` (1 sticking, −1 slipping, 0 none).
+///
+/// Bodies placed by the geometry ([`synovia_contact::operators::ContactGeometry::new_placed`])
+/// are written where they are placed, with their displacements turned from the body frame
+/// into space (`R u`).
 pub fn contact_vtu<const D: usize>(
     model: &Model<D>,
     geometry: &synovia_contact::operators::ContactGeometry<D>,
@@ -84,10 +88,20 @@ pub fn contact_vtu<const D: usize>(
     }
     let mut w = VtuWriter::new(encoding);
     for (bi, body) in model.bodies().iter().enumerate() {
+        let placement = geometry.placement(synovia_fem::BodyId(bi));
+        let placed;
+        let (mesh, displacement) = if placement.is_identity() {
+            (&body.mesh, result.displacement[bi].clone())
+        } else {
+            let mut m = body.mesh.clone();
+            m.map_nodes(|x| placement.position(x))?;
+            placed = m;
+            (&placed, result.displacement[bi].iter().map(|u| placement.to_global(u)).collect())
+        };
         w.add_piece(
-            &body.mesh,
+            mesh,
             vec![
-                Field::point_vectors("displacement", &result.displacement[bi]),
+                Field::point_vectors("displacement", &displacement),
                 Field::point_scalars("contact_pressure", pressure[bi].clone()),
                 Field::point_scalars("contact_active", active[bi].clone()),
                 Field::point_vectors("friction_traction", &traction[bi]),

@@ -117,9 +117,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
         };
         let geometry = match &engine {
             Engine::Contact(s) => s.geometry().clone(),
-            Engine::Elastic { .. } => {
-                ContactGeometry { pairs: Vec::new(), nodes: Vec::new(), adjacency: Vec::new() }
-            }
+            Engine::Elastic { .. } => ContactGeometry::default(),
         };
         Ok(Self {
             joint,

@@ -218,6 +218,26 @@ fn trailing_block_of_the_factor_gives_the_interface_inverse() {
             }
         }
         assert!(worst < 1e-12, "n = {n}: (A⁻¹)_cc differs by {worst:e}");
+        // a right-hand side on the trailing dofs: forward substitution with L₂₂ only, backward
+        // with the whole factor — the same solution as the full solve
+        let mut b = vec![0.0; nd];
+        for (q, &d) in block.dofs.iter().enumerate() {
+            b[d] = (q as f64 * 0.37).sin() + 0.1;
+        }
+        let mut full = b.clone();
+        chol.solve_in_place(&mut full).expect("solve");
+        let mut half = b.clone();
+        chol.solve_trailing_supported_in_place(&mut half).expect("trailing solve");
+        let scale = full.iter().fold(0.0_f64, |a, v| a.max(v.abs()));
+        let diff = full.iter().zip(&half).fold(0.0_f64, |a, (x, y)| a.max((x - y).abs())) / scale;
+        assert!(diff < 1e-12, "n = {n}: trailing-supported solve differs by {diff:e}");
+        // an entry off the trailing dofs: falls back to the full solve
+        let off = (0..nd).find(|i| block.position[*i] == usize::MAX).expect("an interior dof");
+        b[off] = 1.0;
+        let (mut full, mut half) = (b.clone(), b.clone());
+        chol.solve_in_place(&mut full).expect("solve");
+        chol.solve_trailing_supported_in_place(&mut half).expect("fallback");
+        assert_eq!(full, half);
     }
     assert_eq!(layouts, vec![false, true], "both faer layouts must be exercised");
 }
@@ -237,4 +257,50 @@ fn trailing_ordering_over_a_bad_base_permutation_is_an_error() {
     }
     let ok = Ordering::Trailing { base: Box::new(Ordering::Custom((0..n).collect())), last: vec![0, 1] };
     assert!(CholeskySolver::analyse(a, &ok).is_ok());
+}
+
+/// Recycled solves (`LoadSubspace`): a load in the span of loads solved before is answered
+/// without a solve and agrees with a direct solve to rounding; a new load is solved and its
+/// direction kept; the oldest direction is dropped when the subspace is full.
+#[test]
+fn load_subspace_recycles_combinations_of_solved_loads() {
+    use synovia::fem::LoadSubspace;
+    let solver = ElasticSolver::new(&cantilever(), ElasticParams::default()).expect("factor");
+    let chol = solver.cholesky();
+    let n = chol.n();
+    let load = |k: f64| -> Vec<f64> { (0..n).map(|i| ((i as f64 + 1.0) * k).sin()).collect() };
+    let direct = |f: &[f64]| {
+        let mut x = f.to_vec();
+        chol.solve_in_place(&mut x).expect("solve");
+        x
+    };
+    let rel = |a: &[f64], b: &[f64]| {
+        let s = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs())) / s
+    };
+    let mut sub = LoadSubspace::new(2);
+    let (f1, f2, f3) = (load(0.3), load(1.7), load(2.9));
+    for f in [&f1, &f2] {
+        assert!(rel(&sub.solve(chol, f).expect("solve"), &direct(f)) < 1e-13);
+    }
+    assert_eq!((sub.len(), sub.counts()), (2, (0, 2)));
+    let combo: Vec<f64> = f1.iter().zip(&f2).map(|(a, b)| 3.0 * a - 2.0 * b).collect();
+    let x = sub.solve(chol, &combo).expect("recycled");
+    assert_eq!(sub.counts(), (1, 2), "a combination needs no solve");
+    let err = rel(&x, &direct(&combo));
+    assert!(err < 1e-12, "recycled solution differs by {err:e}");
+    // a new direction: solved, kept, and the oldest (f1's) dropped
+    assert!(rel(&sub.solve(chol, &f3).expect("solve"), &direct(&f3)) < 1e-13);
+    assert_eq!((sub.len(), sub.counts()), (2, (1, 3)));
+    let x3 = sub.solve(chol, &f3.iter().map(|v| -0.5 * v).collect::<Vec<_>>()).expect("recycled");
+    assert_eq!(sub.counts(), (2, 3), "f3 is in the subspace");
+    assert!(rel(&x3, &direct(&f3).iter().map(|v| -0.5 * v).collect::<Vec<_>>()) < 1e-12);
+    sub.solve(chol, &f1).expect("solve");
+    assert_eq!(sub.counts(), (2, 4), "f1 left the subspace");
+    // zero load, wrong length, NaN
+    assert!(sub.solve(chol, &vec![0.0; n]).expect("zero").iter().all(|v| *v == 0.0));
+    assert!(sub.solve(chol, &vec![1.0; n + 1]).is_err());
+    let mut bad = f1.clone();
+    bad[3] = f64::NAN;
+    assert!(sub.solve(chol, &bad).is_err());
 }

@@ -70,3 +70,53 @@ fn tkr2d_coarse_cycle_balances_load_and_satisfies_kkt() {
     let peak = steps.iter().map(|s| s.peak_pressure).fold(0.0, f64::max);
     assert!(peak > 20.0 && peak < 50.0, "peak insert pressure {peak}");
 }
+
+/// The cycle's body-frame femur (one factorisation, rows `R(θ)ᵀ n`, prescribed motion rotated
+/// into the femur frame) solves the same problem as the femur re-meshed in the pose
+/// (`Knee2d::model`): at fixed approaches and poses up to the 58° swing maximum, the same
+/// contact nodes, pressures and (rotated) displacements to rounding.
+#[test]
+fn body_frame_femur_equals_the_remeshed_pose() {
+    use synovia::contact::StaticContact;
+    use synovia::fem::ElasticParams;
+    let knee = Knee2d::coarse();
+    let solver = synovia::solvers::by_name("pdas").expect("solver");
+    let mut cycle = knee.cycle().expect("cycle");
+    let flexion = iso14243_flexion().expect("flexion");
+    for (t, delta) in [(0.0, 0.3), (0.13, 0.6), (0.5, 0.5), (0.725, 0.2), (0.87, 0.25)] {
+        let theta = flexion.value(t);
+        // body frame: place the femur, solve at approach δ
+        let pose = cycle.solve_pose(t, solver.as_ref(), Some(delta)).expect("pose");
+        let (model_f, contact_f) = (pose.model, pose.contact);
+        let framed = contact_f.solve(model_f, delta, solver.as_ref(), None, None, None).expect("framed");
+        // reference: the femur re-meshed in the pose
+        let (model_r, pairs_r) = knee.model(t).expect("posed model");
+        let contact_r = StaticContact::new(&model_r, &pairs_r, ElasticParams::default()).expect("factorise");
+        let reference =
+            contact_r.solve(&model_r, delta, solver.as_ref(), None, None, None).expect("reference");
+        let (gf, gr) = (contact_f.geometry(), contact_r.geometry());
+        assert_eq!(gf.len(), gr.len(), "t = {t}: contact nodes");
+        let pmax = reference.solution.lambda_n.iter().copied().fold(0.0, f64::max);
+        assert!(pmax > 0.1, "t = {t}: no contact in the reference ({pmax})");
+        for r in 0..gf.len() {
+            assert_eq!(gf.nodes[r].node, gr.nodes[r].node);
+            assert!((gf.nodes[r].gap - gr.nodes[r].gap).abs() <= 1e-10, "t = {t}: gap at {r}");
+            let (a, b) = (framed.solution.lambda_n[r], reference.solution.lambda_n[r]);
+            assert!((a - b).abs() <= 1e-7 * pmax, "t = {t}: Λ_n at {r}: {a} vs {b}");
+        }
+        assert!(framed.kkt.satisfied(1e-8), "t = {t}: {:?}", framed.kkt);
+        // displacements: femur bodies rotated into space, tibia as is
+        let umax = reference.displacement.iter().flatten().map(|u| u.norm()).fold(0.0, f64::max);
+        for (b, (uf, ur)) in framed.displacement.iter().zip(&reference.displacement).enumerate() {
+            let placement = gf.placement(synovia::fem::BodyId(b));
+            if b < 2 {
+                assert!((placement.rotation()[(1, 0)] - theta.sin()).abs() < 1e-14, "femur placed at θ");
+            } else {
+                assert!(placement.is_identity());
+            }
+            for (a, r) in uf.iter().zip(ur) {
+                assert!((placement.to_global(a) - r).norm() <= 1e-7 * umax, "t = {t}: body {b}");
+            }
+        }
+    }
+}

@@ -45,6 +45,7 @@ impl Synthetic {
             normal: &self.normal,
             friction: None,
             schur_cache: None,
+            load_solution: None,
         }
     }
 }

@@ -50,7 +50,7 @@ pub fn run_cycle(
         if !pose.result.kkt.satisfied(1e-8) {
             return Err(format!("step {i}: KKT violated: {:?}", pose.result.kkt).into());
         }
-        let vtu = synovia::output::contact_vtu(&pose.model, pose.contact.geometry(), &pose.result, Encoding::Base64)?;
+        let vtu = synovia::output::contact_vtu(pose.model, pose.contact.geometry(), &pose.result, Encoding::Base64)?;
         series.write_step(s.time, &vtu)?;
         i += 1;
         Ok(())

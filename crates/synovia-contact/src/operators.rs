@@ -79,7 +79,7 @@ use std::sync::Arc;
 
 use synovia_fem::{BodyId, DofMap, Model};
 use synovia_mesh::matching::match_nodes;
-use synovia_mesh::math::{Point, Real, Vector};
+use synovia_mesh::math::{Point, Real, Tensor, Vector};
 
 use crate::error::ContactError;
 use crate::problem::{FrictionConstraints, NormalConstraints};
@@ -488,8 +488,100 @@ pub struct ContactNode<const D: usize> {
     pub friction: Real,
 }
 
+/// A rigid placement `x ↦ R x + t` of a body in space (`R` a proper rotation): the body's
+/// *frame*, for bodies that move by large rigid motions (a flexing femur) while their elastic
+/// deformation stays small.
+///
+/// Linear elasticity cannot carry a large rotation as a displacement (the linearised strain of
+/// a rotation by `θ` is `cos θ − 1`), but it does not need to: the stiffness of a body in its
+/// own frame does not depend on where the body is. A geometry built with placements
+/// ([`ContactGeometry::new_placed`]) pairs and measures the bodies in their placed positions and
+/// writes the constraint rows for displacements **in each body's frame**: a displacement `u`
+/// of body `b` is `R_b u` in space, so its row coefficients are `R_bᵀ n` instead of `n`. The
+/// stiffness `A` and its factorisation stay those of the reference meshes — one factorisation
+/// serves every pose (issue 6: the `knee2d` gait cycle).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyPlacement<const D: usize> {
+    rotation: Tensor<D>,
+    translation: Vector<D>,
+}
+
+impl<const D: usize> Default for BodyPlacement<D> {
+    fn default() -> Self {
+        Self::identity()
+    }
+}
+
+impl<const D: usize> BodyPlacement<D> {
+    /// The identity placement (the body where its mesh is).
+    pub fn identity() -> Self {
+        Self { rotation: Tensor::<D>::identity(), translation: Vector::<D>::zeros() }
+    }
+
+    /// `x ↦ R x + t`.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] if `R` or `t` is not finite, or `R` is not a proper
+    /// rotation (`‖RᵀR − I‖_max > 1e-10` or `det R < 0`).
+    pub fn new(rotation: Tensor<D>, translation: Vector<D>) -> Result<Self, ContactError> {
+        let finite = rotation.iter().chain(translation.iter()).all(|v| v.is_finite());
+        let orthogonality = (rotation.transpose() * rotation - Tensor::<D>::identity()).amax();
+        if !finite || orthogonality > 1e-10 || synovia_mesh::math::det(&rotation) <= 0.0 {
+            return Err(ContactError::InvalidParameter(format!(
+                "a body placement needs a finite proper rotation and translation (‖RᵀR − I‖ = {orthogonality:.1e}, det R = {:.3})",
+                synovia_mesh::math::det(&rotation)
+            )));
+        }
+        Ok(Self { rotation, translation })
+    }
+
+    /// The rotation `R` about the point `c`: `x ↦ R (x − c) + c`.
+    ///
+    /// # Errors
+    /// As [`BodyPlacement::new`].
+    pub fn rotation_about(center: Point<D>, rotation: Tensor<D>) -> Result<Self, ContactError> {
+        Self::new(rotation, center - rotation * center)
+    }
+
+    /// The rotation `R`.
+    pub fn rotation(&self) -> &Tensor<D> {
+        &self.rotation
+    }
+    /// The translation `t`.
+    pub fn translation(&self) -> &Vector<D> {
+        &self.translation
+    }
+    /// `true` for the identity placement.
+    pub fn is_identity(&self) -> bool {
+        *self == Self::identity()
+    }
+    /// The placed position `R x + t` of a point `x` of the mesh.
+    pub fn position(&self, x: &Point<D>) -> Point<D> {
+        self.rotation * x + self.translation
+    }
+    /// A vector of the body frame in space: `R v`.
+    pub fn to_global(&self, v: &Vector<D>) -> Vector<D> {
+        self.rotation * v
+    }
+    /// A vector in space in the body frame: `Rᵀ v`.
+    pub fn to_body(&self, v: &Vector<D>) -> Vector<D> {
+        self.rotation.tr_mul(v)
+    }
+}
+
+impl BodyPlacement<2> {
+    /// The planar rotation by `angle` (radians, counter-clockwise) about `center`.
+    ///
+    /// # Errors
+    /// If `angle` or `center` is not finite.
+    pub fn planar_rotation(center: Point<2>, angle: Real) -> Result<Self, ContactError> {
+        let (s, c) = angle.sin_cos();
+        Self::rotation_about(center, Tensor::<2>::new(c, -s, s, c))
+    }
+}
+
 /// The geometry of all contact pairs of a model: the contact nodes with normals, weights, gaps.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct ContactGeometry<const D: usize> {
     /// Pair names, with the range of their nodes in `nodes`.
     pub pairs: Vec<(String, std::ops::Range<usize>)>,
@@ -498,6 +590,9 @@ pub struct ContactGeometry<const D: usize> {
     /// Neighbours of each contact node (nodes sharing a contact facet of body `k`), for nested
     /// iteration ([`crate::nested`]).
     pub adjacency: Vec<Vec<usize>>,
+    /// Placement of each body ([`ContactGeometry::new_placed`]); empty: every body where its
+    /// mesh is.
+    placements: Vec<BodyPlacement<D>>,
 }
 
 /// The friction operator for given slip bounds: constraints plus the contact node of each cell.
@@ -579,6 +674,87 @@ impl<const D: usize> ContactGeometry<D> {
             ));
         }
         Self::build(model, pairs, Some(displacement))
+    }
+
+    /// Builds the contact nodes of every pair with body `b` placed at `placements[b]`
+    /// ([`BodyPlacement`]: one per body of the model, in order): pairing, normals, tangents,
+    /// weights and gaps are those of the placed bodies, and the constraint rows act on
+    /// displacements in each body's frame (coefficients `R_bᵀ n`). Loads, prescribed
+    /// displacements and the solution of a body are then in its frame as well (rotate them with
+    /// [`BodyPlacement::to_global`] / [`BodyPlacement::to_body`]); the stiffness is that of the
+    /// reference mesh, so a factorisation of `A` serves every placement
+    /// ([`crate::StaticContact::place_bodies`]). With identity placements it equals
+    /// [`ContactGeometry::new`].
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] if there is not one placement per body, or if two
+    /// tied bodies (which share nodes) have different placements; the errors of
+    /// [`ContactGeometry::new`].
+    pub fn new_placed(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        placements: &[BodyPlacement<D>],
+    ) -> Result<Self, ContactError> {
+        let bodies = model.bodies();
+        if placements.len() != bodies.len() {
+            return Err(ContactError::InvalidParameter(format!(
+                "{} body placements for {} bodies (one per body)",
+                placements.len(),
+                bodies.len()
+            )));
+        }
+        for tie in model.ties() {
+            if placements[tie.body_a.0] != placements[tie.body_b.0] {
+                return Err(ContactError::InvalidParameter(format!(
+                    "tied bodies `{}` and `{}` must have the same placement",
+                    bodies[tie.body_a.0].name, bodies[tie.body_b.0].name
+                )));
+            }
+        }
+        if placements.iter().all(BodyPlacement::is_identity) {
+            return Self::build(model, pairs, None);
+        }
+        // the placed configuration as a displacement u⁰ = R x + t − x of the reference mesh
+        let offsets: Vec<Vec<Vector<D>>> = bodies
+            .iter()
+            .zip(placements)
+            .map(|(b, p)| b.mesh.nodes().iter().map(|x| p.position(x) - x).collect())
+            .collect();
+        let mut geometry = Self::build(model, pairs, Some(&offsets))?;
+        // build gives gaps in total form, d = d_placed + [u⁰]·n; the rows act on the
+        // displacement from the placed configuration, so remove the placement's share
+        for node in &mut geometry.nodes {
+            let shift = node.jump(&offsets).map_or(0.0, |j| j.dot(&node.normal));
+            node.gap -= shift;
+        }
+        geometry.placements = placements.to_vec();
+        Ok(geometry)
+    }
+
+    /// The placement of `body` ([`ContactGeometry::new_placed`]; identity otherwise).
+    pub fn placement(&self, body: BodyId) -> BodyPlacement<D> {
+        self.placements.get(body.0).copied().unwrap_or_default()
+    }
+
+    /// The jump `[u](s_r)` of contact node `r` in space for nodal displacements
+    /// `displacement[body][node]` in the bodies' frames: [`ContactNode::jump`] with each body's
+    /// displacement rotated by its placement. `None` if `r` or the displacements do not fit.
+    pub fn jump(&self, r: usize, displacement: &[Vec<Vector<D>>]) -> Option<Vector<D>> {
+        let node = self.nodes.get(r)?;
+        if self.placements.is_empty() {
+            return node.jump(displacement);
+        }
+        let at = |b: BodyId, i: usize| {
+            displacement.get(b.0).and_then(|u| u.get(i)).map(|u| self.placement(b).to_global(u))
+        };
+        let mut j = at(node.node.0, node.node.1)?;
+        if let Some((b, i)) = node.partner {
+            j -= at(b, i)?;
+        }
+        for &(b, i, w) in &node.master {
+            j -= at(b, i)? * w;
+        }
+        Some(j)
     }
 
     fn build(
@@ -860,7 +1036,7 @@ impl<const D: usize> ContactGeometry<D> {
             a.sort_unstable();
             a.dedup();
         }
-        Ok(Self { pairs: ranges, nodes, adjacency })
+        Ok(Self { pairs: ranges, nodes, adjacency, placements: Vec::new() })
     }
 
     /// Number of contact nodes.
@@ -883,27 +1059,27 @@ impl<const D: usize> ContactGeometry<D> {
     ) -> (Vec<(usize, Real)>, Real) {
         let node = &self.nodes[r];
         let mut entries = Vec::with_capacity(2 * D);
-        let gk = dofs.group_of(node.node.0, node.node.1);
-        let g = &dofs.groups()[gk];
-        for k in 0..g.n_dofs {
-            entries.push((g.first_dof + k, g.basis[k].dot(v)));
-        }
-        let mut lift = lifts[gk].dot(v);
-        if let Some((bl, j)) = node.partner {
-            let gl = dofs.group_of(bl, j);
-            let g = &dofs.groups()[gl];
+        // v in the frame of `body` (rows act on displacements in the bodies' frames)
+        let framed = |body: BodyId| match self.placements.get(body.0) {
+            Some(p) => p.to_body(v),
+            None => *v,
+        };
+        let mut lift = 0.0;
+        let mut add = |body: BodyId, i: usize, w: Real| {
+            let vb = framed(body);
+            let gi = dofs.group_of(body, i);
+            let g = &dofs.groups()[gi];
             for k in 0..g.n_dofs {
-                entries.push((g.first_dof + k, -g.basis[k].dot(v)));
+                entries.push((g.first_dof + k, w * g.basis[k].dot(&vb)));
             }
-            lift -= lifts[gl].dot(v);
+            lift += w * lifts[gi].dot(&vb);
+        };
+        add(node.node.0, node.node.1, 1.0);
+        if let Some((bl, j)) = node.partner {
+            add(bl, j, -1.0);
         }
         for &(bl, j, w) in &node.master {
-            let gl = dofs.group_of(bl, j);
-            let g = &dofs.groups()[gl];
-            for k in 0..g.n_dofs {
-                entries.push((g.first_dof + k, -w * g.basis[k].dot(v)));
-            }
-            lift -= w * lifts[gl].dot(v);
+            add(bl, j, -w);
         }
         (entries, lift)
     }
@@ -930,10 +1106,10 @@ impl<const D: usize> ContactGeometry<D> {
     /// ([`ContactGeometry::new_deformed`]) this is the signed distance of the pose's slave nodes
     /// to their master facets, negated.
     pub fn penetration(&self, displacement: &[Vec<Vector<D>>]) -> Result<Vec<Real>, ContactError> {
-        self.nodes
-            .iter()
-            .map(|n| {
-                n.jump(displacement).map(|j| j.dot(&n.normal) - n.gap).ok_or_else(|| {
+        (0..self.len())
+            .map(|r| {
+                let n = &self.nodes[r];
+                self.jump(r, displacement).map(|j| j.dot(&n.normal) - n.gap).ok_or_else(|| {
                     ContactError::InvalidParameter("displacements do not fit the contact nodes".into())
                 })
             })
@@ -1000,7 +1176,7 @@ impl<const D: usize> ContactGeometry<D> {
                 let (entries, lift) = self.relative_row(dofs, lifts, r, t);
                 rows.push_row(entries.into_iter().map(|(c, v)| (c, scale * v)));
                 let prev = match previous {
-                    Some(p) => t.dot(&node.jump(p).ok_or_else(|| {
+                    Some(p) => t.dot(&self.jump(r, p).ok_or_else(|| {
                         ContactError::InvalidParameter(
                             "previous displacements do not fit the contact nodes".into(),
                         )

@@ -69,6 +69,9 @@ pub struct ContactProblem<'a> {
     /// (e.g. a re-solve with new loads, or the next time level on an unchanged geometry);
     /// `None`: no reuse.
     pub schur_cache: Option<&'a SchurCache>,
+    /// `A⁻¹ F` when the caller already has it (e.g. from a
+    /// [`synovia_fem::LoadSubspace`]); `None`: [`Interface::new`] solves for it.
+    pub load_solution: Option<&'a [f64]>,
 }
 
 /// Columns of the interface Schur complement `S = C A⁻¹ Cᵀ` kept between solves that share
@@ -267,6 +270,8 @@ impl<'a> ContactProblem<'a> {
 #[derive(Debug)]
 pub struct Interface<'a> {
     problem: ContactProblem<'a>,
+    /// `A⁻¹ F`.
+    load_solution: Vec<f64>,
     w: Vec<f64>,
     columns: Vec<Option<Vec<f64>>>,
     solves: usize,
@@ -295,8 +300,14 @@ impl<'a> Interface<'a> {
     pub fn new(problem: ContactProblem<'a>) -> Result<Self, ContactError> {
         problem.validate()?;
         let t0 = Instant::now();
-        let mut x = problem.load.to_vec();
-        problem.factor.solve_in_place(&mut x)?;
+        let (x, solves) = match problem.load_solution {
+            Some(x) if x.len() == problem.load.len() => (x.to_vec(), 0),
+            _ => {
+                let mut x = problem.load.to_vec();
+                problem.factor.solve_in_place(&mut x)?;
+                (x, 1)
+            }
+        };
         let w = problem.apply(&x);
         let m = problem.n_rows();
         let trailing = problem.factor.trailing().and_then(|block| {
@@ -319,7 +330,16 @@ impl<'a> Interface<'a> {
             Some((c, f)) => c.take(f, m),
             None => vec![None; m],
         };
-        Ok(Self { problem, w, columns, solves: 1, solve_s: t0.elapsed().as_secs_f64(), trailing, cache })
+        Ok(Self {
+            problem,
+            load_solution: x,
+            w,
+            columns,
+            solves,
+            solve_s: t0.elapsed().as_secs_f64(),
+            trailing,
+            cache,
+        })
     }
 
     /// `true` if the columns of `S` come from the trailing block of the factor.
@@ -402,13 +422,25 @@ impl<'a> Interface<'a> {
         Ok(self.w.iter().zip(&s).map(|(w, s)| w - s).collect())
     }
 
-    /// The displacement `U = A⁻¹ (F − Cᵀ ν)` (one solve).
+    /// The displacement `U = A⁻¹ (F − Cᵀ ν)` (one solve; half a solve when every row lies on
+    /// the trailing dofs, [`synovia_fem::CholeskySolver::solve_trailing_supported_in_place`]).
     pub fn displacement(&mut self, nu: &[f64]) -> Result<Vec<f64>, ContactError> {
         let t0 = Instant::now();
-        let mut rhs = self.problem.load.to_vec();
-        let neg: Vec<f64> = nu.iter().map(|v| -v).collect();
-        self.problem.apply_transpose_add(&neg, &mut rhs);
-        self.problem.factor.solve_in_place(&mut rhs)?;
+        let rhs = if self.trailing.is_some() {
+            // every row lies on the trailing dofs: U = A⁻¹F − A⁻¹(Cᵀν), the second solve
+            // with a right-hand side on the trailing dofs (half a solve)
+            let mut y = vec![0.0; self.load_solution.len()];
+            self.problem.apply_transpose_add(nu, &mut y);
+            self.problem.factor.solve_trailing_supported_in_place(&mut y)?;
+            y.iter_mut().zip(&self.load_solution).for_each(|(y, x)| *y = x - *y);
+            y
+        } else {
+            let mut rhs = self.problem.load.to_vec();
+            let neg: Vec<f64> = nu.iter().map(|v| -v).collect();
+            self.problem.apply_transpose_add(&neg, &mut rhs);
+            self.problem.factor.solve_in_place(&mut rhs)?;
+            rhs
+        };
         self.solves += 1;
         self.solve_s += t0.elapsed().as_secs_f64();
         Ok(rhs)

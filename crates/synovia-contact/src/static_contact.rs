@@ -6,12 +6,12 @@
 //! given slip bounds `g_c`), runs the solver, and maps the result back to nodal displacements
 //! per body and pressures per contact node.
 
-use synovia_fem::{ElasticParams, ElasticSolver, Model};
+use synovia_fem::{ElasticParams, ElasticSolver, LoadSubspace, Model};
 use synovia_mesh::math::{Real, Vector};
 
 use crate::error::ContactError;
 use crate::kkt::{check_kkt, inf_norm, KktReport};
-use crate::operators::{ContactGeometry, ContactPair};
+use crate::operators::{BodyPlacement, ContactGeometry, ContactPair};
 use crate::problem::{ContactProblem, FrictionConstraints, SchurCache};
 use crate::solver::{ContactSolution, ContactSolver};
 
@@ -23,6 +23,8 @@ pub struct StaticContact<const D: usize> {
     nested_min_rows: Option<usize>,
     /// Columns of `S` kept between solves on the same geometry ([`SchurCache`]).
     schur_cache: SchurCache,
+    /// Solved loads `A⁻¹ F` kept for loads in their span ([`LoadSubspace`]).
+    load_subspace: std::sync::Mutex<LoadSubspace>,
 }
 
 /// The result of one static contact solve.
@@ -58,7 +60,13 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<Self, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
         let elastic = ElasticSolver::new_for_contact(model, params, &interface_nodes(model, pairs)?)?;
-        Ok(Self { elastic, geometry, nested_min_rows: Some(32), schur_cache: SchurCache::new() })
+        Ok(Self {
+            elastic,
+            geometry,
+            nested_min_rows: Some(32),
+            schur_cache: SchurCache::new(),
+            load_subspace: std::sync::Mutex::new(LoadSubspace::new(LOAD_SUBSPACE_CAPACITY)),
+        })
     }
 
     /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
@@ -76,11 +84,38 @@ impl<const D: usize> StaticContact<D> {
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
+    /// Places the bodies rigidly ([`ContactGeometry::new_placed`], one [`BodyPlacement`] per
+    /// body) and rebuilds the contact geometry of `pairs` there, keeping the factorisation of
+    /// `A`: the bodies' stiffness in their own frames does not change with the placement, so a
+    /// sequence of poses (a gait cycle) needs one factorisation. The contact parts' dofs stay
+    /// the interface dofs ordered last, so Schur columns of the new rows still use the dense
+    /// trailing block. Loads, prescribed displacements and results are in the bodies' frames.
+    /// Returns the previous geometry.
+    ///
+    /// # Errors
+    /// From [`ContactGeometry::new_placed`].
+    pub fn place_bodies(
+        &mut self,
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        placements: &[BodyPlacement<D>],
+    ) -> Result<ContactGeometry<D>, ContactError> {
+        let geometry = ContactGeometry::new_placed(model, pairs, placements)?;
+        self.schur_cache.clear();
+        Ok(std::mem::replace(&mut self.geometry, geometry))
+    }
+
     /// Nested iteration for cold starts ([`crate::nested`]): coarsen the contact rows
     /// down to `min_rows` and use the coarse solutions as the warm start (default `Some(32)`);
     /// `None` starts every solve from `Λ = 0`.
     pub fn set_nested_iteration(&mut self, min_rows: Option<usize>) {
         self.nested_min_rows = min_rows;
+    }
+
+    /// `(reused, solved)`: solves whose `A⁻¹ F` came from the recycled load subspace and
+    /// those that needed a solve with the factor ([`LoadSubspace::counts`]).
+    pub fn load_solves(&self) -> (usize, usize) {
+        self.load_subspace.lock().unwrap_or_else(|e| e.into_inner()).counts()
     }
 
     /// The elastic solver (dofs, stiffness, factorisation, timings).
@@ -118,6 +153,12 @@ impl<const D: usize> StaticContact<D> {
             crate::floating::check_balance(st, &load, &normal, friction)?;
         }
         let (matrix, factor) = (self.elastic.system_matrix(), self.elastic.cholesky());
+        // A⁻¹ F: recycled when F is a combination of loads solved before (crate docs of
+        // synovia_fem::recycling); the proximal iteration's loads change every iteration
+        let load_solution = match stabilisation {
+            None => Some(self.load_subspace.lock().unwrap_or_else(|e| e.into_inner()).solve(factor, &load)?),
+            Some(_) => None,
+        };
         macro_rules! problem_with {
             ($rhs:expr) => {
                 ContactProblem {
@@ -127,6 +168,7 @@ impl<const D: usize> StaticContact<D> {
                     normal: &normal,
                     friction,
                     schur_cache: Some(&self.schur_cache),
+                    load_solution: load_solution.as_deref(),
                 }
             };
         }
@@ -257,6 +299,9 @@ fn interface_nodes<const D: usize>(
     }
     Ok(out)
 }
+
+/// Directions kept by the [`LoadSubspace`] of a [`StaticContact`].
+const LOAD_SUBSPACE_CAPACITY: usize = 6;
 
 /// Largest number of proximal-point iterations of a semi-coercive solve.
 const PROXIMAL_MAX_ITERATIONS: usize = 60;

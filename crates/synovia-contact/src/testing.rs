@@ -43,6 +43,7 @@ impl OwnedProblem {
             normal: &self.normal,
             friction: self.friction.as_ref(),
             schur_cache: None,
+            load_solution: None,
         }
     }
 }

@@ -23,6 +23,7 @@ pub mod error;
 pub mod model;
 pub mod post;
 pub mod quadrature;
+pub mod recycling;
 pub mod solver;
 pub mod sparse;
 
@@ -34,5 +35,6 @@ pub use error::FemError;
 pub use model::{Body, BodyId, ComponentMask, Model, TractionField, VectorField};
 pub use post::BodyFields;
 pub use quadrature::QuadratureRule;
+pub use recycling::LoadSubspace;
 pub use solver::{CholeskyInfo, CholeskySolver, Ordering, TrailingBlock};
 pub use sparse::SymmetricMatrix;

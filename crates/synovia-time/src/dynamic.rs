@@ -613,12 +613,12 @@ impl<const D: usize> DynamicStepper<D> {
     /// `|[u'_t]|` per contact node from two nodal displacement levels.
     fn nodal_slip_speeds(&self, new: &[Vec<Vector<D>>], old: &[Vec<Vector<D>>]) -> Vec<Real> {
         let dt = self.params.dt;
-        self.geometry
-            .nodes
-            .iter()
-            .map(|node| {
-                let v = node.jump(new).unwrap_or_else(Vector::<D>::zeros)
-                    - node.jump(old).unwrap_or_else(Vector::<D>::zeros);
+        let geometry = &self.geometry;
+        (0..geometry.len())
+            .map(|r| {
+                let node = &geometry.nodes[r];
+                let v = geometry.jump(r, new).unwrap_or_else(Vector::<D>::zeros)
+                    - geometry.jump(r, old).unwrap_or_else(Vector::<D>::zeros);
                 let vt = v - node.normal * node.normal.dot(&v);
                 vt.norm() / dt
             })
@@ -800,6 +800,7 @@ impl<const D: usize> DynamicStepper<D> {
                 normal: &normal,
                 friction,
                 schur_cache: None,
+                load_solution: None,
             };
             let (cell_node, slip_bound) = match (&friction_op, friction.is_some()) {
                 (Some(op), true) => (op.cell_node.clone(), op.slip_bound.clone()),

@@ -630,7 +630,7 @@ fn relative_displacement<const D: usize>(
     r: usize,
     displacement: &[Vec<Vector<D>>],
 ) -> Option<Vector<D>> {
-    geometry.nodes.get(r)?.jump(displacement)
+    geometry.jump(r, displacement)
 }
 
 /// The friction work of a step, `Σ_c g_c κ_c ‖T_cᵀ([u](s_c) − [u]_prev(s_c))‖` over the

@@ -632,6 +632,32 @@ fn timeless(rec: &StepRecord) -> StepRecord {
     StepRecord { step_s: 0.0, ..rec.clone() }
 }
 
+/// Same step, same active and stick/slip sets (areas, iterations), forces and energies equal to
+/// `tol` relative.
+fn assert_records_close(a: &StepRecord, b: &StepRecord, tol: Real) {
+    // relative to `scale` (the pair's force for its components, which may be rounding zeros)
+    let close_to = |x: Real, y: Real, scale: Real, what: &str| {
+        assert!((x - y).abs() <= tol * scale.max(1e-300), "{what}: {x} vs {y}");
+    };
+    let close = |x: Real, y: Real, what: &str| close_to(x, y, x.abs().max(y.abs()), what);
+    assert_eq!((a.step, a.time, a.iterations, a.pairs.len()), (b.step, b.time, b.iterations, b.pairs.len()));
+    for (p, q) in a.pairs.iter().zip(&b.pairs) {
+        assert_eq!(
+            (&p.name, p.contact_area, p.stick_area, p.slip_area),
+            (&q.name, q.contact_area, q.stick_area, q.slip_area)
+        );
+        let scale = p.force.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        for k in 0..3 {
+            close_to(p.force[k], q.force[k], scale, "force");
+        }
+        close(p.normal_force, q.normal_force, "normal force");
+        close_to(p.tangential_force, q.tangential_force, scale, "tangential force");
+        close(p.peak_pressure, q.peak_pressure, "peak pressure");
+    }
+    close(a.strain_energy, b.strain_energy, "strain energy");
+    close_to(a.friction_dissipation, b.friction_dissipation, a.strain_energy.abs(), "friction dissipation");
+}
+
 fn assert_same_result(a: &StaticContactResult<2>, b: &StaticContactResult<2>) {
     assert_eq!(a.displacement, b.displacement);
     assert_eq!(a.solution.u, b.solution.u);
@@ -677,9 +703,10 @@ fn stepping_one_level_at_a_time_is_bit_identical_to_run() {
         assert!(matches!(stepper.step(&model, 3.0, &solver), Err(TimeError::InvalidParameter(_))));
         assert!(stepper.step(&model, Real::NAN, &solver).is_err());
         assert_eq!(stepper.next_step(), times.len());
-        // restart: step 0 again, cold or warm, equal to the first level of the run
+        // restart: step 0 again, cold or warm, equal to the first level of the run up to
+        // rounding (its A⁻¹F now comes from the recycled load subspace of the later levels)
         let (rec, _) = stepper.restart(&model, times[0], &solver, false).expect("restart");
-        assert_eq!(timeless(&rec), timeless(&records[0]));
+        assert_records_close(&rec, &records[0], 1e-12);
         assert_eq!(stepper.next_step(), 1);
         stepper.reset();
         assert!(stepper.last_result().is_none() && stepper.next_step() == 0);
