@@ -514,13 +514,15 @@ impl KneeCycle {
         let (model, contact) = (&self.model, &self.contact);
         let mut solves = 0;
         let mut its = 0;
+        // the secant iterates need only the multipliers; U and the KKT check are completed
+        // for the accepted one
         let mut solve =
-            |d: Real, warm: Option<&ContactSolution>| -> Result<(Real, StaticContactResult<2>), KneeError> {
-                let res = contact.solve(model, d, solver, None, None, warm)?;
+            |d: Real, warm: Option<&ContactSolution>| -> Result<(Real, ContactSolution), KneeError> {
+                let (sol, coarse) = contact.solve_multipliers(model, d, solver, None, None, warm)?;
                 solves += 1;
-                its += res.solution.report.iterations + res.coarse_iterations;
-                let f = resultant(contact.geometry(), &res)[1].abs();
-                Ok((f, res))
+                its += sol.report.iterations + coarse;
+                let f = traction_resultant(contact.geometry(), &sol.lambda_n)[1].abs();
+                Ok((f, sol))
             };
         let tolerance = self.knee.tolerance * target;
         // predictor: the last pose's approach moved along its force slope to this pose's load
@@ -533,7 +535,7 @@ impl KneeCycle {
         let (mut f0, mut r0) = solve(d0, carried.as_ref())?;
         while f0 <= 0.0 {
             d0 *= 2.0;
-            (f0, r0) = solve(d0, Some(&r0.solution))?;
+            (f0, r0) = solve(d0, Some(&r0))?;
             if d0 > 10.0 {
                 return Err(format!("t = {time}: no contact up to an approach of {d0} mm").into());
             }
@@ -547,7 +549,7 @@ impl KneeCycle {
                 Some(slope) => (d0 + (target - f0) / slope).clamp(0.3 * d0, 3.0 * d0),
                 None => d0 * (target / f0).powf(2.0 / 3.0).clamp(0.3, 3.0),
             };
-            let (mut f1, mut r1) = solve(d1, Some(&r0.solution))?;
+            let (mut f1, mut r1) = solve(d1, Some(&r0))?;
             let mut slope = (f1 - f0) / (d1 - d0);
             let mut iter = 0;
             while (f1 - target).abs() > tolerance {
@@ -560,7 +562,7 @@ impl KneeCycle {
                 if d2 <= 0.0 {
                     d2 = 0.5 * d1;
                 }
-                let (f2, r2) = solve(d2, Some(&r1.solution))?;
+                let (f2, r2) = solve(d2, Some(&r1))?;
                 slope = (f2 - f1) / (d2 - d1);
                 (d0, f0) = (d1, f1);
                 (d1, f1, r1) = (d2, f2, r2);
@@ -568,6 +570,7 @@ impl KneeCycle {
             let _ = (d0, f0);
             (d1, r1, Some(slope).filter(|s| *s > 0.0 && s.is_finite()).or(slope_prev))
         };
+        let r1 = contact.complete(model, d1, None, None, r1)?;
         let geo = contact.geometry();
         let force = resultant(geo, &r1);
         let active: Vec<usize> = (0..geo.len()).filter(|&r| r1.solution.lambda_n[r] > 0.0).collect();
@@ -607,10 +610,15 @@ impl KneeCycle {
 
 /// The resultant `Σ_r κ_r Λ_n,r n_r` of the contact tractions on the slave side (N/mm).
 pub fn resultant(geometry: &ContactGeometry<2>, result: &StaticContactResult<2>) -> Vector<2> {
+    traction_resultant(geometry, &result.solution.lambda_n)
+}
+
+/// `Σ_r κ_r Λ_n,r n_r` for nodal pressures `lambda_n` (one per contact node of `geometry`).
+pub fn traction_resultant(geometry: &ContactGeometry<2>, lambda_n: &[Real]) -> Vector<2> {
     geometry
         .nodes
         .iter()
-        .zip(&result.solution.lambda_n)
+        .zip(lambda_n)
         .fold(Vector::<2>::zeros(), |acc, (n, &l)| acc + n.normal * (n.weight * l))
 }
 

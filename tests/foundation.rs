@@ -266,7 +266,7 @@ fn trailing_ordering_over_a_bad_base_permutation_is_an_error() {
 fn load_subspace_recycles_combinations_of_solved_loads() {
     use synovia::fem::LoadSubspace;
     let solver = ElasticSolver::new(&cantilever(), ElasticParams::default()).expect("factor");
-    let chol = solver.cholesky();
+    let (a, chol) = (solver.stiffness(), solver.cholesky());
     let n = chol.n();
     let load = |k: f64| -> Vec<f64> { (0..n).map(|i| ((i as f64 + 1.0) * k).sin()).collect() };
     let direct = |f: &[f64]| {
@@ -281,26 +281,26 @@ fn load_subspace_recycles_combinations_of_solved_loads() {
     let mut sub = LoadSubspace::new(2);
     let (f1, f2, f3) = (load(0.3), load(1.7), load(2.9));
     for f in [&f1, &f2] {
-        assert!(rel(&sub.solve(chol, f).expect("solve"), &direct(f)) < 1e-13);
+        assert!(rel(&sub.solve(a, chol, f).expect("solve"), &direct(f)) < 1e-13);
     }
     assert_eq!((sub.len(), sub.counts()), (2, (0, 2)));
     let combo: Vec<f64> = f1.iter().zip(&f2).map(|(a, b)| 3.0 * a - 2.0 * b).collect();
-    let x = sub.solve(chol, &combo).expect("recycled");
+    let x = sub.solve(a, chol, &combo).expect("recycled");
     assert_eq!(sub.counts(), (1, 2), "a combination needs no solve");
     let err = rel(&x, &direct(&combo));
     assert!(err < 1e-12, "recycled solution differs by {err:e}");
     // a new direction: solved, kept, and the oldest (f1's) dropped
-    assert!(rel(&sub.solve(chol, &f3).expect("solve"), &direct(&f3)) < 1e-13);
+    assert!(rel(&sub.solve(a, chol, &f3).expect("solve"), &direct(&f3)) < 1e-13);
     assert_eq!((sub.len(), sub.counts()), (2, (1, 3)));
-    let x3 = sub.solve(chol, &f3.iter().map(|v| -0.5 * v).collect::<Vec<_>>()).expect("recycled");
+    let x3 = sub.solve(a, chol, &f3.iter().map(|v| -0.5 * v).collect::<Vec<_>>()).expect("recycled");
     assert_eq!(sub.counts(), (2, 3), "f3 is in the subspace");
     assert!(rel(&x3, &direct(&f3).iter().map(|v| -0.5 * v).collect::<Vec<_>>()) < 1e-12);
-    sub.solve(chol, &f1).expect("solve");
+    sub.solve(a, chol, &f1).expect("solve");
     assert_eq!(sub.counts(), (2, 4), "f1 left the subspace");
     // zero load, wrong length, NaN
-    assert!(sub.solve(chol, &vec![0.0; n]).expect("zero").iter().all(|v| *v == 0.0));
-    assert!(sub.solve(chol, &vec![1.0; n + 1]).is_err());
+    assert!(sub.solve(a, chol, &vec![0.0; n]).expect("zero").iter().all(|v| *v == 0.0));
+    assert!(sub.solve(a, chol, &vec![1.0; n + 1]).is_err());
     let mut bad = f1.clone();
     bad[3] = f64::NAN;
-    assert!(sub.solve(chol, &bad).is_err());
+    assert!(sub.solve(a, chol, &bad).is_err());
 }

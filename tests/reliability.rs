@@ -46,6 +46,7 @@ impl Synthetic {
             friction: None,
             schur_cache: None,
             load_solution: None,
+            multipliers_only: false,
         }
     }
 }

@@ -72,6 +72,11 @@ pub struct ContactProblem<'a> {
     /// `A⁻¹ F` when the caller already has it (e.g. from a
     /// [`synovia_fem::LoadSubspace`]); `None`: [`Interface::new`] solves for it.
     pub load_solution: Option<&'a [f64]>,
+    /// Skip the final displacement `U = A⁻¹ (F − Cᵀ ν)` of the solvers (the returned
+    /// solution's `u` is empty): for callers that need only the multipliers, e.g. the
+    /// iterates of a load search, and complete `U` for the accepted one
+    /// ([`crate::StaticContact::complete`]). The solvers use `U` only to return it.
+    pub multipliers_only: bool,
 }
 
 /// Columns of the interface Schur complement `S = C A⁻¹ Cᵀ` kept between solves that share
@@ -423,8 +428,12 @@ impl<'a> Interface<'a> {
     }
 
     /// The displacement `U = A⁻¹ (F − Cᵀ ν)` (one solve; half a solve when every row lies on
-    /// the trailing dofs, [`synovia_fem::CholeskySolver::solve_trailing_supported_in_place`]).
+    /// the trailing dofs, [`synovia_fem::CholeskySolver::solve_trailing_supported_in_place`]);
+    /// empty for a [`ContactProblem::multipliers_only`] problem.
     pub fn displacement(&mut self, nu: &[f64]) -> Result<Vec<f64>, ContactError> {
+        if self.problem.multipliers_only {
+            return Ok(Vec::new());
+        }
         let t0 = Instant::now();
         let rhs = if self.trailing.is_some() {
             // every row lies on the trailing dofs: U = A⁻¹F − A⁻¹(Cᵀν), the second solve

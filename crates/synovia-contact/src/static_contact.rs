@@ -139,6 +139,109 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         warm_start: Option<&ContactSolution>,
     ) -> Result<StaticContactResult<D>, ContactError> {
+        match self.solve_with(model, t, solver, slip_bound, previous, warm_start, false)? {
+            Solved::Full(result) => Ok(*result),
+            Solved::Multipliers(..) => {
+                Err(ContactError::InvalidParameter("internal: multipliers without displacement".into()))
+            }
+        }
+    }
+
+    /// [`StaticContact::solve`] without the final displacement: the multipliers `Λ_n`, `Λ_t`
+    /// and the solver report (the solution's `u` is empty, [`ContactProblem::multipliers_only`]),
+    /// and the coarse-level iterations of the nested warm start. Saves one solve with the
+    /// factor (half a solve on a condensed interface) and the KKT check per call: for the
+    /// iterates of a search over loads (e.g. the approach that balances a given force,
+    /// [`crate::StaticContact::complete`] for the accepted one). For a semi-coercive model
+    /// (proximal iteration) the displacement is needed inside the iteration and is returned.
+    ///
+    /// # Errors
+    /// As [`StaticContact::solve`].
+    pub fn solve_multipliers(
+        &self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        warm_start: Option<&ContactSolution>,
+    ) -> Result<(ContactSolution, usize), ContactError> {
+        Ok(match self.solve_with(model, t, solver, slip_bound, previous, warm_start, true)? {
+            Solved::Full(result) => (result.solution, result.coarse_iterations),
+            Solved::Multipliers(solution, coarse) => (*solution, coarse),
+        })
+    }
+
+    /// Completes a solution of [`StaticContact::solve_multipliers`] (same `t`, `slip_bound`,
+    /// `previous`): the displacement `U = A⁻¹ F − A⁻¹ (Cᵀ ν)` (with `A⁻¹ F` recycled, half a
+    /// solve on a condensed interface), the KKT check and the nodal fields — the result
+    /// [`StaticContact::solve`] would have returned, to rounding. A solution that already has
+    /// its `u` (semi-coercive models) is completed without a solve.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] if the solution does not fit the contact problem at
+    /// `t`; the errors of the solve.
+    pub fn complete(
+        &self,
+        model: &Model<D>,
+        t: Real,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        solution: ContactSolution,
+    ) -> Result<StaticContactResult<D>, ContactError> {
+        let (load, lifts) = self.elastic.rhs(model, t)?;
+        let dofs = self.elastic.dofs();
+        let normal = self.geometry.normal_constraints(dofs, &lifts);
+        let friction_op = match slip_bound {
+            Some(g) => Some(self.geometry.friction_constraints(dofs, &lifts, g, previous)?),
+            None => None,
+        };
+        let friction: Option<&FrictionConstraints> =
+            friction_op.as_ref().map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0);
+        let n_tangential = friction.map_or(0, |f| f.rows.nrows());
+        if solution.lambda_n.len() != normal.rows.nrows() || solution.lambda_t.len() != n_tangential {
+            return Err(ContactError::InvalidParameter(format!(
+                "a solution with {} normal and {} tangential multipliers for a problem with {} and {}",
+                solution.lambda_n.len(),
+                solution.lambda_t.len(),
+                normal.rows.nrows(),
+                n_tangential
+            )));
+        }
+        let factor = self.elastic.cholesky();
+        let load_solution = self.recycled_load_solution(&load)?;
+        let problem = ContactProblem {
+            matrix: self.elastic.system_matrix(),
+            factor,
+            load: &load,
+            normal: &normal,
+            friction,
+            schur_cache: None,
+            load_solution: load_solution.as_deref(),
+            multipliers_only: false,
+        };
+        let mut solution = solution;
+        if solution.u.is_empty() {
+            let mut nu: Vec<f64> =
+                solution.lambda_n.iter().zip(&normal.weights).map(|(l, k)| l * k).collect();
+            nu.extend_from_slice(&solution.lambda_t);
+            solution.u = crate::problem::Interface::new(problem)?.displacement(&nu)?;
+        }
+        let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
+        self.finish(solution, kkt, &lifts, friction_op, 0, 0)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn solve_with(
+        &self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        warm_start: Option<&ContactSolution>,
+        multipliers_only: bool,
+    ) -> Result<Solved<D>, ContactError> {
         let (load, lifts) = self.elastic.rhs(model, t)?;
         let dofs = self.elastic.dofs();
         let normal = self.geometry.normal_constraints(dofs, &lifts);
@@ -155,10 +258,7 @@ impl<const D: usize> StaticContact<D> {
         let (matrix, factor) = (self.elastic.system_matrix(), self.elastic.cholesky());
         // A⁻¹ F: recycled when F is a combination of loads solved before (crate docs of
         // synovia_fem::recycling); the proximal iteration's loads change every iteration
-        let load_solution = match stabilisation {
-            None => Some(self.load_subspace.lock().unwrap_or_else(|e| e.into_inner()).solve(factor, &load)?),
-            Some(_) => None,
-        };
+        let load_solution = self.recycled_load_solution(&load)?;
         macro_rules! problem_with {
             ($rhs:expr) => {
                 ContactProblem {
@@ -169,6 +269,7 @@ impl<const D: usize> StaticContact<D> {
                     friction,
                     schur_cache: Some(&self.schur_cache),
                     load_solution: load_solution.as_deref(),
+                    multipliers_only: multipliers_only && stabilisation.is_none(),
                 }
             };
         }
@@ -189,8 +290,11 @@ impl<const D: usize> StaticContact<D> {
         let Some(st) = stabilisation else {
             let problem = problem_with!(&load);
             let solution = solver.solve(&problem, warm.as_ref())?;
+            if multipliers_only {
+                return Ok(Solved::Multipliers(Box::new(solution), coarse_iterations));
+            }
             let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
-            return self.finish(solution, kkt, &lifts, friction_op, coarse_iterations, 0);
+            return self.finish(solution, kkt, &lifts, friction_op, coarse_iterations, 0).map(Solved::full);
         };
         // Proximal-point iteration (crate::floating): A + S with load F + S U_k.
         let mut u_k = match &warm {
@@ -220,7 +324,9 @@ impl<const D: usize> StaticContact<D> {
                 let mut kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
                 // the equilibrium residual of the original problem is −S (U_{k+1} − U_k)
                 kkt.equilibrium = kkt.equilibrium.max(relative);
-                return self.finish(solution, kkt, &lifts, friction_op, coarse_iterations, iteration);
+                return self
+                    .finish(solution, kkt, &lifts, friction_op, coarse_iterations, iteration)
+                    .map(Solved::full);
             }
             // A load that contact cannot hold (e.g. a tangential load above the friction
             // capacity) makes the body move by the same amount every iteration: stop early.
@@ -238,6 +344,17 @@ impl<const D: usize> StaticContact<D> {
             iterations: history.len(),
             history,
         })
+    }
+
+    /// `A⁻¹ F` through the [`LoadSubspace`] (recycled when `F` is a combination of loads
+    /// solved before, [`synovia_fem::recycling`]); `None` for a semi-coercive model, whose
+    /// proximal iteration changes the load every iteration.
+    fn recycled_load_solution(&self, load: &[f64]) -> Result<Option<Vec<f64>>, ContactError> {
+        if self.elastic.stabilisation().is_some() {
+            return Ok(None);
+        }
+        let mut subspace = self.load_subspace.lock().unwrap_or_else(|e| e.into_inner());
+        Ok(Some(subspace.solve(self.elastic.system_matrix(), self.elastic.cholesky(), load)?))
     }
 
     fn finish(
@@ -265,6 +382,19 @@ impl<const D: usize> StaticContact<D> {
             coarse_iterations,
             proximal_iterations,
         })
+    }
+}
+
+/// What [`StaticContact::solve_with`] returns: the full result, or (multipliers only) the
+/// solver's solution without `u` and the coarse iterations.
+enum Solved<const D: usize> {
+    Full(Box<StaticContactResult<D>>),
+    Multipliers(Box<ContactSolution>, usize),
+}
+
+impl<const D: usize> Solved<D> {
+    fn full(result: StaticContactResult<D>) -> Self {
+        Self::Full(Box::new(result))
     }
 }
 

@@ -44,6 +44,7 @@ impl OwnedProblem {
             friction: self.friction.as_ref(),
             schur_cache: None,
             load_solution: None,
+            multipliers_only: false,
         }
     }
 }

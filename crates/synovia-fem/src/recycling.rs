@@ -3,28 +3,37 @@
 //! Loads of a joint model are mostly combinations of a few fixed patterns: a load history
 //! `F(t) = Σ_i h_i(t) F_i`, a prescribed motion `u_p(t) = Σ_i δ_i(t) e_i` (its lift load is
 //! linear in the `δ_i`), a force turned with a body frame. [`LoadSubspace`] keeps an
-//! orthonormal basis `Q` of the loads solved so far together with `Z = A⁻¹ Q`. For a new load
-//! it computes `c = Qᵀ F` and the residual `r = F − Q c` (modified Gram–Schmidt): if
-//! `‖r‖ ≤ τ ‖F‖` the solution is `A⁻¹ F = Z c` (O(m n) work, `m` basis vectors) — no solve with
-//! the factor; otherwise it solves with the factor and, when `r` is a new direction
-//! (`‖r‖ ≥ 10⁻² ‖F‖`, so that `z = A⁻¹ r = A⁻¹ F − Z c` loses at most two digits to cancellation), appends
-//! `q = r/‖r‖`, `z = (A⁻¹ F − Z c)/‖r‖` (after a second Gram–Schmidt pass). The result differs from a direct solve by rounding
-//! only: `A (Z c) − F = Σ_j c_j (A z_j − q_j) − r`, both of the order of the factor's own
-//! residual and `τ ‖F‖` (`τ = 10⁻¹⁴`).
+//! orthonormal basis `Q` of the loads solved so far, their solutions `Z ≈ A⁻¹ Q` and the
+//! residual norms `ρ_j = ‖A z_j − q_j‖`. For a new load it computes `c = Qᵀ F` and
+//! `r = F − Q c` (modified Gram–Schmidt). Since
+//!
+//! ```text
+//! A (Z c) − F = Σ_j c_j (A z_j − q_j) − r,   so   ‖A (Z c) − F‖ ≤ Σ_j |c_j| ρ_j + ‖r‖,
+//! ```
+//!
+//! the recycled solution `Z c` (O(m n) work for `m` directions, no solve with the factor) is
+//! used when that bound is at most `τ ‖F‖` (`τ = 10⁻¹²`, the backward error of a direct solve
+//! of these systems is 10⁻¹⁵–10⁻¹³). Otherwise the load is solved with the factor and, if
+//! `r` is a new direction, `q = r/‖r‖`, `z = (A⁻¹ F − Z c)/‖r‖` are appended (after a second
+//! Gram–Schmidt pass) with `ρ = ‖A z − q‖` measured by one product with `A` — a direction
+//! derived from a small `‖r‖` loses digits to cancellation, and `ρ` says how many, so such a
+//! direction is only used with coefficients small enough for the bound.
 
 use crate::error::FemError;
 use crate::solver::CholeskySolver;
+use crate::sparse::SymmetricMatrix;
 
-/// Relative residual `‖F − Q Qᵀ F‖ / ‖F‖` below which a load counts as in the span.
-const SPAN_TOLERANCE: f64 = 1e-14;
-/// Smallest relative residual of a load whose direction is added to the basis.
-const NEW_DIRECTION: f64 = 1e-2;
+/// Relative residual bound `‖A x − F‖ / ‖F‖` of a recycled solution.
+const RECYCLED_RESIDUAL: f64 = 1e-12;
+/// Smallest relative residual `‖r‖ / ‖F‖` of a load whose direction is added to the basis.
+const NEW_DIRECTION: f64 = 1e-10;
 
-/// Orthonormal loads `Q` and their solutions `Z = A⁻¹ Q` for one factorisation of `A`.
+/// Orthonormal loads `Q`, their solutions `Z ≈ A⁻¹ Q` and residuals for one factorisation.
 #[derive(Debug, Clone, Default)]
 pub struct LoadSubspace {
     basis: Vec<Vec<f64>>,
     solutions: Vec<Vec<f64>>,
+    residuals: Vec<f64>,
     capacity: usize,
     reused: usize,
     solved: usize,
@@ -53,20 +62,28 @@ impl LoadSubspace {
     pub fn clear(&mut self) {
         self.basis.clear();
         self.solutions.clear();
+        self.residuals.clear();
     }
 
-    /// `A⁻¹ load`: from the subspace if `load` lies in its span (relative residual ≤ 10⁻¹⁴),
-    /// otherwise by a solve with `factor` (the load's new direction is then kept).
+    /// `A⁻¹ load` for the matrix `matrix` factorised by `factor`: from the subspace when the
+    /// residual bound of the [module documentation](self) allows it, otherwise by a solve with
+    /// `factor` (the load's new direction is then kept).
     ///
     /// # Errors
-    /// [`FemError::InvalidParameter`] if `load` does not match the factor's dimension or is not
-    /// finite; the solve's errors.
-    pub fn solve(&mut self, factor: &CholeskySolver, load: &[f64]) -> Result<Vec<f64>, FemError> {
+    /// [`FemError::InvalidParameter`] if `load`, `matrix` and `factor` do not have the same
+    /// dimension or `load` is not finite; the solve's errors.
+    pub fn solve(
+        &mut self,
+        matrix: &SymmetricMatrix,
+        factor: &CholeskySolver,
+        load: &[f64],
+    ) -> Result<Vec<f64>, FemError> {
         let n = factor.n();
-        if load.len() != n || load.iter().any(|v| !v.is_finite()) {
+        if load.len() != n || matrix.n() != n || load.iter().any(|v| !v.is_finite()) {
             return Err(FemError::InvalidParameter(format!(
-                "load of length {} (finite entries needed) for a factor of dimension {n}",
-                load.len()
+                "load of length {} (finite entries needed) for a matrix of dimension {} and a factor of dimension {n}",
+                load.len(),
+                matrix.n()
             )));
         }
         if self.basis.first().is_some_and(|q| q.len() != n) {
@@ -81,15 +98,16 @@ impl LoadSubspace {
         let mut residual = load.to_vec();
         self.orthogonalise(&mut coeffs, &mut residual);
         let mut rnorm = dot(&residual, &residual).sqrt();
-        let mut x = vec![0.0; n];
-        if rnorm <= SPAN_TOLERANCE * norm {
+        let bound = rnorm + coeffs.iter().zip(&self.residuals).map(|(c, r)| c.abs() * r).sum::<f64>();
+        if bound <= RECYCLED_RESIDUAL * norm {
+            let mut x = vec![0.0; n];
             for (c, z) in coeffs.iter().zip(&self.solutions) {
                 axpy(*c, z, &mut x);
             }
             self.reused += 1;
             return Ok(x);
         }
-        x.copy_from_slice(load);
+        let mut x = load.to_vec();
         factor.solve_in_place(&mut x)?;
         self.solved += 1;
         if self.capacity > 0 && rnorm >= NEW_DIRECTION * norm {
@@ -97,6 +115,7 @@ impl LoadSubspace {
                 // make room first, so that the new load lies in the span it leaves
                 self.basis.remove(0);
                 self.solutions.remove(0);
+                self.residuals.remove(0);
                 coeffs = vec![0.0; self.basis.len()];
                 residual.copy_from_slice(load);
                 self.orthogonalise(&mut coeffs, &mut residual);
@@ -111,14 +130,16 @@ impl LoadSubspace {
             let inv = 1.0 / rnorm;
             residual.iter_mut().for_each(|v| *v *= inv);
             z.iter_mut().for_each(|v| *v *= inv);
+            let mut az = vec![0.0; n];
+            matrix.mul_vec(&z, &mut az);
+            let rho = az.iter().zip(&residual).map(|(a, q)| (a - q) * (a - q)).sum::<f64>().sqrt();
             self.basis.push(residual);
             self.solutions.push(z);
+            self.residuals.push(rho);
         }
         Ok(x)
     }
-}
 
-impl LoadSubspace {
     /// One modified Gram–Schmidt pass of `residual` against the basis, accumulating the
     /// coefficients.
     fn orthogonalise(&self, coeffs: &mut [f64], residual: &mut [f64]) {

@@ -801,6 +801,7 @@ impl<const D: usize> DynamicStepper<D> {
                 friction,
                 schur_cache: None,
                 load_solution: None,
+                multipliers_only: false,
             };
             let (cell_node, slip_bound) = match (&friction_op, friction.is_some()) {
                 (Some(op), true) => (op.cell_node.clone(), op.slip_bound.clone()),
