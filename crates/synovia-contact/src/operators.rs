@@ -633,7 +633,17 @@ impl<const D: usize> ContactNode<D> {
     /// `u^l` is the partner node's (node-to-node), `Σ_j w_j u^l_j` (node-to-segment) or 0
     /// (rigid obstacle). `None` if the displacements do not fit the node.
     pub fn jump(&self, displacement: &[Vec<Vector<D>>]) -> Option<Vector<D>> {
-        let at = |b: BodyId, i: usize| displacement.get(b.0).and_then(|u| u.get(i)).copied();
+        self.jump_mapped(displacement, |_, u| *u)
+    }
+
+    /// [`ContactNode::jump`] with each nodal displacement passed through `map(body, u)` first
+    /// (e.g. from a body frame into space).
+    fn jump_mapped(
+        &self,
+        displacement: &[Vec<Vector<D>>],
+        map: impl Fn(BodyId, &Vector<D>) -> Vector<D>,
+    ) -> Option<Vector<D>> {
+        let at = |b: BodyId, i: usize| displacement.get(b.0).and_then(|u| u.get(i)).map(|u| map(b, u));
         let mut j = at(self.node.0, self.node.1)?;
         if let Some((b, i)) = self.partner {
             j -= at(b, i)?;
@@ -744,17 +754,7 @@ impl<const D: usize> ContactGeometry<D> {
         if self.placements.is_empty() {
             return node.jump(displacement);
         }
-        let at = |b: BodyId, i: usize| {
-            displacement.get(b.0).and_then(|u| u.get(i)).map(|u| self.placement(b).to_global(u))
-        };
-        let mut j = at(node.node.0, node.node.1)?;
-        if let Some((b, i)) = node.partner {
-            j -= at(b, i)?;
-        }
-        for &(b, i, w) in &node.master {
-            j -= at(b, i)? * w;
-        }
-        Some(j)
+        node.jump_mapped(displacement, |b, u| self.placement(b).to_global(u))
     }
 
     fn build(
