@@ -73,7 +73,11 @@ fn normal_tresca<const D: usize>(
     let solver = synovia::solvers::by_name("pdas")?;
     let elastic_s = elastic_time(model)?;
     let t_setup = Instant::now();
-    let sc = StaticContact::new(model, pairs, ElasticParams::default())?;
+    let mut params = ElasticParams::default();
+    if let Some(k) = std::env::var("SYNOVIA_TRAILING_DOFS").ok().and_then(|v| v.parse().ok()) {
+        params.max_trailing_dofs = k;
+    }
+    let sc = StaticContact::new(model, pairs, params)?;
     let setup_s = t_setup.elapsed().as_secs_f64();
     let geo = sc.geometry();
     let t0 = Instant::now();
@@ -92,6 +96,8 @@ fn normal_tresca<const D: usize>(
         "normal_s": normal_s,
         "tresca_s": tresca_s,
         "normal_iterations": normal.solution.report.iterations,
+        "normal_active": normal.solution.report.active,
+        "trailing_dofs": sc.elastic().cholesky().trailing().map_or(0, |b| b.dofs.len()),
         "tresca_iterations": tresca.solution.report.iterations,
         "kkt": tresca.kkt.max().max(normal.kkt.max()),
         // everything from the model: contact set-up (factorisation with the interface ordered

@@ -271,9 +271,11 @@ pub struct Interface<'a> {
     columns: Vec<Option<Vec<f64>>>,
     solves: usize,
     solve_s: f64,
-    /// The rows of `C` in the positions of the factor's trailing block, when every row lives
-    /// on the trailing dofs ([`synovia_fem::TrailingBlock`]): columns of `S` then cost two
-    /// dense triangular solves with `L₂₂` instead of a solve with the whole factor.
+    /// The rows of `C` in the positions of the factor's trailing block
+    /// ([`synovia_fem::TrailingBlock`]), `None` for a row with a dof outside it; kept when at
+    /// most a fifth of the rows are outside. Columns of `S` of trailing rows then cost two
+    /// dense triangular solves with `L₂₂` instead of a solve with the whole factor; their
+    /// entries in the other rows `i` are taken from the (whole-factor) columns `i` by symmetry.
     trailing: Option<(std::sync::Arc<synovia_fem::TrailingBlock>, TrailingRows)>,
     /// Where the columns go back when the interface is dropped.
     cache: Option<(&'a SchurCache, u64)>,
@@ -287,8 +289,9 @@ impl Drop for Interface<'_> {
     }
 }
 
-/// Rows of `C` as `(trailing position, value)` lists.
-type TrailingRows = Vec<Vec<(usize, f64)>>;
+/// Rows of `C` as `(trailing position, value)` lists (`None`: a row with a dof outside the
+/// trailing block).
+type TrailingRows = Vec<Option<Vec<(usize, f64)>>>;
 
 impl<'a> Interface<'a> {
     /// Validates the problem and computes `w = C A⁻¹ F` (one solve).
@@ -300,19 +303,19 @@ impl<'a> Interface<'a> {
         let w = problem.apply(&x);
         let m = problem.n_rows();
         let trailing = problem.factor.trailing().and_then(|block| {
-            let mut rows = Vec::with_capacity(m);
-            for r in 0..m {
-                let mut row = Vec::new();
-                for (i, v) in problem.row(r) {
-                    let p = block.position.get(i).copied().unwrap_or(usize::MAX);
-                    if p == usize::MAX {
-                        return None;
-                    }
-                    row.push((p, v));
-                }
-                rows.push(row);
-            }
-            Some((block.clone(), rows))
+            let rows: TrailingRows = (0..m)
+                .map(|r| {
+                    problem
+                        .row(r)
+                        .map(|(i, v)| match block.position.get(i).copied() {
+                            Some(p) if p != usize::MAX => Some((p, v)),
+                            _ => None,
+                        })
+                        .collect::<Option<Vec<_>>>()
+                })
+                .collect();
+            let outside = rows.iter().filter(|r| r.is_none()).count();
+            (outside * 5 <= m && outside < m).then(|| (block.clone(), rows))
         });
         let cache = problem.schur_cache.map(|c| (c, problem.rows_fingerprint()));
         let columns = match cache {
@@ -362,18 +365,59 @@ impl<'a> Interface<'a> {
         }
         let t0 = Instant::now();
         let problem = self.problem;
-        let computed = match &self.trailing {
-            Some((block, rows)) => in_two_halves(&missing, block.dofs.len() >= 256, |cols| {
-                Ok(trailing_columns(block, rows, cols))
-            })?,
-            None => in_two_halves(&missing, true, |cols| schur_columns(&problem, cols))?,
+        let Some((block, rows)) = self.trailing.take() else {
+            let computed = in_two_halves(&missing, true, |cols| schur_columns(&problem, cols))?;
+            self.store(computed, t0);
+            return Ok(());
         };
+        let result = self.mixed_columns(&block, &rows, &missing);
+        self.trailing = Some((block, rows));
+        result
+    }
+
+    /// [`Interface::ensure_columns`] with a trailing block: whole-factor columns for the rows
+    /// outside the block (all of them as soon as a trailing column is needed), then the
+    /// trailing columns, completed in the outside rows by symmetry `S_ij = S_ji`.
+    fn mixed_columns(
+        &mut self,
+        block: &synovia_fem::TrailingBlock,
+        rows: &[Option<Vec<(usize, f64)>>],
+        missing: &[usize],
+    ) -> Result<(), ContactError> {
+        let problem = self.problem;
+        let (inside, mut outside): (Vec<usize>, Vec<usize>) =
+            missing.iter().partition(|&&j| rows[j].is_some());
+        if !inside.is_empty() {
+            outside = (0..rows.len()).filter(|&j| rows[j].is_none() && self.columns[j].is_none()).collect();
+        }
+        if !outside.is_empty() {
+            let t0 = Instant::now();
+            let computed = in_two_halves(&outside, true, |cols| schur_columns(&problem, cols))?;
+            self.store(computed, t0);
+        }
+        if !inside.is_empty() {
+            let t0 = Instant::now();
+            let mut computed = in_two_halves(&inside, block.dofs.len() >= 256, |cols| {
+                Ok(trailing_columns(block, rows, cols))
+            })?;
+            for (j, col) in &mut computed {
+                for (i, entry) in col.iter_mut().enumerate() {
+                    if rows[i].is_none() {
+                        *entry = self.columns[i].as_ref().map_or(0.0, |c| c[*j]);
+                    }
+                }
+            }
+            self.store(computed, t0);
+        }
+        Ok(())
+    }
+
+    fn store(&mut self, computed: Vec<(usize, Vec<f64>)>, t0: Instant) {
         self.solves += computed.len();
         for (j, col) in computed {
             self.columns[j] = Some(col);
         }
         self.solve_s += t0.elapsed().as_secs_f64();
-        Ok(())
     }
 
     /// Column `j` of `S` (must have been ensured).
@@ -439,15 +483,16 @@ fn in_two_halves(
 }
 
 /// Columns `j ∈ cols` of `S = C_c L₂₂⁻ᵀ L₂₂⁻¹ C_cᵀ` from the trailing block (`rows`: the
-/// rows of `C` in trailing positions): dense triangular solves with all right-hand sides at once.
+/// rows of `C` in trailing positions; every `j ∈ cols` must be one): dense triangular solves
+/// with all right-hand sides at once. Entries in rows outside the block are left 0.
 fn trailing_columns(
     block: &synovia_fem::TrailingBlock,
-    rows: &[Vec<(usize, f64)>],
+    rows: &[Option<Vec<(usize, f64)>>],
     cols: &[usize],
 ) -> Vec<(usize, Vec<f64>)> {
     let mut rhs = faer::Mat::<f64>::zeros(block.dofs.len(), cols.len());
     for (c, &j) in cols.iter().enumerate() {
-        for &(p, v) in &rows[j] {
+        for &(p, v) in rows[j].iter().flatten() {
             rhs[(p, c)] += v;
         }
     }
@@ -456,7 +501,8 @@ fn trailing_columns(
         .enumerate()
         .map(|(c, &j)| {
             let x = rhs.col(c);
-            (j, rows.iter().map(|row| row.iter().map(|&(p, v)| v * x[p]).sum()).collect())
+            let col = rows.iter().map(|row| row.iter().flatten().map(|&(p, v)| v * x[p]).sum()).collect();
+            (j, col)
         })
         .collect()
 }
@@ -483,4 +529,54 @@ fn schur_columns(
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::BlockOnFoundation;
+    use synovia_fem::Ordering;
+
+    /// A trailing block that holds the dofs of all rows but those of two contact nodes: the
+    /// columns of `S` (trailing ones completed by symmetry) equal those of the whole factor.
+    #[test]
+    fn mixed_trailing_columns_match_whole_factor_columns() {
+        let owned = BlockOnFoundation { n: 12, slip_bound: Some(0.1), ..Default::default() }
+            .build::<2>()
+            .expect("problem");
+        let whole = owned.problem();
+        let m = whole.n_normal();
+        let excluded_dofs: std::collections::HashSet<usize> =
+            [0, m / 2, m, m + m / 2].iter().flat_map(|&r| whole.row(r).map(|(i, _)| i)).collect();
+        let mut last: Vec<usize> = (0..whole.n_rows())
+            .flat_map(|r| whole.row(r).map(|(i, _)| i).collect::<Vec<_>>())
+            .filter(|i| !excluded_dofs.contains(i))
+            .collect();
+        last.sort_unstable();
+        last.dedup();
+        let ordering = Ordering::Trailing { base: Box::new(Ordering::Amd), last };
+        let mut factor = CholeskySolver::analyse(&owned.matrix, &ordering).expect("analyse");
+        factor.factorize(&owned.matrix).expect("factorise");
+        let mut mixed = Interface::new(ContactProblem { factor: &factor, ..whole }).expect("interface");
+        let mut plain = Interface::new(whole).expect("interface");
+        assert!(mixed.uses_trailing_block() && !plain.uses_trailing_block());
+        let outside =
+            mixed.trailing.as_ref().map_or(0, |(_, rows)| rows.iter().filter(|r| r.is_none()).count());
+        assert_eq!(outside, 4, "two normal and two tangential rows outside the block");
+        let all: Vec<usize> = (0..whole.n_rows()).collect();
+        // trailing columns first (the outside columns are computed on the way), then the rest
+        mixed.ensure_columns(&[1, 2, m + 3]).expect("columns");
+        mixed.ensure_columns(&all).expect("columns");
+        plain.ensure_columns(&all).expect("columns");
+        let scale =
+            all.iter().filter_map(|&j| plain.column(j)).flatten().fold(0.0_f64, |a, b| a.max(b.abs()));
+        for &j in &all {
+            let (a, b) = (mixed.column(j).expect("mixed column"), plain.column(j).expect("column"));
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                assert!((x - y).abs() <= 1e-12 * scale, "S[{i}, {j}]: {x} vs {y}");
+            }
+        }
+        let dw = mixed.w().iter().zip(plain.w()).fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(dw <= 1e-12 * crate::kkt::inf_norm(plain.w()));
+    }
 }

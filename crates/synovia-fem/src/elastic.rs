@@ -36,9 +36,10 @@ pub struct ElasticParams {
     /// Quadrature degree of the load integrals (default: 2).
     pub load_degree: usize,
     /// Largest number of contact-interface dofs that [`ElasticSolver::new_for_contact`] orders
-    /// last (default 8000; 0 switches the condensed interface off). The trailing block is dense:
-    /// `k²` entries (512 MB at 8000) and `k³/3` flops in the factorisation; measured in
-    /// `docs/performance.md`.
+    /// last (default 8000; 0 switches the condensed interface off). An interface with more dofs
+    /// is cut to its longest prefix of nodes (in the given priority order) that fits. The
+    /// trailing block is dense: `k²` entries (512 MB at 8000) and `k³/3` flops in the
+    /// factorisation; measured in `docs/performance.md`.
     pub max_trailing_dofs: usize,
 }
 
@@ -129,11 +130,14 @@ impl<const D: usize> ElasticSolver<D> {
     }
 
     /// The factorisation for contact problems: like [`ElasticSolver::new_semi_coercive`], and
-    /// the reduced dofs of the `interface` nodes (the nodes of the contact parts) are ordered
-    /// last ([`Ordering::Trailing`]) when there are at most [`ElasticParams::max_trailing_dofs`] of them,
-    /// so that the interface Schur complement `S = C A⁻¹ Cᵀ` is evaluated with the dense
-    /// trailing block `L₂₂` of the factor, `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4), instead of
-    /// solves with the whole factor ([`CholeskySolver::trailing`]).
+    /// the reduced dofs of the `interface` nodes (the nodes of the contact parts, in priority
+    /// order) are ordered last ([`Ordering::Trailing`]), so that the interface Schur complement
+    /// `S = C A⁻¹ Cᵀ` is evaluated with the dense trailing block `L₂₂` of the factor,
+    /// `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4), instead of solves with the whole factor
+    /// ([`CholeskySolver::trailing`]). When the interface has more than
+    /// [`ElasticParams::max_trailing_dofs`] dofs, only the longest prefix of `interface` whose
+    /// dofs fit is ordered last (the contact solve then screens its rows, see
+    /// `synovia_contact::StaticContact`).
     pub fn new_for_contact(
         model: &Model<D>,
         params: ElasticParams,
@@ -177,6 +181,7 @@ impl<const D: usize> ElasticSolver<D> {
         if !interface.is_empty() {
             let mut last = Vec::new();
             let mut seen = vec![false; dofs.groups().len()];
+            let mut full = false;
             for &(b, i) in interface {
                 let n_nodes = model.body(b)?.mesh.n_nodes();
                 if i >= n_nodes {
@@ -186,12 +191,19 @@ impl<const D: usize> ElasticSolver<D> {
                     )));
                 }
                 let g = dofs.group_of(b, i);
-                if !std::mem::replace(&mut seen[g], true) {
-                    let grp = &dofs.groups()[g];
-                    last.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
+                if full || seen[g] {
+                    continue;
                 }
+                let grp = &dofs.groups()[g];
+                if last.len() + grp.n_dofs > params.max_trailing_dofs {
+                    // the longest prefix that fits
+                    full = true;
+                    continue;
+                }
+                seen[g] = true;
+                last.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
             }
-            if !last.is_empty() && last.len() <= params.max_trailing_dofs && last.len() < dofs.n_dofs() {
+            if !last.is_empty() && last.len() < dofs.n_dofs() {
                 ordering = Ordering::Trailing { base: Box::new(ordering), last };
             }
         }
