@@ -28,6 +28,12 @@
 //! cargo run --release --example bench_report 1 hertz2d_tresca resolve_new_loads
 //! ```
 //!
+//! The contact cases also print `normal_active` (rows in contact after the normal solve) and
+//! `trailing_dofs` (dofs in the dense trailing block of the factor). The environment variables
+//! `SYNOVIA_TRAILING_DOFS` and `SYNOVIA_SCREENED_DOFS` override
+//! `ElasticParams::max_trailing_dofs` and `ElasticParams::screened_trailing_dofs` (to measure
+//! the budgets of the trailing block).
+//!
 //! Results on the project's 2-core machine are in `docs/performance.md`.
 
 use std::time::Instant;
@@ -74,8 +80,13 @@ fn normal_tresca<const D: usize>(
     let elastic_s = elastic_time(model)?;
     let t_setup = Instant::now();
     let mut params = ElasticParams::default();
-    if let Some(k) = std::env::var("SYNOVIA_TRAILING_DOFS").ok().and_then(|v| v.parse().ok()) {
+    // overrides for measuring the trailing-block budgets
+    let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse().ok());
+    if let Some(k) = env("SYNOVIA_TRAILING_DOFS") {
         params.max_trailing_dofs = k;
+    }
+    if let Some(k) = env("SYNOVIA_SCREENED_DOFS") {
+        params.screened_trailing_dofs = k;
     }
     let sc = StaticContact::new(model, pairs, params)?;
     let setup_s = t_setup.elapsed().as_secs_f64();

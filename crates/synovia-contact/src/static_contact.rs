@@ -17,6 +17,14 @@ use crate::rows::SparseRows;
 use crate::solver::{ContactSolution, ContactSolver, SolverReport};
 
 /// A factorised model with its contact geometry.
+///
+/// The dofs of the contact interface are ordered last in the factorisation (a dense trailing
+/// block for the interface Schur complement, see [`ElasticSolver::new_for_contact`]). An
+/// interface with more than [`ElasticParams::max_trailing_dofs`] dofs keeps only the contact
+/// nodes of smallest initial gap (with their partner and master nodes) in the block, up to
+/// [`ElasticParams::screened_trailing_dofs`]; each solve then screens the contact rows: it
+/// solves on the rows in the block, checks the others with the computed displacement and adds
+/// those that penetrate until none does, so the result is the one of the full problem.
 #[derive(Debug)]
 pub struct StaticContact<const D: usize> {
     elastic: ElasticSolver<D>,
@@ -194,7 +202,8 @@ impl<const D: usize> StaticContact<D> {
     /// returns the solution with the iterations spent on coarse levels.
     ///
     /// Row screening: when the factor's trailing block holds the dofs of only some normal
-    /// rows ([`ElasticParams::max_trailing_dofs`] smaller than the interface), the solver runs
+    /// rows (an interface larger than [`ElasticParams::max_trailing_dofs`], of which the
+    /// [`ElasticParams::screened_trailing_dofs`] of the smallest gaps are ordered last), the solver runs
     /// on the sub-problem of those *candidate* rows (plus the rows of friction cells and the
     /// rows loaded in the warm start), whose interface Schur complement comes from the dense
     /// trailing block. The excluded rows are then checked with the computed `U`: if none
