@@ -75,10 +75,18 @@ pub struct ContactProblem<'a> {
 /// `A` and `C` (only `F` and the gaps change). An [`Interface`] takes the columns when the
 /// rows of `C` are identical to those they were computed for (compared by a fingerprint of
 /// `C`'s entries) and hands them back, with any new ones, when it is dropped.
+///
+/// It also keeps the load solve `A⁻¹ F` of the last load (keyed by `F` and the factor), which
+/// every [`Interface`] of the same `A` and `F` shares, also through the caches made by
+/// [`SchurCache::sharing_load_solve`] (e.g. for the coarse levels of the nested iteration).
 #[derive(Debug, Default)]
 pub struct SchurCache {
     inner: std::sync::Mutex<Option<(u64, ColumnStore)>>,
+    load: SharedLoadSolve,
 }
+
+/// `A⁻¹ F` with the fingerprint of `F` and the factor, shared between caches.
+type SharedLoadSolve = std::sync::Arc<std::sync::Mutex<Option<(u64, std::sync::Arc<Vec<f64>>)>>>;
 
 /// Columns of `S` by row index (`None`: not computed).
 type ColumnStore = Vec<Option<Vec<f64>>>;
@@ -88,9 +96,24 @@ impl SchurCache {
     pub fn new() -> Self {
         Self::default()
     }
-    /// Forgets every column (e.g. after the geometry or `A` changed).
+    /// Forgets every column and the load solve (e.g. after the geometry or `A` changed).
     pub fn clear(&self) {
         *self.inner.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        *self.load.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    }
+    /// An empty cache for problems with other rows that shares the load solve `A⁻¹ F` with
+    /// `self` (computed once for all of them).
+    pub fn sharing_load_solve(&self) -> Self {
+        Self { inner: Default::default(), load: self.load.clone() }
+    }
+    fn load_solve(&self, key: u64) -> Option<std::sync::Arc<Vec<f64>>> {
+        match &*self.load.lock().unwrap_or_else(|e| e.into_inner()) {
+            Some((k, x)) if *k == key => Some(x.clone()),
+            _ => None,
+        }
+    }
+    fn put_load_solve(&self, key: u64, x: std::sync::Arc<Vec<f64>>) {
+        *self.load.lock().unwrap_or_else(|e| e.into_inner()) = Some((key, x));
     }
     /// Number of columns held.
     pub fn len(&self) -> usize {
@@ -130,6 +153,19 @@ impl<'a> ContactProblem<'a> {
                 v.to_bits().hash(&mut h);
             }
             usize::MAX.hash(&mut h);
+        }
+        h.finish()
+    }
+
+    /// A fingerprint of `F`, the size of `A` and its factorisation (for the load solve kept
+    /// in a [`SchurCache`]).
+    fn load_fingerprint(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        self.matrix.n().hash(&mut h);
+        (self.factor as *const CholeskySolver as usize).hash(&mut h);
+        for f in self.load {
+            f.to_bits().hash(&mut h);
         }
         h.finish()
     }
@@ -294,12 +330,24 @@ impl Drop for Interface<'_> {
 type TrailingRows = Vec<Option<Vec<(usize, f64)>>>;
 
 impl<'a> Interface<'a> {
-    /// Validates the problem and computes `w = C A⁻¹ F` (one solve).
+    /// Validates the problem and computes `w = C A⁻¹ F` (one solve, unless the problem's
+    /// [`SchurCache`] holds `A⁻¹ F` for the same `F` and factor).
     pub fn new(problem: ContactProblem<'a>) -> Result<Self, ContactError> {
         problem.validate()?;
         let t0 = Instant::now();
-        let mut x = problem.load.to_vec();
-        problem.factor.solve_in_place(&mut x)?;
+        let load_key = problem.schur_cache.map(|c| (c, problem.load_fingerprint()));
+        let (x, solves) = match load_key.and_then(|(c, k)| c.load_solve(k)) {
+            Some(x) => (x, 0),
+            None => {
+                let mut x = problem.load.to_vec();
+                problem.factor.solve_in_place(&mut x)?;
+                let x = std::sync::Arc::new(x);
+                if let Some((c, k)) = load_key {
+                    c.put_load_solve(k, x.clone());
+                }
+                (x, 1)
+            }
+        };
         let w = problem.apply(&x);
         let m = problem.n_rows();
         let trailing = problem.factor.trailing().and_then(|block| {
@@ -322,7 +370,7 @@ impl<'a> Interface<'a> {
             Some((c, f)) => c.take(f, m),
             None => vec![None; m],
         };
-        Ok(Self { problem, w, columns, solves: 1, solve_s: t0.elapsed().as_secs_f64(), trailing, cache })
+        Ok(Self { problem, w, columns, solves, solve_s: t0.elapsed().as_secs_f64(), trailing, cache })
     }
 
     /// `true` if the columns of `S` come from the trailing block of the factor.
