@@ -10,13 +10,15 @@ use synovia::fem::{ElasticParams, Model};
 use synovia::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 use synovia::solvers::by_name;
 
-/// The frictionless solve at `t = 0` and the Tresca solve at `t = shift` with the slip bounds
-/// `slip_bound` and the previous displacements `previous` (both from the reference when given,
-/// so that both runs have the same friction cells).
+/// The frictionless solve at `t = 0`, the Tresca solve at `t = shift` with the slip bounds
+/// of the normal solve and slip measured from its displacements (both from the reference when
+/// given, so that both runs have the same friction cells), and a warm-started re-solve.
 struct Run<const D: usize> {
     sc: StaticContact<D>,
     normal: StaticContactResult<D>,
     tresca: StaticContactResult<D>,
+    /// The Tresca solve again at `t = 1.5 shift`, warm-started from `tresca`.
+    resolve: StaticContactResult<D>,
 }
 
 fn run<const D: usize>(
@@ -35,7 +37,17 @@ fn run<const D: usize>(
     let tresca = sc
         .solve(model, shift, solver.as_ref(), Some(&gc), Some(&base.displacement), None)
         .expect("Tresca solve");
-    Run { sc, normal, tresca }
+    let resolve = sc
+        .solve(
+            model,
+            1.5 * shift,
+            solver.as_ref(),
+            Some(&gc),
+            Some(&base.displacement),
+            Some(&tresca.solution),
+        )
+        .expect("warm re-solve");
+    Run { sc, normal, tresca, resolve }
 }
 
 /// For each contact row: are all its dofs (node, partner, master nodes) in the trailing block?
@@ -70,14 +82,27 @@ fn relative_difference(a: &[f64], b: &[f64]) -> f64 {
 /// Compares a screened run with the reference: `U`, `Λ_n` (one per contact node), `Λ_t`, and
 /// the KKT residuals of the full problem.
 fn assert_matches<const D: usize>(screened: &Run<D>, reference: &Run<D>) {
-    for (s, r, what) in
-        [(&screened.normal, &reference.normal, "normal"), (&screened.tresca, &reference.tresca, "Tresca")]
-    {
+    for (s, r, what) in [
+        (&screened.normal, &reference.normal, "normal"),
+        (&screened.tresca, &reference.tresca, "Tresca"),
+        (&screened.resolve, &reference.resolve, "re-solve"),
+    ] {
         assert_eq!(s.solution.lambda_n.len(), reference.sc.geometry().len(), "{what}: one Λ_n per node");
         let du = relative_difference(&s.solution.u, &r.solution.u);
         let dl = relative_difference(&s.solution.lambda_n, &r.solution.lambda_n);
-        let dt = relative_difference(&s.solution.lambda_t, &r.solution.lambda_t);
-        println!("{what}: ΔU {du:.2e}, ΔΛ_n {dl:.2e}, ΔΛ_t {dt:.2e}, KKT {:.2e}", s.kkt.max());
+        // Λ_t is dimensionless with ‖Λ_t‖ ≤ 1: compared absolutely (it is ≈ 0 without slip)
+        assert_eq!(s.solution.lambda_t.len(), r.solution.lambda_t.len());
+        let dt = s
+            .solution
+            .lambda_t
+            .iter()
+            .zip(&r.solution.lambda_t)
+            .fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+        println!(
+            "{what}: ΔU {du:.2e}, ΔΛ_n {dl:.2e}, ΔΛ_t {dt:.2e}, KKT {:.2e}, max Λ_t {:.2e}",
+            s.kkt.max(),
+            max_abs(&r.solution.lambda_t)
+        );
         assert!(du < 1e-9, "{what}: U differs by {du:e}");
         assert!(dl < 1e-9, "{what}: Λ_n differs by {dl:e}");
         assert!(dt < 1e-9, "{what}: Λ_t differs by {dt:e}");
@@ -185,5 +210,27 @@ fn two_body_screening_that_covers_the_contact_zone_is_exact() {
     for r in in_contact(&reference.normal) {
         assert!(inside[r], "row {r} in contact lies outside the trailing block");
     }
+    assert_matches(&screened, &reference);
+}
+
+/// A floating block (no Dirichlet data: proximal-point iteration) pressed onto a rigid flat:
+/// every bottom row comes into contact, the block holds two of them.
+#[test]
+fn semi_coercive_screening_adds_rows_that_come_into_contact() {
+    use synovia::prelude::*;
+    let mesh = rectangle(0.0, 1.0, 0.0, 0.5, 12, 6, Grading::Uniform, Grading::Uniform).expect("mesh");
+    let mut joint = JointModel::<2>::new();
+    let block = joint.add_body("floating", mesh, plane_strain(1.0, 0.3).expect("material")).expect("body");
+    joint.traction(block, "top", Vector::<2>::new(0.0, -0.01), Constant(1.0)).expect("traction");
+    let flat = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0)).expect("plane");
+    joint.contact_rigid("block-flat", block, "bottom", flat, 0.3).expect("pair");
+    let (model, pairs) = (joint.model(), joint.pairs());
+    let (reference, screened, inside) = screened_against_reference(model, pairs, 0.0, |_| 4);
+    let added = in_contact(&screened.normal).into_iter().filter(|&r| !inside[r]).count();
+    println!(
+        "{added} rows in contact outside the block, proximal iterations {}",
+        screened.normal.proximal_iterations
+    );
+    assert!(added > 0 && screened.normal.proximal_iterations >= 1);
     assert_matches(&screened, &reference);
 }
