@@ -28,8 +28,9 @@
 //! cargo run --release --example bench_report 1 hertz2d_tresca resolve_new_loads
 //! ```
 //!
-//! The contact cases also print `normal_active` (rows in contact after the normal solve) and
-//! `trailing_dofs` (dofs in the dense trailing block of the factor). The environment variables
+//! The contact cases also print `normal_active` (rows in contact after the normal solve),
+//! `trailing_dofs` (dofs in the dense trailing block of the factor) and the symbolic and
+//! numeric times and size of the contact set-up's factorisation. The environment variables
 //! `SYNOVIA_TRAILING_DOFS` and `SYNOVIA_SCREENED_DOFS` override
 //! `ElasticParams::max_trailing_dofs` and `ElasticParams::screened_trailing_dofs` (to measure
 //! the budgets of the trailing block).
@@ -109,6 +110,9 @@ fn normal_tresca<const D: usize>(
         "normal_iterations": normal.solution.report.iterations,
         "normal_active": normal.solution.report.active,
         "trailing_dofs": sc.elastic().cholesky().trailing().map_or(0, |b| b.dofs.len()),
+        "contact_symbolic_s": sc.elastic().info().symbolic_s,
+        "contact_numeric_s": sc.elastic().info().numeric_s,
+        "contact_factor_nnz": sc.elastic().info().factor_nnz,
         "tresca_iterations": tresca.solution.report.iterations,
         "kkt": tresca.kkt.max().max(normal.kkt.max()),
         // everything from the model: contact set-up (factorisation with the interface ordered
