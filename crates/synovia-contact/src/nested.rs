@@ -121,8 +121,9 @@ pub fn nested_warm_start(
         return Ok(None);
     }
     // solve from the coarsest level up to level 1; interpolate to the next finer level. The
-    // levels share the load solve A⁻¹ F with the problem's cache (not its columns: other rows).
-    let shared = problem.schur_cache.map(|c| c.sharing_load_solve());
+    // levels share the load solve A⁻¹ F and the trailing solves of their rows with the problem's
+    // cache (not its columns: other rows).
+    let shared = problem.schur_cache.map(|c| c.sharing_solves());
     let mut coarse_iterations = 0;
     let mut warm: Option<Vec<f64>> = None; // Λ_n on the current level's rows
     for lvl in (1..levels.len()).rev() {

@@ -76,17 +76,33 @@ pub struct ContactProblem<'a> {
 /// rows of `C` are identical to those they were computed for (compared by a fingerprint of
 /// `C`'s entries) and hands them back, with any new ones, when it is dropped.
 ///
-/// It also keeps the load solve `A⁻¹ F` of the last load (keyed by `F` and the factor), which
-/// every [`Interface`] of the same `A` and `F` shares, also through the caches made by
-/// [`SchurCache::sharing_load_solve`] (e.g. for the coarse levels of the nested iteration).
+/// It also keeps the load solve `A⁻¹ F` of the last load (keyed by `F` and the factor) and the
+/// trailing-block solves `L₂₂⁻ᵀ L₂₂⁻¹ c` of the rows `c` of `C` that live on the trailing dofs
+/// (keyed by the row's entries and the block; up to [`MAX_KEPT_SOLVE_ENTRIES`] entries), which
+/// every [`Interface`] shares, also through the caches made by [`SchurCache::sharing_solves`]:
+/// the coarse levels of the nested iteration, the frictionless and the Tresca solve, and the
+/// passes of a screened solve all have rows in common.
 #[derive(Debug, Default)]
 pub struct SchurCache {
     inner: std::sync::Mutex<Option<(u64, ColumnStore)>>,
     load: SharedLoadSolve,
+    solves: std::sync::Arc<std::sync::Mutex<TrailingSolves>>,
 }
 
 /// `A⁻¹ F` with the fingerprint of `F` and the factor, shared between caches.
 type SharedLoadSolve = std::sync::Arc<std::sync::Mutex<Option<(u64, std::sync::Arc<Vec<f64>>)>>>;
+
+/// Trailing-block solves by row fingerprint, for one trailing block (its address).
+#[derive(Debug, Default)]
+struct TrailingSolves {
+    block: usize,
+    solves: std::collections::HashMap<u64, std::sync::Arc<Vec<f64>>>,
+    entries: usize,
+}
+
+/// Largest number of entries of trailing-block solves a [`SchurCache`] keeps (512 MB); the
+/// store is emptied when a new solve would exceed it.
+pub const MAX_KEPT_SOLVE_ENTRIES: usize = 1 << 26;
 
 /// Columns of `S` by row index (`None`: not computed).
 type ColumnStore = Vec<Option<Vec<f64>>>;
@@ -96,15 +112,32 @@ impl SchurCache {
     pub fn new() -> Self {
         Self::default()
     }
-    /// Forgets every column and the load solve (e.g. after the geometry or `A` changed).
+    /// Forgets every column, the load solve and the trailing-block solves (e.g. after the
+    /// geometry or `A` changed).
     pub fn clear(&self) {
         *self.inner.lock().unwrap_or_else(|e| e.into_inner()) = None;
         *self.load.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        *self.solves.lock().unwrap_or_else(|e| e.into_inner()) = TrailingSolves::default();
     }
-    /// An empty cache for problems with other rows that shares the load solve `A⁻¹ F` with
-    /// `self` (computed once for all of them).
-    pub fn sharing_load_solve(&self) -> Self {
-        Self { inner: Default::default(), load: self.load.clone() }
+    /// An empty cache for problems with other rows that shares the load solve `A⁻¹ F` and the
+    /// trailing-block solves of rows with `self` (computed once for all of them).
+    pub fn sharing_solves(&self) -> Self {
+        Self { inner: Default::default(), load: self.load.clone(), solves: self.solves.clone() }
+    }
+    fn trailing_solve(&self, block: usize, key: u64) -> Option<std::sync::Arc<Vec<f64>>> {
+        let store = self.solves.lock().unwrap_or_else(|e| e.into_inner());
+        if store.block != block {
+            return None;
+        }
+        store.solves.get(&key).cloned()
+    }
+    fn put_trailing_solve(&self, block: usize, key: u64, x: std::sync::Arc<Vec<f64>>) {
+        let mut store = self.solves.lock().unwrap_or_else(|e| e.into_inner());
+        if store.block != block || store.entries + x.len() > MAX_KEPT_SOLVE_ENTRIES {
+            *store = TrailingSolves { block, ..Default::default() };
+        }
+        store.entries += x.len();
+        store.solves.insert(key, x);
     }
     fn load_solve(&self, key: u64) -> Option<std::sync::Arc<Vec<f64>>> {
         match &*self.load.lock().unwrap_or_else(|e| e.into_inner()) {
@@ -445,17 +478,39 @@ impl<'a> Interface<'a> {
         }
         if !inside.is_empty() {
             let t0 = Instant::now();
-            let mut computed = in_two_halves(&inside, block.dofs.len() >= 256, |cols| {
-                Ok(trailing_columns(block, rows, cols))
+            // trailing solves kept in the cache (rows shared with earlier interfaces), the others
+            let cache = self.cache.map(|(c, _)| c);
+            let block_id = block_fingerprint(block);
+            let keys: Vec<u64> = inside.iter().map(|&j| row_fingerprint(rows[j].as_deref())).collect();
+            let mut solves: Vec<Option<std::sync::Arc<Vec<f64>>>> =
+                keys.iter().map(|&key| cache.and_then(|c| c.trailing_solve(block_id, key))).collect();
+            let todo: Vec<usize> = (0..inside.len()).filter(|&a| solves[a].is_none()).collect();
+            let todo_rows: Vec<usize> = todo.iter().map(|&a| inside[a]).collect();
+            let solved = in_two_halves(&todo_rows, block.dofs.len() >= 256, |cols| {
+                Ok(trailing_solves(block, rows, cols))
             })?;
-            for (j, col) in &mut computed {
-                for (i, entry) in col.iter_mut().enumerate() {
-                    if rows[i].is_none() {
-                        *entry = self.columns[i].as_ref().map_or(0.0, |c| c[*j]);
-                    }
+            for (&a, (_, x)) in todo.iter().zip(solved) {
+                let x = std::sync::Arc::new(x);
+                if let Some(c) = cache {
+                    c.put_trailing_solve(block_id, keys[a], x.clone());
                 }
+                solves[a] = Some(x);
             }
-            self.store(computed, t0);
+            for (&j, x) in inside.iter().zip(&solves) {
+                let Some(x) = x else { continue };
+                let col = rows
+                    .iter()
+                    .enumerate()
+                    .map(|(i, row)| match row {
+                        Some(row) => row.iter().map(|&(p, v)| v * x[p]).sum(),
+                        // outside the block: S_ij = S_ji from the whole-factor column i
+                        None => self.columns[i].as_ref().map_or(0.0, |c| c[j]),
+                    })
+                    .collect();
+                self.columns[j] = Some(col);
+            }
+            self.solves += todo.len();
+            self.solve_s += t0.elapsed().as_secs_f64();
         }
         Ok(())
     }
@@ -530,10 +585,11 @@ fn in_two_halves(
     Ok(ra)
 }
 
-/// Columns `j ∈ cols` of `S = C_c L₂₂⁻ᵀ L₂₂⁻¹ C_cᵀ` from the trailing block (`rows`: the
-/// rows of `C` in trailing positions; every `j ∈ cols` must be one): dense triangular solves
-/// with all right-hand sides at once. Entries in rows outside the block are left 0.
-fn trailing_columns(
+/// The trailing-block solves `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` (in trailing positions) of the rows
+/// `j ∈ cols` (`rows`: the rows of `C` in trailing positions; every `j ∈ cols` must be one):
+/// dense triangular solves with all right-hand sides at once. `S_ij = c_i · x_j` for the rows
+/// `i` in the block.
+fn trailing_solves(
     block: &synovia_fem::TrailingBlock,
     rows: &[Option<Vec<(usize, f64)>>],
     cols: &[usize],
@@ -545,14 +601,32 @@ fn trailing_columns(
         }
     }
     block.solve_in_place(rhs.as_mut());
-    cols.iter()
-        .enumerate()
-        .map(|(c, &j)| {
-            let x = rhs.col(c);
-            let col = rows.iter().map(|row| row.iter().flatten().map(|&(p, v)| v * x[p]).sum()).collect();
-            (j, col)
-        })
-        .collect()
+    cols.iter().enumerate().map(|(c, &j)| (j, rhs.col(c).iter().copied().collect())).collect()
+}
+
+/// A fingerprint of a trailing block: its address, size and corner entries.
+fn block_fingerprint(block: &synovia_fem::TrailingBlock) -> usize {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (block as *const synovia_fem::TrailingBlock as usize).hash(&mut h);
+    let k = block.dofs.len();
+    k.hash(&mut h);
+    if k > 0 {
+        block.factor[(0, 0)].to_bits().hash(&mut h);
+        block.factor[(k - 1, k - 1)].to_bits().hash(&mut h);
+    }
+    h.finish() as usize
+}
+
+/// A fingerprint of a row in trailing positions (for the trailing solves of [`SchurCache`]).
+fn row_fingerprint(row: Option<&[(usize, f64)]>) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for &(p, v) in row.into_iter().flatten() {
+        p.hash(&mut h);
+        v.to_bits().hash(&mut h);
+    }
+    h.finish()
 }
 
 /// Columns `j ∈ cols` of `S = C A⁻¹ Cᵀ`: batched solves, 32 right-hand sides at a time.
@@ -626,5 +700,30 @@ mod tests {
         }
         let dw = mixed.w().iter().zip(plain.w()).fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
         assert!(dw <= 1e-12 * crate::kkt::inf_norm(plain.w()));
+
+        // the same through a cache whose trailing solves come from an earlier interface with
+        // other rows (the normal rows only): the shared solves give the same columns
+        let cache = SchurCache::new();
+        let normal_only =
+            ContactProblem { factor: &factor, friction: None, schur_cache: Some(&cache), ..whole };
+        let mut first = Interface::new(normal_only).expect("interface");
+        first.ensure_columns(&(0..m).collect::<Vec<_>>()).expect("columns");
+        let first_solves = first.solves();
+        drop(first);
+        let shared = cache.sharing_solves();
+        let mut cached =
+            Interface::new(ContactProblem { factor: &factor, schur_cache: Some(&shared), ..whole })
+                .expect("interface");
+        assert_eq!(cached.solves(), 0, "the load solve is shared");
+        cached.ensure_columns(&all).expect("columns");
+        // the normal rows in the block were solved before: only the tangential rows and the
+        // rows outside the block cost solves now
+        assert!(cached.solves() < whole.n_rows() && first_solves > 0, "{} solves", cached.solves());
+        for &j in &all {
+            let (a, b) = (cached.column(j).expect("cached column"), plain.column(j).expect("column"));
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                assert!((x - y).abs() <= 1e-12 * scale, "cached S[{i}, {j}]: {x} vs {y}");
+            }
+        }
     }
 }
