@@ -31,6 +31,13 @@
 //! cargo run --release --example bench_report 1 hertz2d_tresca resolve_new_loads
 //! ```
 //!
+//! The contact cases also print `normal_active` (rows in contact after the normal solve),
+//! `trailing_dofs` (dofs in the dense trailing block of the factor) and the symbolic and
+//! numeric times and size of the contact set-up's factorisation. The environment variables
+//! `SYNOVIA_TRAILING_DOFS` and `SYNOVIA_SCREENED_DOFS` override
+//! `ElasticParams::max_trailing_dofs` and `ElasticParams::screened_trailing_dofs` (to measure
+//! the budgets of the trailing block).
+//!
 //! Results on the project's 2-core machine are in `docs/performance.md`.
 
 use std::time::Instant;
@@ -86,7 +93,16 @@ fn normal_tresca<const D: usize>(
     let solver = synovia::solvers::by_name("pdas")?;
     let (elastic_s, elastic_runs) = elastic_time(model)?;
     let t_setup = Instant::now();
-    let sc = StaticContact::new(model, pairs, ElasticParams::default())?;
+    let mut params = ElasticParams::default();
+    // overrides for measuring the trailing-block budgets
+    let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse().ok());
+    if let Some(k) = env("SYNOVIA_TRAILING_DOFS") {
+        params.max_trailing_dofs = k;
+    }
+    if let Some(k) = env("SYNOVIA_SCREENED_DOFS") {
+        params.screened_trailing_dofs = k;
+    }
+    let sc = StaticContact::new(model, pairs, params)?;
     let setup_s = t_setup.elapsed().as_secs_f64();
     let geo = sc.geometry();
     let t0 = Instant::now();
@@ -106,6 +122,11 @@ fn normal_tresca<const D: usize>(
         "normal_s": normal_s,
         "tresca_s": tresca_s,
         "normal_iterations": normal.solution.report.iterations,
+        "normal_active": normal.solution.report.active,
+        "trailing_dofs": sc.elastic().cholesky().trailing().map_or(0, |b| b.dofs.len()),
+        "contact_symbolic_s": sc.elastic().info().symbolic_s,
+        "contact_numeric_s": sc.elastic().info().numeric_s,
+        "contact_factor_nnz": sc.elastic().info().factor_nnz,
         "tresca_iterations": tresca.solution.report.iterations,
         "kkt": tresca.kkt.max().max(normal.kkt.max()),
         // everything from the model: contact set-up (factorisation with the interface ordered

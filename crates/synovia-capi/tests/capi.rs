@@ -167,7 +167,7 @@ fn arrays_model_matches_joint_model_over_quasistatic_steps() {
 
 #[test]
 fn changing_values_does_not_need_a_new_model() {
-    // the same load solved twice through value changes gives the same answer
+    // the same load solved twice through value changes gives the same answer (to rounding)
     let m = punch_model();
     ok(syn_model_solve_static(m, 0.0));
     let f0 = force(m, 0);
@@ -178,7 +178,8 @@ fn changing_values_does_not_need_a_new_model() {
     let v = common::STEPS[0].1;
     ok(unsafe { syn_model_set_displacement(m, common::TAG_TOP, v.as_ptr(), 2) });
     ok(syn_model_solve_static(m, 0.0));
-    assert_eq!(force(m, 0), f0);
+    // to rounding: A⁻¹F of the repeated load is recycled from the solved loads
+    assert!(rel(force(m, 0), f0) < 1e-12, "{} vs {f0}", force(m, 0));
     // steps must move forward in time
     assert_eq!(syn_model_solve_step(m, 0.0), SynStatus::InvalidArgument);
     assert!(last_error().contains("later"), "{}", last_error());

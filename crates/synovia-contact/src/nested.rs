@@ -120,7 +120,10 @@ pub fn nested_warm_start(
     if levels.len() < 2 {
         return Ok(None);
     }
-    // solve from the coarsest level up to level 1; interpolate to the next finer level
+    // solve from the coarsest level up to level 1; interpolate to the next finer level. The
+    // levels share the load solve A⁻¹ F and the trailing solves of their rows with the problem's
+    // cache (not its columns: other rows).
+    let shared = problem.schur_cache.map(|c| c.sharing_solves());
     let mut coarse_iterations = 0;
     let mut warm: Option<Vec<f64>> = None; // Λ_n on the current level's rows
     for lvl in (1..levels.len()).rev() {
@@ -145,7 +148,8 @@ pub fn nested_warm_start(
             gap.push(problem.normal.gap[r]);
         }
         let normal = NormalConstraints { rows, weights: weight, gap };
-        let sub = ContactProblem { normal: &normal, friction: None, schur_cache: None, ..*problem };
+        let sub =
+            ContactProblem { normal: &normal, friction: None, schur_cache: shared.as_ref(), ..*problem };
         let ws = warm.take().map(|ln| ContactSolution {
             u: Vec::new(),
             lambda_n: ln,

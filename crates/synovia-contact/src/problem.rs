@@ -83,10 +83,34 @@ pub struct ContactProblem<'a> {
 /// `A` and `C` (only `F` and the gaps change). An [`Interface`] takes the columns when the
 /// rows of `C` are identical to those they were computed for (compared by a fingerprint of
 /// `C`'s entries) and hands them back, with any new ones, when it is dropped.
+///
+/// It also keeps the load solve `A⁻¹ F` of the last load (keyed by `F` and the factor) and the
+/// trailing-block solves `L₂₂⁻ᵀ L₂₂⁻¹ c` of the rows `c` of `C` that live on the trailing dofs
+/// (keyed by the row's entries and the block; up to [`MAX_KEPT_SOLVE_ENTRIES`] entries), which
+/// every [`Interface`] shares, also through the caches made by [`SchurCache::sharing_solves`]:
+/// the coarse levels of the nested iteration, the frictionless and the Tresca solve, and the
+/// passes of a screened solve all have rows in common.
 #[derive(Debug, Default)]
 pub struct SchurCache {
     inner: std::sync::Mutex<Option<(u64, ColumnStore)>>,
+    load: SharedLoadSolve,
+    solves: std::sync::Arc<std::sync::Mutex<TrailingSolves>>,
 }
+
+/// `A⁻¹ F` with the fingerprint of `F` and the factor, shared between caches.
+type SharedLoadSolve = std::sync::Arc<std::sync::Mutex<Option<(u64, std::sync::Arc<Vec<f64>>)>>>;
+
+/// Trailing-block solves by row fingerprint, for one trailing block (its address).
+#[derive(Debug, Default)]
+struct TrailingSolves {
+    block: usize,
+    solves: std::collections::HashMap<u64, std::sync::Arc<Vec<f64>>>,
+    entries: usize,
+}
+
+/// Largest number of entries of trailing-block solves a [`SchurCache`] keeps (512 MB); the
+/// store is emptied when a new solve would exceed it.
+pub const MAX_KEPT_SOLVE_ENTRIES: usize = 1 << 26;
 
 /// Columns of `S` by row index (`None`: not computed).
 type ColumnStore = Vec<Option<Vec<f64>>>;
@@ -96,9 +120,41 @@ impl SchurCache {
     pub fn new() -> Self {
         Self::default()
     }
-    /// Forgets every column (e.g. after the geometry or `A` changed).
+    /// Forgets every column, the load solve and the trailing-block solves (e.g. after the
+    /// geometry or `A` changed).
     pub fn clear(&self) {
         *self.inner.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        *self.load.lock().unwrap_or_else(|e| e.into_inner()) = None;
+        *self.solves.lock().unwrap_or_else(|e| e.into_inner()) = TrailingSolves::default();
+    }
+    /// An empty cache for problems with other rows that shares the load solve `A⁻¹ F` and the
+    /// trailing-block solves of rows with `self` (computed once for all of them).
+    pub fn sharing_solves(&self) -> Self {
+        Self { inner: Default::default(), load: self.load.clone(), solves: self.solves.clone() }
+    }
+    fn trailing_solve(&self, block: usize, key: u64) -> Option<std::sync::Arc<Vec<f64>>> {
+        let store = self.solves.lock().unwrap_or_else(|e| e.into_inner());
+        if store.block != block {
+            return None;
+        }
+        store.solves.get(&key).cloned()
+    }
+    fn put_trailing_solve(&self, block: usize, key: u64, x: std::sync::Arc<Vec<f64>>) {
+        let mut store = self.solves.lock().unwrap_or_else(|e| e.into_inner());
+        if store.block != block || store.entries + x.len() > MAX_KEPT_SOLVE_ENTRIES {
+            *store = TrailingSolves { block, ..Default::default() };
+        }
+        store.entries += x.len();
+        store.solves.insert(key, x);
+    }
+    fn load_solve(&self, key: u64) -> Option<std::sync::Arc<Vec<f64>>> {
+        match &*self.load.lock().unwrap_or_else(|e| e.into_inner()) {
+            Some((k, x)) if *k == key => Some(x.clone()),
+            _ => None,
+        }
+    }
+    fn put_load_solve(&self, key: u64, x: std::sync::Arc<Vec<f64>>) {
+        *self.load.lock().unwrap_or_else(|e| e.into_inner()) = Some((key, x));
     }
     /// Number of columns held.
     pub fn len(&self) -> usize {
@@ -138,6 +194,19 @@ impl<'a> ContactProblem<'a> {
                 v.to_bits().hash(&mut h);
             }
             usize::MAX.hash(&mut h);
+        }
+        h.finish()
+    }
+
+    /// A fingerprint of `F`, the size of `A` and its factorisation (for the load solve kept
+    /// in a [`SchurCache`]).
+    fn load_fingerprint(&self) -> u64 {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        self.matrix.n().hash(&mut h);
+        (self.factor as *const CholeskySolver as usize).hash(&mut h);
+        for f in self.load {
+            f.to_bits().hash(&mut h);
         }
         h.finish()
     }
@@ -276,14 +345,16 @@ impl<'a> ContactProblem<'a> {
 pub struct Interface<'a> {
     problem: ContactProblem<'a>,
     /// `A⁻¹ F`.
-    load_solution: Vec<f64>,
+    load_solution: std::sync::Arc<Vec<f64>>,
     w: Vec<f64>,
     columns: Vec<Option<Vec<f64>>>,
     solves: usize,
     solve_s: f64,
-    /// The rows of `C` in the positions of the factor's trailing block, when every row lives
-    /// on the trailing dofs ([`synovia_fem::TrailingBlock`]): columns of `S` then cost two
-    /// dense triangular solves with `L₂₂` instead of a solve with the whole factor.
+    /// The rows of `C` in the positions of the factor's trailing block
+    /// ([`synovia_fem::TrailingBlock`]), `None` for a row with a dof outside it; kept when at
+    /// most a fifth of the rows are outside. Columns of `S` of trailing rows then cost two
+    /// dense triangular solves with `L₂₂` instead of a solve with the whole factor; their
+    /// entries in the other rows `i` are taken from the (whole-factor) columns `i` by symmetry.
     trailing: Option<(std::sync::Arc<synovia_fem::TrailingBlock>, TrailingRows)>,
     /// Where the columns go back when the interface is dropped.
     cache: Option<(&'a SchurCache, u64)>,
@@ -297,38 +368,49 @@ impl Drop for Interface<'_> {
     }
 }
 
-/// Rows of `C` as `(trailing position, value)` lists.
-type TrailingRows = Vec<Vec<(usize, f64)>>;
+/// Rows of `C` as `(trailing position, value)` lists (`None`: a row with a dof outside the
+/// trailing block).
+type TrailingRows = Vec<Option<Vec<(usize, f64)>>>;
 
 impl<'a> Interface<'a> {
-    /// Validates the problem and computes `w = C A⁻¹ F` (one solve).
+    /// Validates the problem and computes `w = C A⁻¹ F` (one solve, unless the problem's
+    /// [`SchurCache`] holds `A⁻¹ F` for the same `F` and factor).
     pub fn new(problem: ContactProblem<'a>) -> Result<Self, ContactError> {
         problem.validate()?;
         let t0 = Instant::now();
-        let (x, solves) = match problem.load_solution {
-            Some(x) if x.len() == problem.load.len() => (x.to_vec(), 0),
-            _ => {
-                let mut x = problem.load.to_vec();
-                problem.factor.solve_in_place(&mut x)?;
-                (x, 1)
-            }
+        let load_key = problem.schur_cache.map(|c| (c, problem.load_fingerprint()));
+        let given = problem.load_solution.filter(|x| x.len() == problem.load.len());
+        let (x, solves) = match given.map(|x| std::sync::Arc::new(x.to_vec())) {
+            Some(x) => (x, 0),
+            None => match load_key.and_then(|(c, k)| c.load_solve(k)) {
+                Some(x) => (x, 0),
+                None => {
+                    let mut x = problem.load.to_vec();
+                    problem.factor.solve_in_place(&mut x)?;
+                    let x = std::sync::Arc::new(x);
+                    if let Some((c, k)) = load_key {
+                        c.put_load_solve(k, x.clone());
+                    }
+                    (x, 1)
+                }
+            },
         };
         let w = problem.apply(&x);
         let m = problem.n_rows();
         let trailing = problem.factor.trailing().and_then(|block| {
-            let mut rows = Vec::with_capacity(m);
-            for r in 0..m {
-                let mut row = Vec::new();
-                for (i, v) in problem.row(r) {
-                    let p = block.position.get(i).copied().unwrap_or(usize::MAX);
-                    if p == usize::MAX {
-                        return None;
-                    }
-                    row.push((p, v));
-                }
-                rows.push(row);
-            }
-            Some((block.clone(), rows))
+            let rows: TrailingRows = (0..m)
+                .map(|r| {
+                    problem
+                        .row(r)
+                        .map(|(i, v)| match block.position.get(i).copied() {
+                            Some(p) if p != usize::MAX => Some((p, v)),
+                            _ => None,
+                        })
+                        .collect::<Option<Vec<_>>>()
+                })
+                .collect();
+            let outside = rows.iter().filter(|r| r.is_none()).count();
+            (outside * 5 <= m && outside < m).then(|| (block.clone(), rows))
         });
         let cache = problem.schur_cache.map(|c| (c, problem.rows_fingerprint()));
         let columns = match cache {
@@ -387,18 +469,81 @@ impl<'a> Interface<'a> {
         }
         let t0 = Instant::now();
         let problem = self.problem;
-        let computed = match &self.trailing {
-            Some((block, rows)) => in_two_halves(&missing, block.dofs.len() >= 256, |cols| {
-                Ok(trailing_columns(block, rows, cols))
-            })?,
-            None => in_two_halves(&missing, true, |cols| schur_columns(&problem, cols))?,
+        let Some((block, rows)) = self.trailing.take() else {
+            let computed = in_two_halves(&missing, true, |cols| schur_columns(&problem, cols))?;
+            self.store(computed, t0);
+            return Ok(());
         };
+        let result = self.mixed_columns(&block, &rows, &missing);
+        self.trailing = Some((block, rows));
+        result
+    }
+
+    /// [`Interface::ensure_columns`] with a trailing block: whole-factor columns for the rows
+    /// outside the block (all of them as soon as a trailing column is needed), then the
+    /// trailing columns, completed in the outside rows by symmetry `S_ij = S_ji`.
+    fn mixed_columns(
+        &mut self,
+        block: &synovia_fem::TrailingBlock,
+        rows: &[Option<Vec<(usize, f64)>>],
+        missing: &[usize],
+    ) -> Result<(), ContactError> {
+        let problem = self.problem;
+        let (inside, mut outside): (Vec<usize>, Vec<usize>) =
+            missing.iter().partition(|&&j| rows[j].is_some());
+        if !inside.is_empty() {
+            outside = (0..rows.len()).filter(|&j| rows[j].is_none() && self.columns[j].is_none()).collect();
+        }
+        if !outside.is_empty() {
+            let t0 = Instant::now();
+            let computed = in_two_halves(&outside, true, |cols| schur_columns(&problem, cols))?;
+            self.store(computed, t0);
+        }
+        if !inside.is_empty() {
+            let t0 = Instant::now();
+            // trailing solves kept in the cache (rows shared with earlier interfaces), the others
+            let cache = self.cache.map(|(c, _)| c);
+            let block_id = block_fingerprint(block);
+            let keys: Vec<u64> = inside.iter().map(|&j| row_fingerprint(rows[j].as_deref())).collect();
+            let mut solves: Vec<Option<std::sync::Arc<Vec<f64>>>> =
+                keys.iter().map(|&key| cache.and_then(|c| c.trailing_solve(block_id, key))).collect();
+            let todo: Vec<usize> = (0..inside.len()).filter(|&a| solves[a].is_none()).collect();
+            let todo_rows: Vec<usize> = todo.iter().map(|&a| inside[a]).collect();
+            let solved = in_two_halves(&todo_rows, block.dofs.len() >= 256, |cols| {
+                Ok(trailing_solves(block, rows, cols))
+            })?;
+            for (&a, (_, x)) in todo.iter().zip(solved) {
+                let x = std::sync::Arc::new(x);
+                if let Some(c) = cache {
+                    c.put_trailing_solve(block_id, keys[a], x.clone());
+                }
+                solves[a] = Some(x);
+            }
+            for (&j, x) in inside.iter().zip(&solves) {
+                let Some(x) = x else { continue };
+                let col = rows
+                    .iter()
+                    .enumerate()
+                    .map(|(i, row)| match row {
+                        Some(row) => row.iter().map(|&(p, v)| v * x[p]).sum(),
+                        // outside the block: S_ij = S_ji from the whole-factor column i
+                        None => self.columns[i].as_ref().map_or(0.0, |c| c[j]),
+                    })
+                    .collect();
+                self.columns[j] = Some(col);
+            }
+            self.solves += todo.len();
+            self.solve_s += t0.elapsed().as_secs_f64();
+        }
+        Ok(())
+    }
+
+    fn store(&mut self, computed: Vec<(usize, Vec<f64>)>, t0: Instant) {
         self.solves += computed.len();
         for (j, col) in computed {
             self.columns[j] = Some(col);
         }
         self.solve_s += t0.elapsed().as_secs_f64();
-        Ok(())
     }
 
     /// Column `j` of `S` (must have been ensured).
@@ -436,12 +581,13 @@ impl<'a> Interface<'a> {
         }
         let t0 = Instant::now();
         let rhs = if self.trailing.is_some() {
-            // every row lies on the trailing dofs: U = A⁻¹F − A⁻¹(Cᵀν), the second solve
-            // with a right-hand side on the trailing dofs (half a solve)
+            // U = A⁻¹F − A⁻¹(Cᵀν): with every row on the trailing dofs the second solve has its
+            // right-hand side there (half a solve); rows outside the block (mixed interface)
+            // make it a full solve
             let mut y = vec![0.0; self.load_solution.len()];
             self.problem.apply_transpose_add(nu, &mut y);
             self.problem.factor.solve_trailing_supported_in_place(&mut y)?;
-            y.iter_mut().zip(&self.load_solution).for_each(|(y, x)| *y = x - *y);
+            y.iter_mut().zip(self.load_solution.iter()).for_each(|(y, x)| *y = x - *y);
             y
         } else {
             let mut rhs = self.problem.load.to_vec();
@@ -479,27 +625,48 @@ fn in_two_halves(
     Ok(ra)
 }
 
-/// Columns `j ∈ cols` of `S = C_c L₂₂⁻ᵀ L₂₂⁻¹ C_cᵀ` from the trailing block (`rows`: the
-/// rows of `C` in trailing positions): dense triangular solves with all right-hand sides at once.
-fn trailing_columns(
+/// The trailing-block solves `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` (in trailing positions) of the rows
+/// `j ∈ cols` (`rows`: the rows of `C` in trailing positions; every `j ∈ cols` must be one):
+/// dense triangular solves with all right-hand sides at once. `S_ij = c_i · x_j` for the rows
+/// `i` in the block.
+fn trailing_solves(
     block: &synovia_fem::TrailingBlock,
-    rows: &[Vec<(usize, f64)>],
+    rows: &[Option<Vec<(usize, f64)>>],
     cols: &[usize],
 ) -> Vec<(usize, Vec<f64>)> {
     let mut rhs = faer::Mat::<f64>::zeros(block.dofs.len(), cols.len());
     for (c, &j) in cols.iter().enumerate() {
-        for &(p, v) in &rows[j] {
+        for &(p, v) in rows[j].iter().flatten() {
             rhs[(p, c)] += v;
         }
     }
     block.solve_in_place(rhs.as_mut());
-    cols.iter()
-        .enumerate()
-        .map(|(c, &j)| {
-            let x = rhs.col(c);
-            (j, rows.iter().map(|row| row.iter().map(|&(p, v)| v * x[p]).sum()).collect())
-        })
-        .collect()
+    cols.iter().enumerate().map(|(c, &j)| (j, rhs.col(c).iter().copied().collect())).collect()
+}
+
+/// A fingerprint of a trailing block: its address, size and corner entries.
+fn block_fingerprint(block: &synovia_fem::TrailingBlock) -> usize {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (block as *const synovia_fem::TrailingBlock as usize).hash(&mut h);
+    let k = block.dofs.len();
+    k.hash(&mut h);
+    if k > 0 {
+        block.factor[(0, 0)].to_bits().hash(&mut h);
+        block.factor[(k - 1, k - 1)].to_bits().hash(&mut h);
+    }
+    h.finish() as usize
+}
+
+/// A fingerprint of a row in trailing positions (for the trailing solves of [`SchurCache`]).
+fn row_fingerprint(row: Option<&[(usize, f64)]>) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for &(p, v) in row.into_iter().flatten() {
+        p.hash(&mut h);
+        v.to_bits().hash(&mut h);
+    }
+    h.finish()
 }
 
 /// Columns `j ∈ cols` of `S = C A⁻¹ Cᵀ`: batched solves, 32 right-hand sides at a time.
@@ -524,4 +691,79 @@ fn schur_columns(
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::BlockOnFoundation;
+    use synovia_fem::Ordering;
+
+    /// A trailing block that holds the dofs of all rows but those of two contact nodes: the
+    /// columns of `S` (trailing ones completed by symmetry) equal those of the whole factor.
+    #[test]
+    fn mixed_trailing_columns_match_whole_factor_columns() {
+        let owned = BlockOnFoundation { n: 12, slip_bound: Some(0.1), ..Default::default() }
+            .build::<2>()
+            .expect("problem");
+        let whole = owned.problem();
+        let m = whole.n_normal();
+        let excluded_dofs: std::collections::HashSet<usize> =
+            [0, m / 2, m, m + m / 2].iter().flat_map(|&r| whole.row(r).map(|(i, _)| i)).collect();
+        let mut last: Vec<usize> = (0..whole.n_rows())
+            .flat_map(|r| whole.row(r).map(|(i, _)| i).collect::<Vec<_>>())
+            .filter(|i| !excluded_dofs.contains(i))
+            .collect();
+        last.sort_unstable();
+        last.dedup();
+        let ordering = Ordering::Trailing { base: Box::new(Ordering::Amd), last };
+        let mut factor = CholeskySolver::analyse(&owned.matrix, &ordering).expect("analyse");
+        factor.factorize(&owned.matrix).expect("factorise");
+        let mut mixed = Interface::new(ContactProblem { factor: &factor, ..whole }).expect("interface");
+        let mut plain = Interface::new(whole).expect("interface");
+        assert!(mixed.uses_trailing_block() && !plain.uses_trailing_block());
+        let outside =
+            mixed.trailing.as_ref().map_or(0, |(_, rows)| rows.iter().filter(|r| r.is_none()).count());
+        assert_eq!(outside, 4, "two normal and two tangential rows outside the block");
+        let all: Vec<usize> = (0..whole.n_rows()).collect();
+        // trailing columns first (the outside columns are computed on the way), then the rest
+        mixed.ensure_columns(&[1, 2, m + 3]).expect("columns");
+        mixed.ensure_columns(&all).expect("columns");
+        plain.ensure_columns(&all).expect("columns");
+        let scale =
+            all.iter().filter_map(|&j| plain.column(j)).flatten().fold(0.0_f64, |a, b| a.max(b.abs()));
+        for &j in &all {
+            let (a, b) = (mixed.column(j).expect("mixed column"), plain.column(j).expect("column"));
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                assert!((x - y).abs() <= 1e-12 * scale, "S[{i}, {j}]: {x} vs {y}");
+            }
+        }
+        let dw = mixed.w().iter().zip(plain.w()).fold(0.0_f64, |a, (x, y)| a.max((x - y).abs()));
+        assert!(dw <= 1e-12 * crate::kkt::inf_norm(plain.w()));
+
+        // the same through a cache whose trailing solves come from an earlier interface with
+        // other rows (the normal rows only): the shared solves give the same columns
+        let cache = SchurCache::new();
+        let normal_only =
+            ContactProblem { factor: &factor, friction: None, schur_cache: Some(&cache), ..whole };
+        let mut first = Interface::new(normal_only).expect("interface");
+        first.ensure_columns(&(0..m).collect::<Vec<_>>()).expect("columns");
+        let first_solves = first.solves();
+        drop(first);
+        let shared = cache.sharing_solves();
+        let mut cached =
+            Interface::new(ContactProblem { factor: &factor, schur_cache: Some(&shared), ..whole })
+                .expect("interface");
+        assert_eq!(cached.solves(), 0, "the load solve is shared");
+        cached.ensure_columns(&all).expect("columns");
+        // the normal rows in the block were solved before: only the tangential rows and the
+        // rows outside the block cost solves now
+        assert!(cached.solves() < whole.n_rows() && first_solves > 0, "{} solves", cached.solves());
+        for &j in &all {
+            let (a, b) = (cached.column(j).expect("cached column"), plain.column(j).expect("column"));
+            for (i, (x, y)) in a.iter().zip(b).enumerate() {
+                assert!((x - y).abs() <= 1e-12 * scale, "cached S[{i}, {j}]: {x} vs {y}");
+            }
+        }
+    }
 }

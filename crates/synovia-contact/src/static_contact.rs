@@ -12,10 +12,19 @@ use synovia_mesh::math::{Real, Vector};
 use crate::error::ContactError;
 use crate::kkt::{check_kkt, inf_norm, KktReport};
 use crate::operators::{BodyPlacement, ContactGeometry, ContactPair};
-use crate::problem::{ContactProblem, FrictionConstraints, SchurCache};
-use crate::solver::{ContactSolution, ContactSolver};
+use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints, SchurCache};
+use crate::rows::SparseRows;
+use crate::solver::{ContactSolution, ContactSolver, SolverReport};
 
 /// A factorised model with its contact geometry.
+///
+/// The dofs of the contact interface are ordered last in the factorisation (a dense trailing
+/// block for the interface Schur complement, see [`ElasticSolver::new_for_contact`]). An
+/// interface with more than [`ElasticParams::max_trailing_dofs`] dofs keeps only the contact
+/// nodes of smallest initial gap (with their partner and master nodes) in the block, up to
+/// [`ElasticParams::screened_trailing_dofs`]; each solve then screens the contact rows: it
+/// solves on the rows in the block, checks the others with the computed displacement and adds
+/// those that penetrate until none does, so the result is the one of the full problem.
 #[derive(Debug)]
 pub struct StaticContact<const D: usize> {
     elastic: ElasticSolver<D>,
@@ -59,7 +68,8 @@ impl<const D: usize> StaticContact<D> {
         params: ElasticParams,
     ) -> Result<Self, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
-        let elastic = ElasticSolver::new_for_contact(model, params, &interface_nodes(model, pairs)?)?;
+        let elastic =
+            ElasticSolver::new_for_contact(model, params, &interface_nodes(model, pairs, &geometry)?)?;
         Ok(Self {
             elastic,
             geometry,
@@ -273,28 +283,17 @@ impl<const D: usize> StaticContact<D> {
                 }
             };
         }
+        let cell_node = friction_op.as_ref().map_or(&[][..], |f| &f.cell_node[..]);
         let mut coarse_iterations = 0;
-        let nested = match (warm_start, self.nested_min_rows) {
-            (None, Some(min_rows)) => crate::nested::nested_warm_start(
-                &problem_with!(&load),
-                solver,
-                &self.geometry.adjacency,
-                min_rows,
-            )?,
-            _ => None,
-        };
-        if let Some((_, it)) = &nested {
-            coarse_iterations = *it;
-        }
-        let mut warm = warm_start.or(nested.as_ref().map(|(w, _)| w)).cloned();
+        let mut warm = warm_start.cloned();
         let Some(st) = stabilisation else {
             let problem = problem_with!(&load);
-            let solution = solver.solve(&problem, warm.as_ref())?;
+            let (solution, it) = self.run(&problem, solver, warm.as_ref(), cell_node)?;
             if multipliers_only {
-                return Ok(Solved::Multipliers(Box::new(solution), coarse_iterations));
+                return Ok(Solved::Multipliers(Box::new(solution), it));
             }
             let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
-            return self.finish(solution, kkt, &lifts, friction_op, coarse_iterations, 0).map(Solved::full);
+            return self.finish(solution, kkt, &lifts, friction_op, it, 0).map(Solved::full);
         };
         // Proximal-point iteration (crate::floating): A + S with load F + S U_k.
         let mut u_k = match &warm {
@@ -306,7 +305,8 @@ impl<const D: usize> StaticContact<D> {
         for iteration in 1..=PROXIMAL_MAX_ITERATIONS {
             let rhs: Vec<f64> = st.spring_mul(&u_k).iter().zip(&load).map(|(s, f)| s + f).collect();
             let problem = problem_with!(&rhs);
-            let solution = solver.solve(&problem, warm.as_ref())?;
+            let (solution, it) = self.run(&problem, solver, warm.as_ref(), cell_node)?;
+            coarse_iterations += it;
             let step: Vec<f64> = solution.u.iter().zip(&u_k).map(|(a, b)| a - b).collect();
             let residual = inf_norm(&st.spring_mul(&step));
             let mut forces = vec![0.0; load.len()];
@@ -357,6 +357,109 @@ impl<const D: usize> StaticContact<D> {
         Ok(Some(subspace.solve(self.elastic.system_matrix(), self.elastic.cholesky(), load)?))
     }
 
+    /// Runs `solver` on `problem` (with the nested iteration when there is no warm start) and
+    /// returns the solution with the iterations spent on coarse levels.
+    ///
+    /// Row screening: when the factor's trailing block holds the dofs of only some normal
+    /// rows (an interface larger than [`ElasticParams::max_trailing_dofs`], of which the
+    /// [`ElasticParams::screened_trailing_dofs`] of the smallest gaps are ordered last), the solver runs
+    /// on the sub-problem of those *candidate* rows (plus the rows of friction cells and the
+    /// rows loaded in the warm start), whose interface Schur complement comes from the dense
+    /// trailing block. The excluded rows are then checked with the computed `U`: if none
+    /// penetrates, `(U, Λ_n, Λ_t)` with `Λ_n = 0` on them solves the full problem (its KKT
+    /// conditions hold row by row); otherwise the penetrating rows join the candidates and the
+    /// sub-problem is solved again, warm-started, until no excluded row penetrates. The
+    /// returned solution has one `Λ_n` per row of `problem`.
+    fn run(
+        &self,
+        problem: &ContactProblem<'_>,
+        solver: &dyn ContactSolver,
+        warm: Option<&ContactSolution>,
+        cell_node: &[usize],
+    ) -> Result<(ContactSolution, usize), ContactError> {
+        let nested = |p: &ContactProblem<'_>, adjacency: &[Vec<usize>]| match (warm, self.nested_min_rows) {
+            (None, Some(min_rows)) => crate::nested::nested_warm_start(p, solver, adjacency, min_rows),
+            _ => Ok(None),
+        };
+        let m = problem.n_normal();
+        let Some(mut candidate) = self.trailing_rows(problem.normal) else {
+            let coarse = nested(problem, &self.geometry.adjacency)?;
+            let start = warm.or(coarse.as_ref().map(|(w, _)| w));
+            let solution = solver.solve(problem, start)?;
+            return Ok((solution, coarse.map_or(0, |(_, it)| it)));
+        };
+        for &r in cell_node {
+            if let Some(c) = candidate.get_mut(r) {
+                *c = true;
+            }
+        }
+        if let Some(w) = warm.filter(|w| w.lambda_n.len() == m) {
+            for (c, l) in candidate.iter_mut().zip(&w.lambda_n) {
+                *c |= *l != 0.0;
+            }
+        }
+        let mut coarse_iterations = 0;
+        let mut current = warm.cloned();
+        let mut report: Option<SolverReport> = None;
+        loop {
+            let rows: Vec<usize> = (0..m).filter(|&r| candidate[r]).collect();
+            let normal = restrict_rows(problem.normal, &rows);
+            // the screening check below needs U, whatever the caller asked for
+            let sub = ContactProblem { normal: &normal, multipliers_only: false, ..*problem };
+            let start = match &current {
+                Some(w) if w.lambda_n.len() == m => Some(ContactSolution {
+                    u: w.u.clone(),
+                    lambda_n: rows.iter().map(|&r| w.lambda_n[r]).collect(),
+                    lambda_t: w.lambda_t.clone(),
+                    report: SolverReport::default(),
+                }),
+                // a warm start that does not fit: the solver reports it
+                Some(w) => Some(w.clone()),
+                None => {
+                    let adjacency = restrict_adjacency(&self.geometry.adjacency, &rows, m);
+                    nested(&sub, &adjacency)?.map(|(w, it)| {
+                        coarse_iterations += it;
+                        w
+                    })
+                }
+            };
+            let solution = solver.solve(&sub, start.as_ref())?;
+            let mut lambda_n = vec![0.0; m];
+            for (&r, l) in rows.iter().zip(&solution.lambda_n) {
+                lambda_n[r] = *l;
+            }
+            let merged = merge_reports(report.take(), solution.report);
+            let full =
+                ContactSolution { u: solution.u, lambda_n, lambda_t: solution.lambda_t, report: merged };
+            let scale = inf_norm(&full.u).max(inf_norm(&problem.normal.gap)).max(f64::MIN_POSITIVE);
+            let penetrating: Vec<usize> = (0..m)
+                .filter(|&r| {
+                    !candidate[r]
+                        && problem.normal.rows.row_dot(r, &full.u) - problem.normal.gap[r]
+                            > SCREENING_TOLERANCE * scale
+                })
+                .collect();
+            if penetrating.is_empty() {
+                return Ok((full, coarse_iterations));
+            }
+            for r in penetrating {
+                candidate[r] = true;
+            }
+            report = Some(full.report.clone());
+            current = Some(full);
+        }
+    }
+
+    /// For each normal row, whether all its dofs lie in the trailing block of the factor;
+    /// `None` when there is no trailing block or every row does (no screening needed).
+    fn trailing_rows(&self, normal: &NormalConstraints) -> Option<Vec<bool>> {
+        let block = self.elastic.cholesky().trailing()?;
+        let inside: Vec<bool> = (0..normal.rows.nrows())
+            .map(|r| normal.rows.row(r).all(|(i, _)| block.position.get(i).is_some_and(|&p| p != usize::MAX)))
+            .collect();
+        (!inside.iter().all(|&b| b)).then_some(inside)
+    }
+
     fn finish(
         &self,
         solution: ContactSolution,
@@ -399,14 +502,28 @@ impl<const D: usize> Solved<D> {
 }
 
 /// Every node of the contact parts of `pairs` (both sides), each once: the dofs that
-/// [`ElasticSolver::new_for_contact`] orders last.
+/// [`ElasticSolver::new_for_contact`] orders last. Priority order (what a trailing block too
+/// small for all of them keeps): the contact nodes of `geometry` by increasing initial gap,
+/// each with its partner and master nodes, then the remaining nodes of the parts.
 fn interface_nodes<const D: usize>(
     model: &Model<D>,
     pairs: &[ContactPair<D>],
+    geometry: &ContactGeometry<D>,
 ) -> Result<Vec<(synovia_fem::BodyId, usize)>, ContactError> {
     use crate::operators::Partner;
     let mut out = Vec::new();
     let mut seen = std::collections::HashSet::new();
+    let mut by_gap: Vec<usize> = (0..geometry.len()).collect();
+    by_gap.sort_by(|&a, &b| geometry.nodes[a].gap.total_cmp(&geometry.nodes[b].gap).then(a.cmp(&b)));
+    for r in by_gap {
+        let node = &geometry.nodes[r];
+        let others = node.partner.iter().copied().chain(node.master.iter().map(|&(b, j, _)| (b, j)));
+        for (b, i) in std::iter::once(node.node).chain(others) {
+            if seen.insert((b.0, i)) {
+                out.push((b, i));
+            }
+        }
+    }
     let mut add = |body: synovia_fem::BodyId, part: &str| -> Result<(), ContactError> {
         let mesh = &model.body(body)?.mesh;
         for f in mesh.boundary_part(part)?.facets() {
@@ -432,6 +549,53 @@ fn interface_nodes<const D: usize>(
 
 /// Directions kept by the [`LoadSubspace`] of a [`StaticContact`].
 const LOAD_SUBSPACE_CAPACITY: usize = 6;
+
+/// The rows `rows` of `normal` (with their weights and gaps).
+fn restrict_rows(normal: &NormalConstraints, rows: &[usize]) -> NormalConstraints {
+    let mut out = SparseRows::new(normal.rows.ncols());
+    for &r in rows {
+        out.push_row(normal.rows.row(r));
+    }
+    NormalConstraints {
+        rows: out,
+        weights: rows.iter().map(|&r| normal.weights[r]).collect(),
+        gap: rows.iter().map(|&r| normal.gap[r]).collect(),
+    }
+}
+
+/// The contact-node graph `adjacency` (of `m` rows) restricted to `rows`, renumbered.
+fn restrict_adjacency(adjacency: &[Vec<usize>], rows: &[usize], m: usize) -> Vec<Vec<usize>> {
+    let mut index = vec![usize::MAX; m];
+    for (i, &r) in rows.iter().enumerate() {
+        index[r] = i;
+    }
+    rows.iter()
+        .map(|&r| {
+            adjacency.get(r).map_or_else(Vec::new, |nb| {
+                nb.iter().filter_map(|&j| index.get(j).copied().filter(|&i| i != usize::MAX)).collect()
+            })
+        })
+        .collect()
+}
+
+/// The report of a screened solve: counts and times of all passes, states of the last one.
+fn merge_reports(previous: Option<SolverReport>, last: SolverReport) -> SolverReport {
+    let Some(p) = previous else { return last };
+    let mut history = p.history;
+    history.extend(last.history);
+    SolverReport {
+        iterations: p.iterations + last.iterations,
+        inner_iterations: p.inner_iterations + last.inner_iterations,
+        linear_solves: p.linear_solves + last.linear_solves,
+        time_s: p.time_s + last.time_s,
+        history,
+        ..last
+    }
+}
+
+/// Relative penetration `(B_hn U − d)_r / max(‖U‖_∞, ‖d‖_∞)` above which a row excluded by
+/// the screening of [`StaticContact`] joins the solve.
+const SCREENING_TOLERANCE: f64 = 1e-12;
 
 /// Largest number of proximal-point iterations of a semi-coercive solve.
 const PROXIMAL_MAX_ITERATIONS: usize = 60;

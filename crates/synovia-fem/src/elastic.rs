@@ -36,15 +36,27 @@ pub struct ElasticParams {
     /// Quadrature degree of the load integrals (default: 2).
     pub load_degree: usize,
     /// Largest number of contact-interface dofs that [`ElasticSolver::new_for_contact`] orders
-    /// last (default 8000; 0 switches the condensed interface off). The trailing block is dense:
-    /// `k²` entries (512 MB at 8000) and `k³/3` flops in the factorisation; measured in
-    /// `docs/performance.md`.
+    /// last all together (default 8000; 0 switches the condensed interface off). The trailing
+    /// block is dense: `k²` entries (512 MB at 8000) and `k³/3` flops in the factorisation;
+    /// measured in `docs/performance.md`.
     pub max_trailing_dofs: usize,
+    /// For an interface with more than [`Self::max_trailing_dofs`] dofs: the number of dofs of
+    /// its leading nodes (in the given priority order; for `synovia_contact::StaticContact`
+    /// the contact nodes of smallest initial gap) that are ordered last instead (default
+    /// 6000, capped at [`Self::max_trailing_dofs`]; 0: no trailing block for such an
+    /// interface). The contact solve screens its rows against this block (exactly: rows
+    /// outside it are added when they come into contact).
+    pub screened_trailing_dofs: usize,
 }
 
 impl Default for ElasticParams {
     fn default() -> Self {
-        Self { ordering: OrderingChoice::Auto, load_degree: 2, max_trailing_dofs: 8000 }
+        Self {
+            ordering: OrderingChoice::Auto,
+            load_degree: 2,
+            max_trailing_dofs: 8000,
+            screened_trailing_dofs: 6000,
+        }
     }
 }
 
@@ -129,11 +141,14 @@ impl<const D: usize> ElasticSolver<D> {
     }
 
     /// The factorisation for contact problems: like [`ElasticSolver::new_semi_coercive`], and
-    /// the reduced dofs of the `interface` nodes (the nodes of the contact parts) are ordered
-    /// last ([`Ordering::Trailing`]) when there are at most [`ElasticParams::max_trailing_dofs`] of them,
-    /// so that the interface Schur complement `S = C A⁻¹ Cᵀ` is evaluated with the dense
-    /// trailing block `L₂₂` of the factor, `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4), instead of
-    /// solves with the whole factor ([`CholeskySolver::trailing`]).
+    /// the reduced dofs of the `interface` nodes (the nodes of the contact parts, in priority
+    /// order) are ordered last ([`Ordering::Trailing`]), so that the interface Schur complement
+    /// `S = C A⁻¹ Cᵀ` is evaluated with the dense trailing block `L₂₂` of the factor,
+    /// `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4), instead of solves with the whole factor
+    /// ([`CholeskySolver::trailing`]). When the interface has more than
+    /// [`ElasticParams::max_trailing_dofs`] dofs, only the longest prefix of `interface` with at
+    /// most [`ElasticParams::screened_trailing_dofs`] dofs is ordered last (the contact solve
+    /// then screens its rows, see `synovia_contact::StaticContact`).
     pub fn new_for_contact(
         model: &Model<D>,
         params: ElasticParams,
@@ -175,8 +190,8 @@ impl<const D: usize> ElasticSolver<D> {
             _ => metis,
         };
         if !interface.is_empty() {
-            let mut last = Vec::new();
             let mut seen = vec![false; dofs.groups().len()];
+            let mut total = 0;
             for &(b, i) in interface {
                 let n_nodes = model.body(b)?.mesh.n_nodes();
                 if i >= n_nodes {
@@ -187,11 +202,29 @@ impl<const D: usize> ElasticSolver<D> {
                 }
                 let g = dofs.group_of(b, i);
                 if !std::mem::replace(&mut seen[g], true) {
-                    let grp = &dofs.groups()[g];
-                    last.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
+                    total += dofs.groups()[g].n_dofs;
                 }
             }
-            if !last.is_empty() && last.len() <= params.max_trailing_dofs && last.len() < dofs.n_dofs() {
+            // the whole interface if it fits, else its longest prefix within the screened budget
+            let budget = if total <= params.max_trailing_dofs {
+                total
+            } else {
+                params.screened_trailing_dofs.min(params.max_trailing_dofs)
+            };
+            let mut last = Vec::new();
+            seen.fill(false);
+            for &(b, i) in interface {
+                let g = dofs.group_of(b, i);
+                if std::mem::replace(&mut seen[g], true) {
+                    continue;
+                }
+                let grp = &dofs.groups()[g];
+                if last.len() + grp.n_dofs > budget {
+                    break;
+                }
+                last.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
+            }
+            if !last.is_empty() && last.len() < dofs.n_dofs() {
                 ordering = Ordering::Trailing { base: Box::new(ordering), last };
             }
         }

@@ -5,7 +5,7 @@
 //! Notation (crate docs): force multipliers `ν = (κ Λ_n, Λ_t)`, interface values
 //! `y = w − S ν`, offsets `g = (d, s)`, complementarity parameters `ρ`.
 
-use nalgebra::{Cholesky, DMatrix, DVector};
+use faer::linalg::solvers::Solve;
 use synovia_contact::{ContactError, ContactParams, ContactProblem, ContactSolution, Interface};
 
 /// Relative width of the switching band: a row whose switching quantity lies within
@@ -422,7 +422,7 @@ impl<'p> State<'p> {
             }
             cols.push(pair);
         }
-        let mut k_mat = DMatrix::<f64>::zeros(n, n);
+        let mut k_mat = faer::Mat::<f64>::zeros(n, n);
         for b in 0..n {
             let (_, tb, lb, db) = q[b];
             for a in b..n {
@@ -438,27 +438,28 @@ impl<'p> State<'p> {
             }
             k_mat[(b, b)] += db;
         }
-        let rhs = DVector::from_iterator(
-            n,
-            q.iter().map(|(r, t, l, _)| (0..*l).map(|i| t[i] * rhs_full[r[i]]).sum::<f64>()),
-        );
+        let rhs = faer::Mat::<f64>::from_fn(n, 1, |a, _| {
+            let (r, t, l, _) = &q[a];
+            (0..*l).map(|i| t[i] * rhs_full[r[i]]).sum::<f64>()
+        });
         let diag: Vec<f64> = (0..n).map(|a| k_mat[(a, a)]).collect();
         let singular = || ContactError::Singular { solver: solver.to_string(), iteration, size: n };
         if diag.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
             return Err(singular());
         }
-        let chol = Cholesky::new(k_mat).ok_or_else(singular)?;
-        let l = chol.l_dirty();
+        // faer's blocked dense Cholesky (the active systems reach a few thousand unknowns)
+        let chol = k_mat.llt(faer::Side::Lower).map_err(|_| singular())?;
+        let l = chol.L();
         if (0..n).any(|a| l[(a, a)] * l[(a, a)] <= PIVOT_TOL * diag[a]) {
             return Err(singular());
         }
         let x = chol.solve(&rhs);
-        if x.iter().any(|v| !v.is_finite()) {
+        if (0..n).any(|a| !x[(a, 0)].is_finite()) {
             return Err(singular());
         }
         for (a, (r, t, l, _)) in q.iter().enumerate() {
             for i in 0..*l {
-                nu[r[i]] += t[i] * x[a];
+                nu[r[i]] += t[i] * x[(a, 0)];
             }
         }
         Ok(nu)
