@@ -99,7 +99,10 @@ impl<const D: usize> StaticContact<D> {
     /// `A`: the bodies' stiffness in their own frames does not change with the placement, so a
     /// sequence of poses (a gait cycle) needs one factorisation. The contact parts' dofs stay
     /// the interface dofs ordered last, so Schur columns of the new rows still use the dense
-    /// trailing block. Loads, prescribed displacements and results are in the bodies' frames.
+    /// trailing block (for an interface above [`ElasticParams::max_trailing_dofs`], the block
+    /// chosen by the initial gaps at construction; rows outside it are screened as in
+    /// [`StaticContact::solve`]). Loads, prescribed displacements and results are in the
+    /// bodies' frames.
     /// Returns the previous geometry.
     ///
     /// # Errors
@@ -199,15 +202,8 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         solution: ContactSolution,
     ) -> Result<StaticContactResult<D>, ContactError> {
-        let (load, lifts) = self.elastic.rhs(model, t)?;
-        let dofs = self.elastic.dofs();
-        let normal = self.geometry.normal_constraints(dofs, &lifts);
-        let friction_op = match slip_bound {
-            Some(g) => Some(self.geometry.friction_constraints(dofs, &lifts, g, previous)?),
-            None => None,
-        };
-        let friction: Option<&FrictionConstraints> =
-            friction_op.as_ref().map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0);
+        let Assembled { load, lifts, normal, friction_op } = self.assemble(model, t, slip_bound, previous)?;
+        let friction = active_friction(friction_op.as_ref());
         let n_tangential = friction.map_or(0, |f| f.rows.nrows());
         if solution.lambda_n.len() != normal.rows.nrows() || solution.lambda_t.len() != n_tangential {
             return Err(ContactError::InvalidParameter(format!(
@@ -252,15 +248,8 @@ impl<const D: usize> StaticContact<D> {
         warm_start: Option<&ContactSolution>,
         multipliers_only: bool,
     ) -> Result<Solved<D>, ContactError> {
-        let (load, lifts) = self.elastic.rhs(model, t)?;
-        let dofs = self.elastic.dofs();
-        let normal = self.geometry.normal_constraints(dofs, &lifts);
-        let friction_op = match slip_bound {
-            Some(g) => Some(self.geometry.friction_constraints(dofs, &lifts, g, previous)?),
-            None => None,
-        };
-        let friction: Option<&FrictionConstraints> =
-            friction_op.as_ref().map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0);
+        let Assembled { load, lifts, normal, friction_op } = self.assemble(model, t, slip_bound, previous)?;
+        let friction = active_friction(friction_op.as_ref());
         let stabilisation = self.elastic.stabilisation();
         if let Some(st) = stabilisation {
             crate::floating::check_balance(st, &load, &normal, friction)?;
@@ -344,6 +333,24 @@ impl<const D: usize> StaticContact<D> {
             iterations: history.len(),
             history,
         })
+    }
+
+    /// The load, the lifts of prescribed displacements and the constraints at `t`.
+    fn assemble(
+        &self,
+        model: &Model<D>,
+        t: Real,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+    ) -> Result<Assembled<D>, ContactError> {
+        let (load, lifts) = self.elastic.rhs(model, t)?;
+        let dofs = self.elastic.dofs();
+        let normal = self.geometry.normal_constraints(dofs, &lifts);
+        let friction_op = match slip_bound {
+            Some(g) => Some(self.geometry.friction_constraints(dofs, &lifts, g, previous)?),
+            None => None,
+        };
+        Ok(Assembled { load, lifts, normal, friction_op })
     }
 
     /// `A⁻¹ F` through the [`LoadSubspace`] (recycled when `F` is a combination of loads
@@ -486,6 +493,19 @@ impl<const D: usize> StaticContact<D> {
             proximal_iterations,
         })
     }
+}
+
+/// The right-hand side and constraints of one contact problem ([`StaticContact::assemble`]).
+struct Assembled<const D: usize> {
+    load: Vec<f64>,
+    lifts: Vec<Vector<D>>,
+    normal: NormalConstraints,
+    friction_op: Option<crate::operators::FrictionOperator>,
+}
+
+/// The friction constraints of `op`, if it has any cell.
+fn active_friction(op: Option<&crate::operators::FrictionOperator>) -> Option<&FrictionConstraints> {
+    op.map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0)
 }
 
 /// What [`StaticContact::solve_with`] returns: the full result, or (multipliers only) the

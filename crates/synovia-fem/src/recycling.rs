@@ -16,8 +16,9 @@
 //! of these systems is 10⁻¹⁵–10⁻¹³). Otherwise the load is solved with the factor and, if
 //! `r` is a new direction, `q = r/‖r‖`, `z = (A⁻¹ F − Z c)/‖r‖` are appended (after a second
 //! Gram–Schmidt pass) with `ρ = ‖A z − q‖` measured by one product with `A` — a direction
-//! derived from a small `‖r‖` loses digits to cancellation, and `ρ` says how many, so such a
-//! direction is only used with coefficients small enough for the bound.
+//! derived from a small `‖r‖` loses digits to cancellation, and `ρ` says how many: above
+//! `10⁻¹³` the direction gets one step of iterative refinement (one more solve, once per
+//! direction), and the bound decides with the measured `ρ` in any case.
 
 use crate::error::FemError;
 use crate::solver::CholeskySolver;
@@ -25,6 +26,9 @@ use crate::sparse::SymmetricMatrix;
 
 /// Relative residual bound `‖A x − F‖ / ‖F‖` of a recycled solution.
 const RECYCLED_RESIDUAL: f64 = 1e-12;
+/// Residual `‖A z − q‖` of a new direction above which `z` gets one step of iterative
+/// refinement (a direct solve of these systems reaches 10⁻¹⁵–10⁻¹³).
+const REFINE_ABOVE: f64 = 1e-13;
 /// Smallest relative residual `‖r‖ / ‖F‖` of a load whose direction is added to the basis.
 const NEW_DIRECTION: f64 = 1e-10;
 
@@ -132,7 +136,16 @@ impl LoadSubspace {
             z.iter_mut().for_each(|v| *v *= inv);
             let mut az = vec![0.0; n];
             matrix.mul_vec(&z, &mut az);
-            let rho = az.iter().zip(&residual).map(|(a, q)| (a - q) * (a - q)).sum::<f64>().sqrt();
+            let mut rho = residual_norm(&az, &residual);
+            if rho > REFINE_ABOVE {
+                // cancellation in z (a small ‖r‖): one step of iterative refinement,
+                // z ← z + A⁻¹ (q − A z), one more solve for this direction only
+                let mut correction: Vec<f64> = residual.iter().zip(&az).map(|(q, a)| q - a).collect();
+                factor.solve_in_place(&mut correction)?;
+                z.iter_mut().zip(&correction).for_each(|(z, c)| *z += c);
+                matrix.mul_vec(&z, &mut az);
+                rho = residual_norm(&az, &residual);
+            }
             self.basis.push(residual);
             self.solutions.push(z);
             self.residuals.push(rho);
@@ -149,6 +162,11 @@ impl LoadSubspace {
             axpy(-a, q, residual);
         }
     }
+}
+
+/// `‖a − q‖₂`.
+fn residual_norm(a: &[f64], q: &[f64]) -> f64 {
+    a.iter().zip(q).map(|(a, q)| (a - q) * (a - q)).sum::<f64>().sqrt()
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
