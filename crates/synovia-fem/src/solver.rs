@@ -113,7 +113,7 @@ impl CholeskySolver {
                     }
                     other => match explicit_order(n, other)? {
                         Some(p) => p,
-                        None => amd_order_without(a, last)?,
+                        None => amd_order(a)?,
                     },
                 };
                 inverse_permutation(&base_perm, n)?;
@@ -383,46 +383,17 @@ fn explicit_order(n: usize, ordering: &Ordering) -> Result<Option<Vec<usize>>, F
     }
 }
 
-/// AMD on the graph of `a` without the dofs `last` (which a trailing ordering appends after
-/// all others), followed by `last`: the minimum-degree choices then see the graph that is
-/// actually eliminated first, instead of one in which the trailing dofs look like ordinary
-/// neighbours (eliminating them early in AMD's order and moving them last afterwards fills the
-/// coupling block `L₂₁`).
-fn amd_order_without(a: &SymmetricMatrix, last: &[usize]) -> Result<Vec<usize>, FemError> {
+/// faer's AMD ordering of the pattern of `a`, as a forward permutation.
+fn amd_order(a: &SymmetricMatrix) -> Result<Vec<usize>, FemError> {
     use faer::sparse::linalg::amd;
-    use faer::sparse::SymbolicSparseColMat;
     let n = a.n();
-    let mut index = vec![0usize; n];
-    let mut is_last = vec![false; n];
-    for &d in last {
-        if let Some(flag) = is_last.get_mut(d) {
-            *flag = true;
-        }
-    }
-    let rest: Vec<usize> = (0..n).filter(|&d| !is_last[d]).collect();
-    for (i, &d) in rest.iter().enumerate() {
-        index[d] = i;
-    }
-    let pattern = a.pattern();
-    let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
-    let mut col_ptr = Vec::with_capacity(rest.len() + 1);
-    let mut row_idx = Vec::with_capacity(ri.len());
-    col_ptr.push(0);
-    for &j in &rest {
-        row_idx.extend(ri[cp[j]..cp[j + 1]].iter().filter(|&&i| !is_last[i]).map(|&i| index[i]));
-        col_ptr.push(row_idx.len());
-    }
-    let m = rest.len();
-    let sub = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
-    let (mut fwd, mut inv) = (vec![0usize; m], vec![0usize; m]);
-    let req = amd::order_scratch::<usize>(m, sub.compute_nnz());
+    let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+    let req = amd::order_scratch::<usize>(n, a.nnz());
     let mut mem =
         MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (AMD scratch)".into()))?;
-    amd::order(&mut fwd, &mut inv, sub.as_ref(), amd::Control::default(), MemStack::new(&mut mem))
+    amd::order(&mut fwd, &mut inv, a.pattern().as_ref(), amd::Control::default(), MemStack::new(&mut mem))
         .map_err(|e| FemError::Sparse(format!("AMD ordering: {e:?}")))?;
-    let mut order: Vec<usize> = fwd.iter().map(|&i| rest[i]).collect();
-    order.extend(last.iter().copied().filter(|&d| d < n));
-    Ok(order)
+    Ok(fwd)
 }
 
 /// The inverse of the forward permutation `fwd` of `0..n`; an error if it is not one.
