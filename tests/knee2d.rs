@@ -120,3 +120,80 @@ fn body_frame_femur_equals_the_remeshed_pose() {
         }
     }
 }
+
+/// The VTU of a pose writes the femur where it is placed (nodes `R(θ)(x − c) + c`) with its
+/// displacements turned into space (`R(θ) u`), and the tibia as meshed.
+#[test]
+fn pose_output_writes_the_placed_femur() {
+    let knee = Knee2d::coarse();
+    let solver = synovia::solvers::by_name("pdas").expect("solver");
+    let mut cycle = knee.cycle().expect("cycle");
+    let t = 0.725; // swing: 57.8° of flexion
+    let pose = cycle.solve_pose(t, solver.as_ref(), None).expect("pose");
+    let dir = std::env::temp_dir().join(format!("synovia-knee-vtu-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let path = dir.join("pose.vtu");
+    synovia::output::contact_vtu(
+        pose.model,
+        pose.contact.geometry(),
+        &pose.result,
+        synovia::io::Encoding::Ascii,
+    )
+    .expect("writer")
+    .write(&path)
+    .expect("write");
+    let data = synovia::io::read_vtu(&path).expect("read");
+    let theta = iso14243_flexion().expect("flexion").value(t);
+    assert!(theta.to_degrees() > 50.0);
+    let c = knee.condyle_centre();
+    let (s, co) = theta.sin_cos();
+    for (b, body) in pose.model.bodies().iter().enumerate() {
+        let piece = &data.pieces[b];
+        let u = piece.point_field("displacement").expect("displacement");
+        for (i, x) in body.mesh.nodes().iter().enumerate() {
+            let (expected, ue) = if b < 2 {
+                let d = x - c;
+                let ul = pose.result.displacement[b][i];
+                (
+                    [c[0] + co * d[0] - s * d[1], c[1] + s * d[0] + co * d[1]],
+                    [co * ul[0] - s * ul[1], s * ul[0] + co * ul[1]],
+                )
+            } else {
+                ([x[0], x[1]], [pose.result.displacement[b][i][0], pose.result.displacement[b][i][1]])
+            };
+            let p = piece.points[i];
+            assert!(
+                (p[0] - expected[0]).abs() < 1e-9 && (p[1] - expected[1]).abs() < 1e-9,
+                "body {b} node {i}"
+            );
+            let k = u.components;
+            let (ux, uy) = (u.values[k * i], u.values[k * i + 1]);
+            assert!((ux - ue[0]).abs() < 1e-12 && (uy - ue[1]).abs() < 1e-12, "body {b} node {i}: u");
+        }
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Bad placements are typed errors: not a proper rotation, not one per body, tied bodies
+/// placed apart.
+#[test]
+fn bad_body_placements_are_errors() {
+    use synovia::contact_ops::operators::{BodyPlacement, ContactGeometry};
+    use synovia::mesh::math::{Tensor, Vector};
+    let zero = Vector::<2>::zeros();
+    assert!(BodyPlacement::new(Tensor::<2>::new(1.0, 0.0, 0.0, -1.0), zero).is_err(), "reflection");
+    assert!(BodyPlacement::new(Tensor::<2>::identity() * 1.01, zero).is_err(), "scaling");
+    assert!(BodyPlacement::new(Tensor::<2>::identity(), Vector::<2>::new(f64::NAN, 0.0)).is_err());
+    assert!(BodyPlacement::<2>::planar_rotation(Vector::<2>::zeros(), f64::INFINITY).is_err());
+    let knee = Knee2d::coarse();
+    let (model, pairs, femur) =
+        knee.body_frame_model(synovia::prelude::SharedValue::new(0.0)).expect("model");
+    let turned = BodyPlacement::planar_rotation(knee.condyle_centre(), 0.3).expect("rotation");
+    let mut placements = vec![BodyPlacement::identity(); model.bodies().len()];
+    assert!(ContactGeometry::new_placed(&model, &pairs, &placements[1..]).is_err(), "one per body");
+    placements[femur[1].0] = turned; // cartilage turned, its tied bone not
+    let err = ContactGeometry::new_placed(&model, &pairs, &placements).expect_err("tied apart");
+    assert!(err.to_string().contains("tied"), "{err}");
+    placements[femur[0].0] = turned;
+    assert!(ContactGeometry::new_placed(&model, &pairs, &placements).is_ok());
+}
