@@ -580,22 +580,13 @@ impl<'a> Interface<'a> {
             return Ok(Vec::new());
         }
         let t0 = Instant::now();
-        let rhs = if self.trailing.is_some() {
-            // U = A⁻¹F − A⁻¹(Cᵀν): with every row on the trailing dofs the second solve has its
-            // right-hand side there (half a solve); rows outside the block (mixed interface)
-            // make it a full solve
-            let mut y = vec![0.0; self.load_solution.len()];
-            self.problem.apply_transpose_add(nu, &mut y);
-            self.problem.factor.solve_trailing_supported_in_place(&mut y)?;
-            y.iter_mut().zip(self.load_solution.iter()).for_each(|(y, x)| *y = x - *y);
-            y
-        } else {
-            let mut rhs = self.problem.load.to_vec();
-            let neg: Vec<f64> = nu.iter().map(|v| -v).collect();
-            self.problem.apply_transpose_add(&neg, &mut rhs);
-            self.problem.factor.solve_in_place(&mut rhs)?;
-            rhs
-        };
+        // U = A⁻¹F − A⁻¹(Cᵀν) with A⁻¹F from `new`: when every row lies on the trailing dofs
+        // the right-hand side Cᵀν vanishes outside them and the solve is half a solve; it falls
+        // back to a full solve otherwise (no block, or rows outside it)
+        let mut rhs = vec![0.0; self.load_solution.len()];
+        self.problem.apply_transpose_add(nu, &mut rhs);
+        self.problem.factor.solve_trailing_supported_in_place(&mut rhs)?;
+        rhs.iter_mut().zip(self.load_solution.iter()).for_each(|(y, x)| *y = x - *y);
         self.solves += 1;
         self.solve_s += t0.elapsed().as_secs_f64();
         Ok(rhs)
