@@ -2,7 +2,7 @@
 //!
 //! Two identical cylinders (so normal and tangential problems decouple, Dundurs `β = 0`) are
 //! pressed together, then sheared by a tangential displacement of the upper one's top with
-//! Tresca friction `g_c = μ p` frozen from the normal state and slip measured from it (spec §3,
+//! Tresca friction `g_c = μ p` frozen from the normal state and slip measured from it (docs/model.md §3,
 //! §9). For `Q/(μP) = 0.5` the centre sticks over `|x| ≤ c = a sqrt(1 − Q/(μP))` and the
 //! tangential traction is
 //! `q(x) = μ p₀ sqrt(1 − x²/a²) − (c/a) μ p₀ sqrt(1 − x²/c²)` (second term only for `|x| ≤ c`).

@@ -1,4 +1,4 @@
-//! # A viscoelastic cylinder dropped on a rigid floor with friction (dynamic, spec §7)
+//! # A viscoelastic cylinder dropped on a rigid floor with friction (dynamic, docs/model.md §7)
 //!
 //! A plane-strain Kelvin–Voigt cylinder (radius R = 50 mm, E = 5 MPa, ν = 0.3, ρ = 1100 kg/m³,
 //! viscosity `C⁽¹⁾ = τ_v C⁽⁰⁾` with τ_v = 0.05 ms) starts 5 mm above a rigid floor with the
@@ -6,8 +6,8 @@
 //! matrix keeps `A = M_ρ + Δt² A⁽⁰⁾ + Δt A⁽¹⁾` positive definite). Its lower arc is the
 //! contact part; friction follows the slip-rate-dependent law
 //! `F_c(v) = μ_k + (μ_s − μ_k) exp(−v/v_c)` (μ_s = 0.5, μ_k = 0.3, v_c = 0.05 m/s) with the
-//! slip bound `g_c = F_c |λ_n|` frozen from the previous level (spec §3, §7). Each step is one
-//! contact problem of spec §5 solved by PDAS with the factorisation of `A` computed once.
+//! slip bound `g_c = F_c |λ_n|` frozen from the previous level (docs/model.md §3, §7). Each step is one
+//! contact problem of docs/model.md §5 solved by PDAS with the factorisation of `A` computed once.
 //!
 //! Printed every 20 steps: time, height of the centre of mass, its velocity, the normal and
 //! friction contact forces (per metre of thickness), kinetic and strain energy and the friction

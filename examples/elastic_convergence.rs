@@ -1,4 +1,4 @@
-//! # Elastic convergence study with a manufactured solution (spec §8)
+//! # Elastic convergence study with a manufactured solution (docs/model.md §8)
 //!
 //! Two bodies bonded along `x = ½` — one isotropic, one fully anisotropic — are loaded so that
 //! `u_k = a_k sin(b_k · x + c_k)` is the exact solution (see `synovia::verification`). P1

@@ -5,7 +5,7 @@
 //! `p(x) = p₀ sqrt(1 − x²/a²)`, `p₀ = 2P/(π a)`, with `1/E* = Σ (1 − ν_i²)/E_i` and
 //! `1/R* = Σ 1/R_i`. The indenter is a half-disc whose top is pushed down; its contact part is
 //! refined toward the contact point by longest-edge bisection. The contact problem
-//! (spec §5) is solved by the chosen solver (default: PDAS, the semismooth Newton method).
+//! (docs/model.md §5) is solved by the chosen solver (default: PDAS, the semismooth Newton method).
 //!
 //! For four refinements the example prints `a`, `p₀` and the L² error of the pressure
 //! profile against the analytic values for the measured `P`, and the solver's iteration
@@ -85,7 +85,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     table("two cylinders (E₁ = 1, E₂ = 3, ν = 0.3, R₁ = R₂ = 1)", &pair);
 
-    // ## Step 3: checks (spec §9 tolerances) on the resolved meshes (≥ 40 nodes across 2a)
+    // ## Step 3: checks (docs/model.md §9 tolerances) on the resolved meshes (≥ 40 nodes across 2a)
     for r in rigid.iter().chain(&pair).filter(|r| 2.0 * r.a_exact / r.h >= 40.0) {
         assert!(r.a_rel_err() < 0.02 && r.p0_rel_err() < 0.02 && r.pressure_l2_err < 0.03, "{r:?}");
     }

@@ -2,13 +2,13 @@
 //!
 //! Two identical cylinders (plane strain, `R = 1`, `E = 1`, `ν = 0.3`, Dundurs `β = 0`) are
 //! pressed together by a push of the upper one's top (step 0, frictionless), then sheared by a
-//! tangential displacement `s(t) = t` of that top that rises level by level (spec §7). Each
+//! tangential displacement `s(t) = t` of that top that rises level by level (docs/model.md §7). Each
 //! level solves the Tresca problem with `g_c = μ |λ_n|` of the previous level and slip measured
-//! from the previous level (spec §3), warm-started from it, with one factorisation of `A` for
+//! from the previous level (docs/model.md §3), warm-started from it, with one factorisation of `A` for
 //! the whole run.
 //!
 //! While `Q < μP` the centre sticks over `|x| ≤ c = a sqrt(1 − Q/(μP))`,
-//! `a = sqrt(4 P R*/(π E*))`, `R* = R/2`, `E* = E/(2(1 − ν²))` (spec §9); at `Q = μP` the
+//! `a = sqrt(4 P R*/(π E*))`, `R* = R/2`, `E* = E/(2(1 − ν²))` (docs/model.md §9); at `Q = μP` the
 //! whole contact slips (gross sliding) and `Q` stops growing. The example prints, per level,
 //! `Q/(μP)`, the measured stick half-width `c`, `c_exact` and the error, then one JSON line,
 //! and writes `out/quasistatic_cm/cm.csv` and the ParaView series `out/quasistatic_cm/cm.pvd`.

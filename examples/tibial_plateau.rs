@@ -6,7 +6,7 @@
 //! scale of this model — is a rigid circle of radius R = 40 mm. The tibia's base is pushed up
 //! against the condyle until the contact force reaches P = 60 N per mm of slice thickness
 //! (≈ 2.5 × body weight over a 30 mm wide condyle); the push is found by a secant iteration on
-//! the prescribed base displacement, each step one unilateral contact solve (spec §3–§5) with
+//! the prescribed base displacement, each step one unilateral contact solve (docs/model.md §3–§5) with
 //! the PDAS solver on a factorisation of `A` computed once.
 //!
 //! For comparison the example prints the Hertz estimate for a cylinder on a cartilage half-space,

@@ -22,7 +22,7 @@
 //! * [`JointModel::run_static`]: one contact problem at time `t` (step 0 of the quasi-static
 //!   scheme: frictionless, or with [`QuasiStaticParams::initial_friction`] a Tresca solve with
 //!   `g_c` from the frictionless pressure);
-//! * [`JointModel::run_quasistatic`]: the quasi-static scheme of spec §7 over the given times;
+//! * [`JointModel::run_quasistatic`]: the quasi-static scheme of docs/model.md §7 over the given times;
 //! * [`JointModel::run_dynamic`]: the semi-implicit Kelvin–Voigt scheme with `dt` and `steps`
 //!   (every body needs a density: a [`KelvinVoigt`] material, [`JointModel::set_density`] or
 //!   [`JointModel::set_dynamic`]);
@@ -817,7 +817,7 @@ impl<const D: usize> JointModel<D> {
         self.run_levels(&[t], |_| Ok(()))
     }
 
-    /// The quasi-static scheme over `times` (spec §7).
+    /// The quasi-static scheme over `times` (docs/model.md §7).
     ///
     /// # Errors
     /// As [`JointModel::run_static`]; bad `times`.

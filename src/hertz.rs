@@ -1,4 +1,4 @@
-//! Hertz and Cattaneo–Mindlin contact problems with closed-form references (spec §9), shared by
+//! Hertz and Cattaneo–Mindlin contact problems with closed-form references (docs/model.md §9), shared by
 //! the examples `hertz2d`, `hertz3d`, `cattaneo_mindlin` and the test suite.
 //!
 //! * 2D Hertz (plane strain): a half-disc of radius `R` pressed by a prescribed displacement of
@@ -79,7 +79,7 @@ pub struct ContactRun {
     pub traction_l2_err: Real,
     /// Cattaneo–Mindlin only: `max (|q| − μ p)` over the contact nodes (≤ 0 up to round-off).
     pub coulomb_excess: Real,
-    /// Largest KKT residual of the solution (spec §5).
+    /// Largest KKT residual of the solution (docs/model.md §5).
     pub kkt: Real,
     /// The computed nodal pressure profile `(radial coordinate, Λ_n)` of the contact nodes,
     /// in contact-node order (for plots against the Hertz curve).

@@ -16,7 +16,7 @@
 //! | [`time`] (`synovia-time`) | load histories, rigid motions, quasi-static and dynamic time stepping |
 //!
 //! See `docs/architecture.md` for the crate graph and the path of data from mesh to solution,
-//! and the specification `spec/model.md` for the equations.
+//! and the specification `docs/model.md` for the equations.
 //!
 //! ## A complete small model
 //!

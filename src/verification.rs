@@ -1,7 +1,7 @@
 //! Verification problems with exact solutions, shared by the examples and the test suite so
 //! that anyone can re-run them on their own machine.
 //!
-//! ## Manufactured solution for bonded multi-body elasticity (spec §8)
+//! ## Manufactured solution for bonded multi-body elasticity (docs/model.md §8)
 //!
 //! On the box `[0, 1]^D`, split at `x = ½` into two bodies bonded along the interface — body
 //! `"iso"` (isotropic) on the left, body `"aniso"` (a fully anisotropic Voigt matrix) on the
@@ -15,7 +15,7 @@
 //! `u₂ = u` on the outer boundary except the right face, the traction `P = C_aniso e(u) n`
 //! there, and on the interface the jump `(C_iso − C_aniso) e(u) n_iso` of the tractions (the
 //! exact solution is smooth, but the stress jumps with the material). The P1 error is
-//! `O(h)` in the energy norm and `O(h²)` in `L²` (spec §8).
+//! `O(h)` in the energy norm and `O(h²)` in `L²` (docs/model.md §8).
 
 use std::sync::Arc;
 

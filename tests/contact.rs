@@ -1,4 +1,4 @@
-//! Contact verification (spec §9) and solver behaviour: Hertz 2D/3D, Cattaneo–Mindlin,
+//! Contact verification (docs/model.md §9) and solver behaviour: Hertz 2D/3D, Cattaneo–Mindlin,
 //! agreement of the solvers, mesh-independence of PDAS, KKT conditions of every solution, and
 //! the error paths.
 

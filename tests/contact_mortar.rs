@@ -1,4 +1,4 @@
-//! Dual mortar contact on non-matching meshes (issue 9, spec §5): the contact patch test in 2D
+//! Dual mortar contact on non-matching meshes (issue 9, docs/model.md §5): the contact patch test in 2D
 //! and 3D (exact to round-off, both choices of the slave side, node-to-segment / node-to-facet
 //! on the same meshes for comparison), Hertz on non-matching meshes in 2D and 3D, and every
 //! solver on mortar operators. Numbers printed with `--nocapture` are the ones quoted in

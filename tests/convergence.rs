@@ -1,5 +1,5 @@
 //! Manufactured-solution convergence of the bonded two-body (isotropic + anisotropic) elastic
-//! problem over four refinements in 2D and 3D (spec §8): energy-norm rate ≥ 0.95, L² rate ≥ 1.9
+//! problem over four refinements in 2D and 3D (docs/model.md §8): energy-norm rate ≥ 0.95, L² rate ≥ 1.9
 //! between every pair of consecutive meshes.
 
 use synovia::verification::{bonded_mms, rates, ConvergenceRow};

@@ -1,4 +1,4 @@
-//! Semi-coercive bodies (spec §4, issue 7): bodies without Dirichlet data, held only by
+//! Semi-coercive bodies (docs/model.md §4, issue 7): bodies without Dirichlet data, held only by
 //! contact. Solved by the proximal-point iteration of `synovia_contact::floating` when the load
 //! presses them into contact; rejected with a typed error when it pulls them away or slides
 //! them off. References: the exact uniform-compression state (patch test) and Hertz theory.

@@ -5,7 +5,7 @@ use thiserror::Error;
 use synovia_fem::FemError;
 use synovia_mesh::MeshError;
 
-/// One line of a solver's residual history (spec §5 residuals).
+/// One line of a solver's residual history (docs/model.md §5 residuals).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct IterationResidual {
     /// Iteration number (1-based).
@@ -72,7 +72,7 @@ pub enum ContactError {
         /// Size of the system.
         size: usize,
     },
-    /// Bodies held only by contact (semi-coercive, spec §4) carry a load whose rigid part no
+    /// Bodies held only by contact (semi-coercive, docs/model.md §4) carry a load whose rigid part no
     /// admissible contact force balances: the load pulls them away from, or slides them off,
     /// their contact partners.
     #[error("bodies {bodies:?} are held only by contact, and contact forces cannot balance their load (unbalanced rigid-body load {residual:.3e} of {load:.3e}): the load pulls them away or slides them off; add Dirichlet or symmetry data, friction, or change the load")]

@@ -1,4 +1,4 @@
-//! Semi-coercive contact problems (spec §4): bodies that only the contact holds.
+//! Semi-coercive contact problems (docs/model.md §4): bodies that only the contact holds.
 //!
 //! A body without Dirichlet data (a floating patella, an implant held by contact alone) leaves
 //! rigid motions `R` (the kernel of `A`) free. The contact problem

@@ -1,4 +1,4 @@
-//! Friction laws `F_c(x, |[u'_t]|)` (spec §3): the Coulomb coefficient, possibly depending on
+//! Friction laws `F_c(x, |[u'_t]|)` (docs/model.md §3): the Coulomb coefficient, possibly depending on
 //! the slip speed (static-to-kinetic decrease). User-replaceable through [`FrictionLaw`].
 
 use std::fmt;
@@ -19,7 +19,7 @@ impl FrictionLaw for ConstantFriction {
     }
 }
 
-/// The exponential static-to-kinetic law `F_c(v) = μ_k + (μ_s − μ_k) exp(−v / v_c)` (spec §3,
+/// The exponential static-to-kinetic law `F_c(v) = μ_k + (μ_s − μ_k) exp(−v / v_c)` (docs/model.md §3,
 /// the report's Fig. 1): `μ_s` at rest, decreasing to `μ_k` over the characteristic speed `v_c`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ExponentialFriction {

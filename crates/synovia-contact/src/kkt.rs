@@ -1,4 +1,4 @@
-//! A checker of the KKT (complementarity) conditions of spec §5 for any returned solution.
+//! A checker of the KKT (complementarity) conditions of docs/model.md §5 for any returned solution.
 
 use crate::problem::ContactProblem;
 
@@ -49,7 +49,7 @@ pub(crate) fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |a, b| a.max(b.abs()))
 }
 
-/// Evaluates the KKT conditions of spec §5 for `(U, Λ_n, Λ_t)`.
+/// Evaluates the KKT conditions of docs/model.md §5 for `(U, Λ_n, Λ_t)`.
 pub fn check_kkt(problem: &ContactProblem<'_>, u: &[f64], lambda_n: &[f64], lambda_t: &[f64]) -> KktReport {
     let n = problem.matrix.n();
     let mut r = vec![0.0; n];

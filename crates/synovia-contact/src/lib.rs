@@ -1,9 +1,9 @@
 //! # synovia-contact
 //!
 //! Unilateral contact with Coulomb friction frozen to Tresca friction at each time level
-//! (spec §3–§5): the discrete operators `B_hn` (normal, one row per contact node) and `B_Ht`
+//! (docs/model.md §3–§5): the discrete operators `B_hn` (normal, one row per contact node) and `B_Ht`
 //! (tangential, per friction cell), the lumped weights `κ`, the gaps `d` and the slip bounds
-//! `g_c`; the algebraic [`ContactProblem`] of spec §5
+//! `g_c`; the algebraic [`ContactProblem`] of docs/model.md §5
 //!
 //! ```text
 //! A U + B_hnᵀ diag(κ) Λ_n + B_Htᵀ Λ_t − F = 0
@@ -17,7 +17,7 @@
 //! the geometry can be rebuilt at every pose ([`operators::ContactGeometry::new_deformed`],
 //! [`StaticContact::update_geometry`]).
 //!
-//! its condensation on the contact interface ([`Interface`], spec §6.4), the
+//! its condensation on the contact interface ([`Interface`], docs/model.md §6.4), the
 //! [`ContactSolver`] trait implemented by `synovia-pdas` and `synovia-uzawa`, and the KKT checker
 //! [`check_kkt`].
 #![warn(missing_docs)]

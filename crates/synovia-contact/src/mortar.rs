@@ -1,4 +1,4 @@
-//! Dual (biorthogonal) mortar coupling of non-matching contact surfaces (spec §5, beyond the
+//! Dual (biorthogonal) mortar coupling of non-matching contact surfaces (docs/model.md §5, beyond the
 //! report's node-to-node case; Wohlmuth 2000, Hüeber–Wohlmuth 2005; the 3D segmentation of
 //! Puso–Laursen 2004 and Popp–Gee–Wall 2009/2010).
 //!
@@ -37,7 +37,7 @@
 //! # The constraint rows
 //!
 //! The dual basis makes `D` diagonal, so the mortar multiplier condenses node by node and each
-//! slave node `j` gives one constraint row of the per-contact-node form of spec §5
+//! slave node `j` gives one constraint row of the per-contact-node form of docs/model.md §5
 //! (`(B_hn U)_r ≤ d_r` with the node weight `κ_r`):
 //!
 //! ```text
@@ -46,11 +46,11 @@
 //! ```
 //!
 //! `n_j` is the outward nodal normal of the slave surface (as for a conforming pair). The rows
-//! enter `B_hn`, `κ` and `d` of spec §5 unchanged, so the PDAS / semismooth Newton, AU-PDAS and
-//! Uzawa–MPRGP systems of spec §6 keep their form. The nodal
+//! enter `B_hn`, `κ` and `d` of docs/model.md §5 unchanged, so the PDAS / semismooth Newton, AU-PDAS and
+//! Uzawa–MPRGP systems of docs/model.md §6 keep their form. The nodal
 //! forces `B_hnᵀ diag(κ) Λ_n` are then `D_jj Λ_j n_j` on slave node `j` and
 //! `−Σ_j M_jk Λ_j n_j` on master node `k`: a uniform pressure is passed exactly. Friction rows
-//! (spec §5, `B_Ht`) use the same weights in the slave tangent basis:
+//! (docs/model.md §5, `B_Ht`) use the same weights in the slave tangent basis:
 //! `g_{c,j} D_jj T_jᵀ (u_j − Σ_k w_jk u_k)`.
 //!
 //! # Boundary of the slave surface

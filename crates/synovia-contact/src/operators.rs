@@ -1,4 +1,4 @@
-//! Contact pairs and the discrete contact operators of spec §5.
+//! Contact pairs and the discrete contact operators of docs/model.md §5.
 //!
 //! A [`ContactPair`] joins the contact part of a body `k` either to the contact part of another
 //! body `l` with nodes at matching positions (node-to-node, the conforming case of the report),
@@ -8,7 +8,7 @@
 //! described by a signed-distance function (the foundation case). For every contact node `s_r`
 //! of body `k` [`ContactGeometry`] stores
 //!
-//! * the normal `n_r` (the outward nodal normal `n^k` of body `k`, spec §1, or a fixed
+//! * the normal `n_r` (the outward nodal normal `n^k` of body `k`, docs/model.md §1, or a fixed
 //!   direction; for node-to-segment the master facet's outward normal negated), and an
 //!   orthonormal tangent basis,
 //! * the lumped weight `κ_r = ∫_{Γ_c} φ_r ds` (row sums of the boundary mass of part `k`),
@@ -22,7 +22,7 @@
 //! [`ContactGeometry::friction_constraints`] builds `B_Ht` on the dual cells of the contact nodes:
 //! `(B_Ht U)_r = g_{c,r} κ_r T_rᵀ [U_t](s_r)`, the cell integral `∫_{cell r} g_c [U_t] ds` with the
 //! nodal (lumped) rule, `T_r` the tangent basis (one vector in 2D, two in 3D), for the cells with
-//! `g_{c,r} > 0` only (spec §5: `λ_t` vanishes outside `supp g_c`).
+//! `g_{c,r} > 0` only (docs/model.md §5: `λ_t` vanishes outside `supp g_c`).
 //!
 //! In 3D the report puts `λ_t` on the triangles `Δ_H` of a separate contact triangulation of
 //! size `H`; with `H = h` one 2-vector per contact triangle gives about twice as many
@@ -45,7 +45,7 @@
 //!   [`ContactNode::master`]), `[u_n] = (u_k − Σ_j w_j u_{l,j}) · n`,
 //!   `d = (x_m − x_s) · n` (the signed distance, negative if `x_s` is inside body `l`);
 //! * the tangent basis of `n` and the weight `κ_s` from the slave facets (the multipliers live
-//!   on the slave side, spec §5).
+//!   on the slave side, docs/model.md §5).
 //!
 //! Slave nodes without a master facet — farther than the pair's search distance, facing no
 //! master facet, or beyond the rim of the master part — are left out of the pair; they can
@@ -302,7 +302,7 @@ impl<const D: usize> SignedDistance<D> for FnObstacle<D> {
 /// Which normal a node-to-node pair uses.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum NormalChoice<const D: usize> {
-    /// The outward nodal normal `n^k` of body `k` (spec §1; default).
+    /// The outward nodal normal `n^k` of body `k` (docs/model.md §1; default).
     BodyK,
     /// A fixed unit direction from body `k` toward body `l` for every node.
     Fixed(Vector<D>),
@@ -356,7 +356,7 @@ pub enum Partner<const D: usize> {
     },
 }
 
-/// A contact pair `Γ_c^{kl}` (spec §1, §3).
+/// A contact pair `Γ_c^{kl}` (docs/model.md §1, §3).
 #[derive(Debug, Clone)]
 pub struct ContactPair<const D: usize> {
     /// Name for reports and errors.
@@ -400,7 +400,7 @@ impl<const D: usize> ContactPair<D> {
             friction: 0.0,
         }
     }
-    /// Body–body pair on non-matching meshes coupled by **dual mortar** (2D and 3D; spec §5,
+    /// Body–body pair on non-matching meshes coupled by **dual mortar** (2D and 3D; docs/model.md §5,
     /// [`crate::mortar`]): `part_k` of body `k` is the slave side, `part_l` of body `l` the
     /// master side; no search-distance limit (see [`ContactPair::with_search_distance`]).
     /// Passes the contact patch test exactly on non-matching meshes.
@@ -1134,14 +1134,14 @@ impl<const D: usize> ContactGeometry<D> {
             .collect()
     }
 
-    /// Tresca slip bounds `g_{c,r} = F_c |Λ_n,r|` from nodal pressures (spec §3).
+    /// Tresca slip bounds `g_{c,r} = F_c |Λ_n,r|` from nodal pressures (docs/model.md §3).
     pub fn slip_bounds_from_pressure(&self, lambda_n: &[Real]) -> Vec<Real> {
         self.nodes.iter().zip(lambda_n).map(|(n, l)| n.friction * l.abs()).collect()
     }
 
     /// `B_Ht` for the slip bounds `g_c` (one per contact node; cells with `g_c = 0` are left out),
     /// with the shift `s = B_Ht (U_prev − u_p)` of incremental slip when the previous nodal
-    /// displacements `previous[body][node]` are given (spec §3: slip measured from the previous
+    /// displacements `previous[body][node]` are given (docs/model.md §3: slip measured from the previous
     /// time level).
     pub fn friction_constraints(
         &self,

@@ -1,5 +1,5 @@
-//! The algebraic contact problem of spec §5 and its condensation on the contact interface
-//! (spec §6.4).
+//! The algebraic contact problem of docs/model.md §5 and its condensation on the contact interface
+//! (docs/model.md §6.4).
 //!
 //! ```text
 //! A U + B_hnᵀ diag(κ) Λ_n + B_Htᵀ Λ_t − F = 0
@@ -52,7 +52,7 @@ impl FrictionConstraints {
     }
 }
 
-/// One contact problem of spec §5: `A`, its factorisation, `F`, and the contact operators.
+/// One contact problem of docs/model.md §5: `A`, its factorisation, `F`, and the contact operators.
 #[derive(Debug, Clone, Copy)]
 pub struct ContactProblem<'a> {
     /// `A` (stiffness, or the time-step matrix), reduced unknowns.
@@ -331,7 +331,7 @@ impl<'a> ContactProblem<'a> {
             .collect()
     }
 
-    /// The multipliers of spec §5 from force multipliers: `Λ_n = ν_n / κ`, `Λ_t = ν_t`.
+    /// The multipliers of docs/model.md §5 from force multipliers: `Λ_n = ν_n / κ`, `Λ_t = ν_t`.
     pub fn split_multipliers(&self, nu: &[f64]) -> (Vec<f64>, Vec<f64>) {
         let m = self.n_normal();
         let ln = nu[..m].iter().zip(&self.normal.weights).map(|(v, k)| v / k).collect();
@@ -340,7 +340,7 @@ impl<'a> ContactProblem<'a> {
 }
 
 /// Lazily evaluated interface Schur complement `S = C A⁻¹ Cᵀ` and the interface load
-/// `w = C A⁻¹ F` (spec §6.4).
+/// `w = C A⁻¹ F` (docs/model.md §6.4).
 #[derive(Debug)]
 pub struct Interface<'a> {
     problem: ContactProblem<'a>,

@@ -52,7 +52,7 @@ pub struct SolverReport {
     pub fallback: Option<String>,
 }
 
-/// A solution of the contact problem of spec §5.
+/// A solution of the contact problem of docs/model.md §5.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ContactSolution {
     /// Displacement `U` (reduced unknowns).
@@ -66,7 +66,7 @@ pub struct ContactSolution {
     pub report: SolverReport,
 }
 
-/// A solver of the contact problem of spec §5 (frictionless or Tresca).
+/// A solver of the contact problem of docs/model.md §5 (frictionless or Tresca).
 ///
 /// Implemented by the PDAS and AU-PDAS solvers (`synovia-pdas`) and the Uzawa solvers
 /// (`synovia-uzawa`). `warm_start` (a previous solution of a nearby problem with the same

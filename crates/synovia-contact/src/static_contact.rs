@@ -1,5 +1,5 @@
 //! Static contact problems of a [`Model`]: one elastic factorisation, the contact operators of
-//! every pair, and any [`ContactSolver`] (spec §4–§6).
+//! every pair, and any [`ContactSolver`] (docs/model.md §4–§6).
 //!
 //! [`StaticContact`] factorises `A` once; each [`StaticContact::solve`] assembles the load and
 //! the lifts of prescribed displacements at the requested time, builds `B_hn` (and `B_Ht` for
@@ -47,7 +47,7 @@ pub struct StaticContactResult<const D: usize> {
     pub cell_node: Vec<usize>,
     /// `g_c` of each friction cell.
     pub slip_bound: Vec<Real>,
-    /// The KKT residuals of the returned solution (spec §5).
+    /// The KKT residuals of the returned solution (docs/model.md §5).
     pub kkt: KktReport,
     /// Solver iterations spent on the coarse levels of the nested iteration (0 if none).
     pub coarse_iterations: usize,
@@ -59,7 +59,7 @@ pub struct StaticContactResult<const D: usize> {
 impl<const D: usize> StaticContact<D> {
     /// Factorises the model's stiffness and builds the contact nodes of `pairs`.
     ///
-    /// Bodies that no Dirichlet or symmetry data hold (semi-coercive, spec §4) are accepted:
+    /// Bodies that no Dirichlet or symmetry data hold (semi-coercive, docs/model.md §4) are accepted:
     /// the factorisation is then of `A + S` ([`ElasticSolver::new_semi_coercive`]) and
     /// [`StaticContact::solve`] runs the proximal-point iteration of [`crate::floating`].
     pub fn new(

@@ -447,7 +447,7 @@ fn add_nodal<const D: usize>(dofs: &DofMap<D>, b: usize, node: usize, f: &Vector
     }
 }
 
-/// Adds the load `(f, v) = ∫ F · v dx + ∫_{¹Γ_τ} P · v ds` at time `t` (spec §2) to the
+/// Adds the load `(f, v) = ∫ F · v dx + ∫_{¹Γ_τ} P · v ds` at time `t` (docs/model.md §2) to the
 /// reduced right-hand side, with quadrature of degree `degree`.
 pub fn add_loads<const D: usize>(
     model: &Model<D>,

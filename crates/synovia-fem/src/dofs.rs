@@ -1,4 +1,4 @@
-//! Degrees of freedom and linear constraints (spec §1, §4: `V = u₂ + V_0`).
+//! Degrees of freedom and linear constraints (docs/model.md §1, §4: `V = u₂ + V_0`).
 //!
 //! Every node carries `D` displacement components. Bonded interfaces merge coincident nodes
 //! into one *node group*; every group collects the linear constraints of the boundary parts its
@@ -12,7 +12,7 @@
 //!
 //! with `ũ ∈ R^{D − rank C}` the group's free (reduced) unknowns. The reduced stiffness
 //! `Ñ ᵀ K Ñ` is symmetric positive definite whenever no rigid motion satisfies the constraints,
-//! which [`DofMap::check_coercive`] verifies from the data (spec §4). Constraints along normals
+//! which [`DofMap::check_coercive`] verifies from the data (docs/model.md §4). Constraints along normals
 //! that are not coordinate axes need no special treatment.
 
 use std::collections::BTreeSet;
@@ -357,7 +357,7 @@ impl<const D: usize> DofMap<D> {
     }
 
     /// Checks that no rigid motion of any connected set of bodies satisfies the homogeneous
-    /// constraints (spec §4, coercivity): [`DofMap::floating_components`] must be empty.
+    /// constraints (docs/model.md §4, coercivity): [`DofMap::floating_components`] must be empty.
     pub fn check_coercive(&self, model: &Model<D>) -> Result<(), FemError> {
         match self.floating_components(model).into_iter().next() {
             None => Ok(()),
@@ -366,7 +366,7 @@ impl<const D: usize> DofMap<D> {
     }
 
     /// The rigid motions left free by the homogeneous constraints, per connected set of
-    /// bodies (bodies joined by bonded interfaces): the kernel of `K̃` (spec §4,
+    /// bodies (bodies joined by bonded interfaces): the kernel of `K̃` (docs/model.md §4,
     /// semi-coercive problems).
     ///
     /// A rigid motion `r(x) = a + W (x − x̄)` (`W` skew) is unrestrained if `c_jᵀ r(x_j) = 0`
@@ -471,7 +471,7 @@ impl<const D: usize> DofMap<D> {
     }
 }
 
-/// A connected set of bodies whose constraints leave rigid motions free (spec §4,
+/// A connected set of bodies whose constraints leave rigid motions free (docs/model.md §4,
 /// semi-coercive): the kernel of `K̃` restricted to it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FloatingComponent {

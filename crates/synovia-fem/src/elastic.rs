@@ -1,4 +1,4 @@
-//! The linear elastic solve (spec §4 without contact): `K̃ ũ = F̃(t)` with the reduced stiffness
+//! The linear elastic solve (docs/model.md §4 without contact): `K̃ ũ = F̃(t)` with the reduced stiffness
 //! `K̃ = Pᵀ K P`, factorised once by sparse Cholesky and reused for any number of load cases
 //! and times.
 
@@ -105,7 +105,7 @@ pub struct ElasticSolver<const D: usize> {
     stabilisation: Option<Stabilisation>,
 }
 
-/// The regularisation of a semi-coercive model (spec §4): the floating components, the
+/// The regularisation of a semi-coercive model (docs/model.md §4): the floating components, the
 /// diagonal spring `S` on their unknowns, and `A + S` (which is what the factorisation holds).
 ///
 /// `S_ii = ε A_ii` on the unknowns of every floating component (`ε` =
@@ -134,7 +134,7 @@ impl Stabilisation {
 }
 
 impl<const D: usize> ElasticSolver<D> {
-    /// Validates the model, builds the dofs, checks coercivity (spec §4), assembles `K̃`, and
+    /// Validates the model, builds the dofs, checks coercivity (docs/model.md §4), assembles `K̃`, and
     /// factorises it.
     pub fn new(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
         Self::build(model, params, false, &[])
@@ -144,7 +144,7 @@ impl<const D: usize> ElasticSolver<D> {
     /// the reduced dofs of the `interface` nodes (the nodes of the contact parts, in priority
     /// order) are ordered last ([`Ordering::Trailing`]), so that the interface Schur complement
     /// `S = C A⁻¹ Cᵀ` is evaluated with the dense trailing block `L₂₂` of the factor,
-    /// `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4), instead of solves with the whole factor
+    /// `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (docs/model.md §6.4), instead of solves with the whole factor
     /// ([`CholeskySolver::trailing`]). When the interface has more than
     /// [`ElasticParams::max_trailing_dofs`] dofs, only the longest prefix of `interface` with at
     /// most [`ElasticParams::screened_trailing_dofs`] dofs is ordered last (the contact solve
@@ -158,7 +158,7 @@ impl<const D: usize> ElasticSolver<D> {
     }
 
     /// Like [`ElasticSolver::new`], but a semi-coercive model (bodies whose rigid motions no
-    /// Dirichlet or symmetry data restrain, spec §4) is accepted: the factorisation is of
+    /// Dirichlet or symmetry data restrain, docs/model.md §4) is accepted: the factorisation is of
     /// `A + S` with the [`Stabilisation`] spring `S` on the floating components, for contact
     /// problems whose contact conditions hold those bodies. [`ElasticSolver::solve`] still
     /// refuses such a model ([`FemError::SemiCoercive`]): without contact it has no unique

@@ -125,7 +125,7 @@ fn b_entry<const D: usize>(g: &Vector<D>, r: usize, i: usize) -> Real {
 }
 
 /// Element stiffness `K_T = |T| Bᵀ C B` of the bilinear form
-/// `a(u, v) = ∫_T C e(u) : e(v) dx` (spec §2), for a constant Voigt stiffness `C`
+/// `a(u, v) = ∫_T C e(u) : e(v) dx` (docs/model.md §2), for a constant Voigt stiffness `C`
 /// (`voigt_len(D)` square, engineering-shear convention). Written into `out`, a
 /// `D(D+1) × D(D+1)` row-major buffer, node-major dof order.
 pub fn stiffness_into<const D: usize>(geo: &SimplexGeometry<D>, c: &DMatrix<Real>, out: &mut [Real]) {
@@ -190,7 +190,7 @@ pub fn lumped_mass_into<const D: usize>(geo: &SimplexGeometry<D>, rho: Real, out
     out[..D * (D + 1)].iter_mut().for_each(|x| *x = m);
 }
 
-/// Mass element matrix with coefficient `c` (`ρ` for `M_ρ`, `α` for `M_α`, spec §7):
+/// Mass element matrix with coefficient `c` (`ρ` for `M_ρ`, `α` for `M_α`, docs/model.md §7):
 /// consistent ([`consistent_mass_into`]) or row-sum lumped (diagonal), into `out`
 /// (`D(D+1)` square, row-major).
 pub fn mass_into<const D: usize>(geo: &SimplexGeometry<D>, c: Real, lumped: bool, out: &mut [Real]) {

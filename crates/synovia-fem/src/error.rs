@@ -76,7 +76,7 @@ pub enum FemError {
     /// Nodes of a tied (bonded) interface have no partner at the same position.
     #[error("{0}")]
     UnmatchedInterface(Box<UnmatchedInterface>),
-    /// Some bodies are not held against rigid motion (spec §4): the elastic problem is
+    /// Some bodies are not held against rigid motion (docs/model.md §4): the elastic problem is
     /// semi-coercive and its stiffness matrix singular.
     #[error("bodies {bodies:?} are semi-coercive: {free_modes} rigid-body mode(s) are not restrained by Dirichlet or symmetry data; add boundary conditions or solve it as a contact problem")]
     SemiCoercive {

@@ -1,6 +1,6 @@
 //! # synovia-fem
 //!
-//! P1 finite elements for multi-body linear elasticity (spec §1–§2, §4–§5): element kernels,
+//! P1 finite elements for multi-body linear elasticity (docs/model.md §1–§2, §4–§5): element kernels,
 //! constraints, assembly into a fixed sparse pattern, and the sparse Cholesky solve.
 //!
 //! The bilinear form is `a(u, v) = Σ_ι ∫_{Ω^ι} C e(u) : e(v) dx` and the load

@@ -1,5 +1,5 @@
 //! The description of a multi-body elastic problem: bodies (mesh + material), boundary data by
-//! part name, bonded interfaces and body forces (spec §1–§2).
+//! part name, bonded interfaces and body forces (docs/model.md §1–§2).
 
 use std::fmt;
 use std::sync::Arc;
@@ -21,7 +21,7 @@ pub type TractionField<const D: usize> = Arc<dyn Fn(&Point<D>, &Vector<D>, Real)
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct BodyId(pub usize);
 
-/// One body `Ω^ι`: its own mesh and its own material (spec §1).
+/// One body `Ω^ι`: its own mesh and its own material (docs/model.md §1).
 pub struct Body<const D: usize> {
     /// Name, unique in the model.
     pub name: String,
@@ -106,7 +106,7 @@ pub struct Tie {
     pub tolerance: Option<Real>,
 }
 
-/// A multi-body linear elastic problem (spec §1–§2, §4): bodies with materials and the data of
+/// A multi-body linear elastic problem (docs/model.md §1–§2, §4): bodies with materials and the data of
 /// their boundary parts.
 ///
 /// Parts of kind [`BoundaryKind::Clamped`] are clamped and parts of kind

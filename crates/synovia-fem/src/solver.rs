@@ -49,7 +49,7 @@ pub enum Ordering {
 }
 
 /// The trailing block of a factorisation with [`Ordering::Trailing`]: with the dofs `c` ordered
-/// last, `P A Pᵀ = L Lᵀ` gives `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (spec §6.4: the interface Schur
+/// last, `P A Pᵀ = L Lᵀ` gives `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (docs/model.md §6.4: the interface Schur
 /// complement needs no solve with the whole factor).
 #[derive(Debug, Clone)]
 pub struct TrailingBlock {
@@ -272,7 +272,7 @@ impl CholeskySolver {
     /// about half the cost of [`CholeskySolver::solve_in_place`]: with `P A Pᵀ = L Lᵀ` and
     /// `P b = (0, b_c)`, the forward substitution is `y = (0, L₂₂⁻¹ b_c)` (dense, size
     /// `k = |c|`), and only the backward substitution `Lᵀ P x = y` runs over the whole factor
-    /// (spec §6.4). Falls back to the full solve when there is no trailing block or `b` has
+    /// (docs/model.md §6.4). Falls back to the full solve when there is no trailing block or `b` has
     /// entries outside `c`.
     ///
     /// # Errors

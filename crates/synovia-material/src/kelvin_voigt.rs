@@ -1,11 +1,11 @@
-//! The Kelvin–Voigt viscoelastic law `τ = C⁽⁰⁾ e(u) + C⁽¹⁾ e(u')` of spec §2.
+//! The Kelvin–Voigt viscoelastic law `τ = C⁽⁰⁾ e(u) + C⁽¹⁾ e(u')` of docs/model.md §2.
 
 use std::sync::Arc;
 
 use crate::voigt::{check_finite, check_positive_semidefinite, check_size, voigt_pairs};
 use crate::{check_admissible, voigt_len, LinearElastic, Material, MaterialError, VoigtMatrix, VoigtVector};
 
-/// A Kelvin–Voigt viscoelastic body material (spec §2):
+/// A Kelvin–Voigt viscoelastic body material (docs/model.md §2):
 ///
 /// ```text
 /// τ = C⁽⁰⁾ e(u) + C⁽¹⁾ e(u'),

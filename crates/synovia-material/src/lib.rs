@@ -2,9 +2,9 @@
 //!
 //! Constitutive laws for synovia's bodies (bone, cartilage, menisci, ...): linear elastic
 //! materials of any symmetry class in 2D and 3D, and the Kelvin–Voigt viscoelastic law of
-//! spec §2.
+//! docs/model.md §2.
 //!
-//! ## Constitutive laws (spec §2)
+//! ## Constitutive laws (docs/model.md §2)
 //!
 //! For an elastic body the stress `τ` depends on the small-strain tensor
 //! `e(u) = ½(∇u + ∇uᵀ)` through
@@ -116,7 +116,7 @@ pub trait Material<const D: usize>: Send + Sync + std::fmt::Debug {
     /// (the constant `C` for linear materials).
     fn tangent(&self, strain: &VoigtVector) -> VoigtMatrix;
 
-    /// Strain energy density `Φ(e)`, the potential of spec §2 with `τ = ∂Φ/∂e`
+    /// Strain energy density `Φ(e)`, the potential of docs/model.md §2 with `τ = ∂Φ/∂e`
     /// (`Φ = ½ εᵀ C ε` for linear materials).
     fn energy_density(&self, strain: &VoigtVector) -> f64;
 

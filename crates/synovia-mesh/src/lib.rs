@@ -4,7 +4,7 @@
 //! (tetrahedra), generic over the dimension `const D: usize`.
 //!
 //! A [`Mesh`] holds node coordinates, cells and named [`BoundaryPart`]s of the kinds of
-//! spec §1 ([`BoundaryKind`]: prescribed `u₂(t)`, clamped, traction `P(t)`, traction free,
+//! docs/model.md §1 ([`BoundaryKind`]: prescribed `u₂(t)`, clamped, traction `P(t)`, traction free,
 //! symmetry `Γ₀`, contact). Every cell is positively oriented, which the constructors check
 //! (and [`Mesh::new_with_repair`] enforces). Boundary facets carry the outward orientation, so
 //! [`Mesh::facet_normal`] is the outward unit normal `n` and [`Mesh::nodal_normals`] the

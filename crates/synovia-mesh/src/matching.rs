@@ -1,6 +1,6 @@
 //! Pairing of nodes at equal positions, for bonded (tied) interfaces and node-to-node contact.
 //!
-//! Two bodies meshed with matching interface nodes (spec §5, the conforming case) have, on their
+//! Two bodies meshed with matching interface nodes (docs/model.md §5, the conforming case) have, on their
 //! common boundary, pairs of nodes at the same position. [`match_nodes`] finds those pairs with a
 //! hash grid in `O(n)` expected time.
 

@@ -8,7 +8,7 @@ use crate::math::{factorial, is_supported_dim, simplex_det, Point, Real, Vector}
 /// Relative determinant below which a cell counts as degenerate (`|det| / h^D`).
 pub const DEGENERACY_TOLERANCE: Real = 1e-12;
 
-/// The kind of a boundary part, following spec §1.
+/// The kind of a boundary part, following docs/model.md §1.
 ///
 /// The mesh only records *where* each part is and *what kind* it is; the data (`u₂(t)`, `P(t)`,
 /// the contact partner) are given by the problem that uses the mesh, keyed by the part's name.

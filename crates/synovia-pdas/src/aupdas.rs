@@ -1,4 +1,4 @@
-//! The alternating Uzawa–PDAS method (AU-PDAS) of spec §6.2.
+//! The alternating Uzawa–PDAS method (AU-PDAS) of docs/model.md §6.2.
 
 use std::time::Instant;
 
@@ -9,7 +9,7 @@ use synovia_contact::{
 
 use crate::sets::{finish, CellState, Sets, State};
 
-/// Alternating Uzawa–PDAS (AU-PDAS) of spec §6.2 for the contact problem of spec §5:
+/// Alternating Uzawa–PDAS (AU-PDAS) of docs/model.md §6.2 for the contact problem of docs/model.md §5:
 /// a PDAS step on the normal part with the friction multiplier frozen, then a PDAS/Uzawa step
 /// on the tangential part with the normal multiplier frozen.
 ///

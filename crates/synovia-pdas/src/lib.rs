@@ -1,13 +1,13 @@
 //! # synovia-pdas
 //!
-//! Primal–dual active set solvers (spec §6.1–§6.2) for the contact problem of spec §5,
+//! Primal–dual active set solvers (docs/model.md §6.1–§6.2) for the contact problem of docs/model.md §5,
 //! frictionless or with Tresca friction, in 2D and 3D:
 //!
 //! * [`Pdas`] — the primal–dual active set method, i.e. a semismooth Newton method applied
 //!   to the complementarity (NCP) formulation (Hintermüller, Ito & Kunisch, *SIAM J. Optim.*
 //!   13 (2003); Hüeber & Wohlmuth, *CMAME* 194 (2005)); in 3D the slip condition on the disc is
 //!   linearised as in Hüeber, Stadler & Wohlmuth, *SIAM J. Sci. Comput.* 30 (2008);
-//! * [`AuPdas`] — the alternating Uzawa–PDAS of spec §6.2 (normal PDAS step with the friction
+//! * [`AuPdas`] — the alternating Uzawa–PDAS of docs/model.md §6.2 (normal PDAS step with the friction
 //!   multiplier frozen, then tangential step with the pressure frozen).
 //!
 //! Both implement [`synovia_contact::ContactSolver`].
@@ -21,7 +21,7 @@
 //! ```
 //!
 //! with `(·)⁺ = max(·, 0)` and `π` the projection onto `[−1, 1]` (2D) or the unit disc (3D).
-//! Both solvers work on the contact interface (spec §6.4): with the force multipliers
+//! Both solvers work on the contact interface (docs/model.md §6.4): with the force multipliers
 //! `ν = (κ Λ_n, Λ_t)` and `C = [B_hn; B_Ht]`,
 //!
 //! ```text

@@ -11,7 +11,7 @@ use synovia_contact::{
 use crate::sets::{finish, CellState, Sets, State};
 
 /// Primal–dual active set method (PDAS) = semismooth Newton method for the contact problem of
-/// spec §5 (frictionless or Tresca, 2D or 3D), condensed on the contact interface.
+/// docs/model.md §5 (frictionless or Tresca, 2D or 3D), condensed on the contact interface.
 ///
 /// With the force multipliers `ν = (κ Λ_n, Λ_t)`, the interface values `y(ν) = w − S ν`
 /// (`S = C A⁻¹ Cᵀ`, `w = C A⁻¹ F`, `C = [B_hn; B_Ht]`), the offsets `g = (d, s)` and the

@@ -1,11 +1,11 @@
-//! The dynamic semi-implicit Kelvin–Voigt stepper with contact and friction (spec §2, §3, §7).
+//! The dynamic semi-implicit Kelvin–Voigt stepper with contact and friction (docs/model.md §2, §3, §7).
 //!
-//! ## The scheme (spec §7, report Part II (2.16)–(2.22))
+//! ## The scheme (docs/model.md §7, report Part II (2.16)–(2.22))
 //!
 //! With `Δt` the step, `U^i ≈ u(t_i)`, `t_i = t_0 + iΔt`, the mass matrices
 //! `M_ρ = (ρ φ_a, φ_b)`, `M_α = (α φ_a, φ_b)` (consistent or row-sum lumped), the stiffness
 //! `A⁽⁰⁾` of `C⁽⁰⁾` and the viscosity matrix `A⁽¹⁾` of `C⁽¹⁾`, every step solves the contact
-//! problem of spec §5 with
+//! problem of docs/model.md §5 with
 //!
 //! ```text
 //! A = M_ρ + Δt M_α + Δt² A⁽⁰⁾ + Δt A⁽¹⁾
@@ -28,7 +28,7 @@
 //! multipliers of the step problem are `Λ̄_n = Δt² λ_n`: the physical contact pressure is
 //! `λ_n = Λ̄_n / Δt²` and the nodal contact forces are `−B_hnᵀ κ Λ̄_n / Δt²`.
 //!
-//! **Friction on the slip rate** (spec §3): the rate form `j(w) = ∫ g_c |[w_t]| ds` in the
+//! **Friction on the slip rate** (docs/model.md §3): the rate form `j(w) = ∫ g_c |[w_t]| ds` in the
 //! velocity `w = (v − U^i)/Δt`, tested with `(v − U^{i+1})/Δt` and multiplied by `Δt²`
 //! (`j` is positively homogeneous), becomes `Δt² ∫ g_c |[v_t − U^i_t]| ds` in the step problem
 //! with the *physical* slip bound `g_c = F_c(|[u'_t]|) |λ_n|` (force per area). The spec's
@@ -95,7 +95,7 @@ use crate::results::{pair_records, PairRecord, StepRecord};
 /// Largest element matrix size `(D(D+1))²` for `D ≤ 3`.
 const KE_MAX: usize = 144;
 
-/// The inertia and viscosity data of one body for dynamics (spec §2): density `ρ`, damping `α`
+/// The inertia and viscosity data of one body for dynamics (docs/model.md §2): density `ρ`, damping `α`
 /// and the viscosity `C⁽¹⁾` of `τ = C⁽⁰⁾ e(u) + C⁽¹⁾ e(u')`. The elasticity `C⁽⁰⁾` is the
 /// body's material in the [`Model`].
 #[derive(Debug, Clone, PartialEq)]
@@ -103,7 +103,7 @@ pub struct DynamicBody {
     /// Mass density `ρ > 0` (mass per volume; per area in 2D plane strain per unit thickness).
     pub density: Real,
     /// Damping coefficient `α ≥ 0` of the damping force `α u'` per volume, i.e. the bilinear
-    /// form `(α u', v) = ∫ α u'·v dx` of spec §2 (`M_α`). A mass-proportional damping
+    /// form `(α u', v) = ∫ α u'·v dx` of docs/model.md §2 (`M_α`). A mass-proportional damping
     /// `c ρ u'` is `α = c ρ`.
     pub damping: Real,
     /// The viscosity `C⁽¹⁾` (Voigt, `voigt_len(D)` square, symmetric positive semi-definite);
@@ -172,7 +172,7 @@ pub enum MassKind {
     Lumped,
 }
 
-/// Parameters of the dynamic stepper (spec §7).
+/// Parameters of the dynamic stepper (docs/model.md §7).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DynamicParams {
     /// Time step `Δt > 0`.
@@ -186,8 +186,8 @@ pub struct DynamicParams {
     /// Quadrature degree of the load integrals (default 2).
     pub load_degree: usize,
     /// Coulomb fixed-point iterations per step: 0 (default) freezes `g_c` from level `i`
-    /// (spec §7); `k > 0` re-solves up to `k` times with `g_c` from the new level (true Coulomb
-    /// friction at `t_{i+1}`, spec §3) until the relative change of `g_c` is at most
+    /// (docs/model.md §7); `k > 0` re-solves up to `k` times with `g_c` from the new level (true Coulomb
+    /// friction at `t_{i+1}`, docs/model.md §3) until the relative change of `g_c` is at most
     /// [`DynamicParams::coulomb_tolerance`].
     pub coulomb_iterations: usize,
     /// Tolerance of the Coulomb fixed point (default `1e-8`).
@@ -288,8 +288,8 @@ pub struct DynamicInfo {
     pub numeric_s: f64,
 }
 
-/// The dynamic semi-implicit stepper of spec §7 (see the module docs): factorises
-/// `A = M_ρ + Δt M_α + Δt² A⁽⁰⁾ + Δt A⁽¹⁾` once and solves one contact problem of spec §5 per
+/// The dynamic semi-implicit stepper of docs/model.md §7 (see the module docs): factorises
+/// `A = M_ρ + Δt M_α + Δt² A⁽⁰⁾ + Δt A⁽¹⁾` once and solves one contact problem of docs/model.md §5 per
 /// step with any [`ContactSolver`].
 ///
 /// The [`Model`] passed to [`DynamicStepper::step`] must be the one given to
@@ -477,7 +477,7 @@ impl<const D: usize> DynamicStepper<D> {
     }
 
     /// Sets the initial data `u(t_0) = u₀`, `u'(t_0) = u₁` (nodal values per body; `None` = 0)
-    /// and resets the stepper to step 0 (spec §7: `U^{−1} = U^0 − Δt u₁`).
+    /// and resets the stepper to step 0 (docs/model.md §7: `U^{−1} = U^0 − Δt u₁`).
     ///
     /// The constrained components of `U^0` are taken from the prescribed displacements at
     /// `t_0` (the lift `u_p(t_0)`), the free ones from `u₀`; `U^{−1} = U^0 − Δt u₁` is formed
@@ -573,7 +573,7 @@ impl<const D: usize> DynamicStepper<D> {
         Ok(())
     }
 
-    /// Replaces the friction law `F_c(|[u'_t]|)` of the contact pair `pair` (spec §3; default
+    /// Replaces the friction law `F_c(|[u'_t]|)` of the contact pair `pair` (docs/model.md §3; default
     /// `ConstantFriction(pair.friction)`, none for a frictionless pair).
     ///
     /// # Errors

@@ -1,4 +1,4 @@
-//! Load histories and prescribed rigid motions (spec §1, §7: loads `F(t)`, `P(t)` and prescribed
+//! Load histories and prescribed rigid motions (docs/model.md §1, §7: loads `F(t)`, `P(t)` and prescribed
 //! displacements `u₂(t)` that vary in time).
 //!
 //! A [`LoadHistory`] is a scalar amplitude `h(t)`. Loads and prescribed displacements of a
@@ -34,7 +34,7 @@ use synovia_mesh::math::{Point, Real, Vector};
 
 use crate::error::TimeError;
 
-/// A scalar amplitude `h(t)` of a load or prescribed displacement (spec §7).
+/// A scalar amplitude `h(t)` of a load or prescribed displacement (docs/model.md §7).
 pub trait LoadHistory: Send + Sync + fmt::Debug {
     /// `h(t)`.
     fn value(&self, t: Real) -> Real;
@@ -311,7 +311,7 @@ pub fn pressure<const D: usize>(
 /// # Ok::<(), synovia_time::TimeError>(())
 /// ```
 ///
-/// **Small strain.** The model (spec §1) is linear (small-strain) elasticity. The prescribed
+/// **Small strain.** The model (docs/model.md §1) is linear (small-strain) elasticity. The prescribed
 /// field is the exact rigid displacement, so a large `θ` simply gives large displacements, but
 /// the linear strain of a rigid rotation is not zero: `e = sym(R − I) = (cos θ − 1) I` (in the
 /// rotation plane), `O(θ²)`. Keep `θ` small (the strain error is `θ²/2`, about `1.5·10⁻⁴` at

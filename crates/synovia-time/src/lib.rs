@@ -1,6 +1,6 @@
 //! # synovia-time
 //!
-//! Time-varying loads (spec §7): load histories, prescribed rigid motions of boundary parts,
+//! Time-varying loads (docs/model.md §7): load histories, prescribed rigid motions of boundary parts,
 //! the quasi-static stepper (a Tresca contact problem per time level with `g_c` frozen from the
 //! previous level, incremental slip, optional Coulomb fixed point) and the dynamic semi-implicit
 //! Kelvin–Voigt stepper, with per-step results written as CSV and PVD.

@@ -1,17 +1,17 @@
-//! Quasi-static time stepping (spec §7, Part I of the report): inertia is neglected and every
+//! Quasi-static time stepping (docs/model.md §7, Part I of the report): inertia is neglected and every
 //! time level `t_i` is a static contact problem with Tresca friction whose slip bound is frozen
-//! from the previous level (spec §3).
+//! from the previous level (docs/model.md §3).
 //!
 //! # The scheme
 //!
 //! For the times `t_0 < t_1 < … < t_m` ([`QuasiStaticStepper::run`]):
 //!
-//! * **Step 0** (the initial state `u₀`, spec §7): the frictionless contact problem at `t_0`
+//! * **Step 0** (the initial state `u₀`, docs/model.md §7): the frictionless contact problem at `t_0`
 //!   (loads `F(t_0)`, `P(t_0)`, prescribed `u₂(t_0)`). With
 //!   [`QuasiStaticParams::initial_friction`] it is followed by a Tresca solve at `t_0` with
 //!   `g_c = F_c |λ_n|` of that frictionless pre-solve and slip measured from the reference
 //!   (undeformed) state, i.e. friction acting while the initial load is applied in one step.
-//! * **Step i ≥ 1**: the Tresca problem of spec §5 at `t_i`,
+//! * **Step i ≥ 1**: the Tresca problem of docs/model.md §5 at `t_i`,
 //!
 //!   ```text
 //!   A U + B_hnᵀ diag(κ) Λ_n + B_Htᵀ Λ_t − F(t_i) = 0
@@ -20,22 +20,22 @@
 //!   ```
 //!
 //!   with `B_Ht` built on the cells of `supp g_c`, `g_c,r = F_c |Λ_n,r(t_{i−1})|`
-//!   ([`ContactGeometry::slip_bounds_from_pressure`] of the previous level, spec §3, `r = 1`),
-//!   and slip measured from the previous level `U(t_{i−1})` (incremental slip, spec §3; with
+//!   ([`ContactGeometry::slip_bounds_from_pressure`] of the previous level, docs/model.md §3, `r = 1`),
+//!   and slip measured from the previous level `U(t_{i−1})` (incremental slip, docs/model.md §3; with
 //!   [`QuasiStaticParams::incremental_slip`] `= false` the report's total-displacement form
 //!   `Λ_t − π(Λ_t + ρ B_Ht U)` is used instead, slip measured from the reference state).
 //!   The solve is warm-started from the previous level: `U` and `Λ_n` (the normal rows are the
 //!   same at every level) are copied, and `Λ_t` is mapped cell by cell through the contact
 //!   node of each cell ([`StaticContactResult::cell_node`]), since the friction cells
 //!   `supp g_c` change from level to level; new cells start from `Λ_t = 0`.
-//! * **Coulomb fixed point** ([`QuasiStaticParams::coulomb_fixed_point`], spec §3): the level
+//! * **Coulomb fixed point** ([`QuasiStaticParams::coulomb_fixed_point`], docs/model.md §3): the level
 //!   is re-solved with `g_c^{k+1} = F_c |Λ_n^k|` from the current iterate until
 //!   `max_r |g^{k+1}_r − g^k_r| / max_r |g^{k+1}_r| ≤ fixed_point_tolerance`; the accepted
 //!   solution is the last one (computed with `g^k`). After `max_fixed_point` solves without
 //!   convergence the run stops with [`TimeError::FixedPoint`].
 //!
 //! The factorisation of `A` is done once, in [`QuasiStaticStepper::new`], and reused at every
-//! level and fixed-point iteration (spec §7).
+//! level and fixed-point iteration (docs/model.md §7).
 //!
 //! # One level at a time
 //!
@@ -97,7 +97,7 @@ use crate::results::{pair_records, write_csv, StepRecord};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct QuasiStaticParams {
     /// Re-solve each level with `g_c = F_c |Λ_n|` of the current iterate until `g_c` stops
-    /// changing (true Coulomb friction, spec §3). Default `false` (Tresca with `g_c` frozen
+    /// changing (true Coulomb friction, docs/model.md §3). Default `false` (Tresca with `g_c` frozen
     /// from the previous level).
     pub coulomb_fixed_point: bool,
     /// Maximum contact solves per level in the Coulomb fixed point (default 50, ≥ 1).
@@ -105,7 +105,7 @@ pub struct QuasiStaticParams {
     /// Stopping tolerance of the fixed point on the relative change
     /// `max |Δg_c| / max |g_c|` (default `1e-8`, > 0).
     pub fixed_point_tolerance: Real,
-    /// Slip measured from the previous level (default `true`, spec §3); `false`: the report's
+    /// Slip measured from the previous level (default `true`, docs/model.md §3); `false`: the report's
     /// total-displacement form, slip measured from the reference state.
     pub incremental_slip: bool,
     /// Step 0 with friction: after the frictionless solve at `t_0`, solve the Tresca problem at
@@ -146,7 +146,7 @@ impl QuasiStaticParams {
     }
 }
 
-/// The quasi-static stepper of spec §7: owns a [`StaticContact`] (one factorisation of `A`,
+/// The quasi-static stepper of docs/model.md §7: owns a [`StaticContact`] (one factorisation of `A`,
 /// reused at every level) and solves one Tresca contact problem per time level with `g_c`
 /// frozen from the previous level (see the [module documentation](self)).
 #[derive(Debug)]

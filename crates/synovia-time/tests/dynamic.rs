@@ -1,4 +1,4 @@
-//! Tests of the dynamic semi-implicit Kelvin–Voigt stepper (spec §7): discrete energy identity,
+//! Tests of the dynamic semi-implicit Kelvin–Voigt stepper (docs/model.md §7): discrete energy identity,
 //! dissipation by damping and viscosity, a free block dropped on a rigid foundation (no
 //! penetration, momentum = impulse), first-order convergence in time, and a block sliding with
 //! slip-rate-dependent friction that stops.
@@ -475,7 +475,7 @@ fn invalid_data_are_errors() {
     assert_eq!(rec.step, 1);
 }
 
-/// The optional Coulomb fixed point (spec §3): with `g_c` from the new level, friction acts from
+/// The optional Coulomb fixed point (docs/model.md §3): with `g_c` from the new level, friction acts from
 /// the first step without an initial pressure, and on a uniformly slipping block the friction /
 /// normal force ratio is `F_c` of the current slip speed.
 #[test]
@@ -526,7 +526,7 @@ fn coulomb_fixed_point_uses_the_new_level() {
     assert!(checked >= 5, "only {checked} fully slipping steps");
 }
 
-/// Initial data from a static contact problem (spec §7): a block pressed by its prescribed top
+/// Initial data from a static contact problem (docs/model.md §7): a block pressed by its prescribed top
 /// onto a rigid flat is in static equilibrium; started from that state (`u₀` and the pressure
 /// from `StaticContact`, `u₁ = 0`) with constant data, the dynamic scheme stays at rest: with
 /// `U^i = U^{i−1} = u₀` the step equation reduces to the static one.

@@ -1,4 +1,4 @@
-//! Quasi-static time stepping (spec §7): path independence of frictionless contact, energy
+//! Quasi-static time stepping (docs/model.md §7): path independence of frictionless contact, energy
 //! balance of a frictional cycle, Cattaneo–Mindlin under a rising tangential load up to gross
 //! sliding, the Coulomb fixed point, and the CSV/PVD output.
 

@@ -1,5 +1,5 @@
 //! Shared pieces of the two contact solvers: parameter checks, warm starts, the Jacobi scaling
-//! of the dual variables, the residuals of spec §5 and the final solution.
+//! of the dual variables, the residuals of docs/model.md §5 and the final solution.
 
 use synovia_contact::{ContactError, ContactParams, ContactProblem, ContactSolution, SolverReport};
 
@@ -99,7 +99,7 @@ pub(crate) fn normal_bounds(
     Ok(blocks)
 }
 
-/// Residuals of spec §5 at force multipliers `ν` with interface values `y = C U`.
+/// Residuals of docs/model.md §5 at force multipliers `ν` with interface values `y = C U`.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Residuals {
     /// `max_r |Λ_n,r − (Λ_n,r + ρ_r (y_r − d_r))⁺| / max Λ_n`.

@@ -1,5 +1,5 @@
 //! [`DualMprgp`]: the whole dual QP of the Tresca problem on the interface Schur complement
-//! (spec §6.3–§6.4).
+//! (docs/model.md §6.3–§6.4).
 
 use std::time::Instant;
 
@@ -15,7 +15,7 @@ use crate::qp::{solve_qp, ConvexBlock, QpOptions, QpState};
 use crate::schur::{ScaledBlock, SchurOperator};
 
 /// Solves the Tresca (or frictionless) contact problem through its dual in the force
-/// multipliers `ν = (κ Λ_n, Λ_t)` on the interface (spec §6.4):
+/// multipliers `ν = (κ Λ_n, Λ_t)` on the interface (docs/model.md §6.4):
 ///
 /// ```text
 /// min_ν ½ νᵀ S ν − νᵀ (w − g)   s.t.  ν_n ≥ 0,  ‖ν_t,c‖ ≤ 1 per friction cell,
@@ -31,10 +31,10 @@ use crate::schur::{ScaledBlock, SchurOperator};
 /// applied matrix-free (one solve per product) beyond.
 ///
 /// The iteration stops when both the QP test `‖g^P‖ ≤ ε ‖b‖` (in the scaled variables) and the
-/// residuals of spec §5, `‖Λ_n − (Λ_n + ρ(B_hn U − d))⁺‖_∞ / max Λ_n` and
+/// residuals of docs/model.md §5, `‖Λ_n − (Λ_n + ρ(B_hn U − d))⁺‖_∞ / max Λ_n` and
 /// `‖Λ_t − π(Λ_t + ρ (B_Ht U − s))‖_∞` (`ρ` from [`ContactProblem::default_rho`]), are at most
 /// `ε = params.tolerance`; `params.max_iterations` bounds the QP iterations (CG, expansion and
-/// proportioning steps), the history records the residuals of spec §5 after each of them, and
+/// proportioning steps), the history records the residuals of docs/model.md §5 after each of them, and
 /// `report.inner_iterations` counts the products with `S`. Name: `"dual-mprgp"`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct DualMprgp {
@@ -89,7 +89,7 @@ impl ContactSolver for DualMprgp {
             ..QpOptions::default()
         };
 
-        // spec §5 residuals after every QP iteration, from the gradient: y − g = −D^{½} ĝ
+        // docs/model.md §5 residuals after every QP iteration, from the gradient: y − g = −D^{½} ĝ
         let mut history: Vec<IterationResidual> = Vec::new();
         let mut last = Residuals::default();
         let mut nu = vec![0.0; m];

@@ -1,6 +1,6 @@
 //! # synovia-uzawa
 //!
-//! Dual (interface) solvers of the Tresca contact problem of spec §5 (spec §6.3–§6.4), and the
+//! Dual (interface) solvers of the Tresca contact problem of docs/model.md §5 (docs/model.md §6.3–§6.4), and the
 //! quadratic programming algorithms they rest on.
 //!
 //! ## The dual problem
@@ -14,7 +14,7 @@
 //! min_ν ½ νᵀ S ν − νᵀ (w − g)   s.t.  ν_n ≥ 0,  ‖ν_t,c‖ ≤ 1 per friction cell,  g = (d, s),
 //! ```
 //!
-//! whose KKT conditions are exactly the complementarity conditions of spec §5 (the gradient is
+//! whose KKT conditions are exactly the complementarity conditions of docs/model.md §5 (the gradient is
 //! `S ν − (w − g) = −(y − g)`).
 //!
 //! ## Algorithms
@@ -32,10 +32,10 @@
 //!   T. Kozubek, *An optimal algorithm and superrelaxation for minimization of a quadratic
 //!   function subject to separable convex constraints with applications*, Math. Program.
 //!   135 (2012) 195–220.
-//! * [`UzawaMprgp`] (`"uzawa-mprgp"`, spec §6.3) — the outer Uzawa iteration
+//! * [`UzawaMprgp`] (`"uzawa-mprgp"`, docs/model.md §6.3) — the outer Uzawa iteration
 //!   `Λ_t ← π(Λ_t + ω D⁻¹ (y_t − s))` on the friction multiplier, the inner normal contact
 //!   problem solved by MPRGP on its dual in `ν_n`.
-//! * [`DualMprgp`] (`"dual-mprgp"`, spec §6.4) — the whole dual QP above by MPRGP (2D:
+//! * [`DualMprgp`] (`"dual-mprgp"`, docs/model.md §6.4) — the whole dual QP above by MPRGP (2D:
 //!   `ν_n ≥ 0`, `−1 ≤ ν_t ≤ 1`) or MPGP (3D: half-lines and unit discs).
 //!
 //! Both contact solvers evaluate `S` through [`SchurOperator`]: all columns once (one solve

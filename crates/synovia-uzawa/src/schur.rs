@@ -1,4 +1,4 @@
-//! The interface Schur complement `S = C A⁻¹ Cᵀ` (spec §6.4) as an operator: dense (all columns
+//! The interface Schur complement `S = C A⁻¹ Cᵀ` (docs/model.md §6.4) as an operator: dense (all columns
 //! computed once, one solve with the factorisation of `A` each, cached by
 //! [`synovia_contact::Interface`]) for moderate interface sizes, matrix-free
 //! (`S v = C A⁻¹ (Cᵀ v)`, one solve per product) beyond [`SchurOperator::DENSE_LIMIT`] rows.

@@ -1,5 +1,5 @@
 //! [`UzawaMprgp`]: outer Uzawa iteration on the friction multiplier, inner MPRGP on the dual
-//! of the normal contact problem (spec §6.3).
+//! of the normal contact problem (docs/model.md §6.3).
 
 use std::time::Instant;
 
@@ -15,7 +15,7 @@ use crate::common::{
 use crate::qp::{estimate_norm, solve_qp, QpOptions};
 use crate::schur::{ScaledBlock, SchurOperator};
 
-/// Uzawa's method with MPRGP inner solves (spec §6.3), in the force multipliers
+/// Uzawa's method with MPRGP inner solves (docs/model.md §6.3), in the force multipliers
 /// `ν = (ν_n, Λ_t) = (κ Λ_n, Λ_t)` on the interface (`S`, `w`, `g = (d, s)` as in
 /// [`DualMprgp`](crate::DualMprgp)).
 ///
@@ -194,7 +194,7 @@ impl ContactSolver for UzawaMprgp {
             for i in 0..mn {
                 nu[i] = x[i] * isq[i];
             }
-            // interface values y = w − S ν and the residuals of spec §5 at (ν_n, Λ̂)
+            // interface values y = w − S ν and the residuals of docs/model.md §5 at (ν_n, Λ̂)
             op.apply(&nu, &mut y)?;
             for i in 0..m {
                 ymg[i] = w[i] - y[i] - offsets[i];
