@@ -35,7 +35,7 @@
 //! `trailing_dofs` (dofs in the dense trailing block of the factor) and the symbolic and
 //! numeric times and size of the contact set-up's factorisation. The environment variables
 //! `SYNOVIA_TRAILING_DOFS` and `SYNOVIA_SCREENED_DOFS` override
-//! `ElasticParams::max_trailing_dofs` and `ElasticParams::screened_trailing_dofs` (to measure
+//! `InterfaceBlockParams::max_dofs` and `InterfaceBlockParams::screened_dofs` (to measure
 //! the budgets of the trailing block).
 //!
 //! Results on the project's 2-core machine are in `docs/performance.md`.
@@ -93,16 +93,16 @@ fn normal_tresca<const D: usize>(
     let solver = synovia::solvers::by_name("pdas")?;
     let (elastic_s, elastic_runs) = elastic_time(model)?;
     let t_setup = Instant::now();
-    let mut params = ElasticParams::default();
-    // overrides for measuring the trailing-block budgets
+    let mut block = synovia::linalg::InterfaceBlockParams::default();
+    // overrides for measuring the interface-block budgets
     let env = |name: &str| std::env::var(name).ok().and_then(|v| v.parse().ok());
     if let Some(k) = env("SYNOVIA_TRAILING_DOFS") {
-        params.max_trailing_dofs = k;
+        block = block.with_max_dofs(k);
     }
     if let Some(k) = env("SYNOVIA_SCREENED_DOFS") {
-        params.screened_trailing_dofs = k;
+        block = block.with_screened_dofs(k);
     }
-    let sc = StaticContact::new(model, pairs, params)?;
+    let sc = StaticContact::with_interface_block(model, pairs, ElasticParams::default(), block)?;
     let setup_s = t_setup.elapsed().as_secs_f64();
     let geo = sc.geometry();
     let t0 = Instant::now();

@@ -8,7 +8,8 @@
 //! |---|---|
 //! | [`mesh`] (`synovia-mesh`) | simplicial meshes, boundary parts, generators, local refinement |
 //! | [`material`] (`synovia-material`) | constitutive laws `C⁽⁰⁾`, `C⁽¹⁾` (isotropic, transversely isotropic, anisotropic, Kelvin–Voigt) |
-//! | [`fem`] (`synovia-fem`) | P1 elements, constraints, assembly, sparse Cholesky, post-processing |
+//! | [`linalg`] (`synovia-linalg`) | sparse matrices, the `FactorisedOperator` seam, faer sparse Cholesky (orderings, interface block, recycled solves) |
+//! | [`fem`] (`synovia-fem`) | P1 elements, constraints, assembly, the elastic solve, post-processing |
 //! | [`io`] (`synovia-io`) | VTU/PVD output for ParaView |
 //! | [`contact_ops`] (`synovia-contact`) | contact pairs, `B_hn`/`B_Ht`, the contact problem, `ContactSolver`, KKT checker |
 //! | [`pdas`] (`synovia-pdas`) | semismooth Newton / PDAS and AU-PDAS |
@@ -58,6 +59,7 @@
 pub use synovia_contact as contact_ops;
 pub use synovia_fem as fem;
 pub use synovia_io as io;
+pub use synovia_linalg as linalg;
 pub use synovia_material as material;
 pub use synovia_mesh as mesh;
 pub use synovia_pdas as pdas;

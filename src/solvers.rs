@@ -1,7 +1,9 @@
 //! Choosing a contact solver by name (examples, scenario files), and the `pdas-fallback`
 //! combinator.
 
-use synovia_contact::{ContactError, ContactParams, ContactProblem, ContactSolution, ContactSolver};
+use synovia_contact::{
+    ContactError, ContactParams, ContactProblem, ContactSolution, ContactSolver, SolveContext,
+};
 use synovia_pdas::Pdas;
 use synovia_uzawa::DualMprgp;
 
@@ -82,16 +84,16 @@ impl ContactSolver for PdasFallback {
     fn solve(
         &self,
         problem: &ContactProblem<'_>,
-        warm_start: Option<&ContactSolution>,
+        context: &SolveContext,
     ) -> Result<ContactSolution, ContactError> {
-        let trace = self.pdas.solve_traced(problem, warm_start, true);
+        let trace = self.pdas.solve_traced(problem, context, true);
         let failure = match trace.result {
             Ok(sol) => return Ok(sol),
             Err(e @ (ContactError::NoConvergence { .. } | ContactError::Singular { .. })) => e,
             Err(e) => return Err(e),
         };
-        let warm = trace.last_iterate.as_ref().or(warm_start);
-        let mut sol = self.fallback.solve(problem, warm)?;
+        let warm = trace.last_iterate.or_else(|| context.warm_start().cloned());
+        let mut sol = self.fallback.solve(problem, &context.with_start(warm, context.multipliers_only()))?;
         sol.report.cycling_detected = trace.cycle_period.is_some();
         sol.report.stagnation_detected = trace.stagnation;
         let why = match trace.cycle_period {

@@ -198,7 +198,7 @@ pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> 
     model.tie(bl, "right", br, "interface")?;
 
     let t0 = std::time::Instant::now();
-    let mut solver = ElasticSolver::new(&model, ElasticParams { load_degree: 4, ..Default::default() })?;
+    let mut solver = ElasticSolver::new(&model, ElasticParams::default().with_load_degree(4))?;
     let sol = solver.solve(&model, 0.0)?;
     let solve_s = t0.elapsed().as_secs_f64();
 

@@ -282,7 +282,9 @@ fn the_solvers_agree_in_3d_with_friction() {
     for name in SOLVER_NAMES {
         let params = if *name == "au-pdas" { ContactParams { rho_scale: 0.2, ..tight } } else { tight };
         let s = by_name_with(name, params).expect("solver");
-        let sol = s.solve(&problem, None).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let sol = s
+            .solve(&problem, &synovia::contact_ops::SolveContext::new())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
         let kkt = synovia::contact_ops::check_kkt(&problem, &sol.u, &sol.lambda_n, &sol.lambda_t);
         assert!(kkt.satisfied(1e-8), "{name}: {kkt:?}");
         sols.push(sol);

@@ -144,7 +144,7 @@ fn metis_and_amd_orderings_give_the_same_solution() {
     let mut sols = Vec::new();
     for ordering in [synovia::fem::OrderingChoice::Amd, synovia::fem::OrderingChoice::Metis] {
         let mut s =
-            ElasticSolver::new(&model, ElasticParams { ordering, ..Default::default() }).expect("factorise");
+            ElasticSolver::new(&model, ElasticParams::default().with_ordering(ordering)).expect("factorise");
         sols.push(s.solve(&model, 0.0).expect("solve").reduced);
     }
     let scale = sols[0].iter().fold(0.0_f64, |a, b| a.max(b.abs()));
@@ -180,7 +180,7 @@ fn vtu_output_of_a_solution_reads_back() {
 }
 
 /// The trailing block of a factorisation with the interface dofs ordered last
-/// (`ElasticSolver::new_for_contact`) reproduces `(A⁻¹)_cc` computed with the whole factor, for
+/// (`ElasticSolver::new_with_ordering` with `InterfaceBlockParams::ordering`) reproduces `(A⁻¹)_cc` computed with the whole factor, for
 /// the simplicial (small) and the supernodal (larger) factor layouts of faer.
 #[test]
 fn trailing_block_of_the_factor_gives_the_interface_inverse() {
@@ -197,7 +197,17 @@ fn trailing_block_of_the_factor_gives_the_interface_inverse() {
         nodes.sort_unstable();
         nodes.dedup();
         let solver =
-            ElasticSolver::new_for_contact(&model, ElasticParams::default(), &nodes).expect("factor");
+            ElasticSolver::new_with_ordering(&model, ElasticParams::default(), false, &|dofs, base| {
+                let groups: Vec<std::ops::Range<usize>> = nodes
+                    .iter()
+                    .map(|&(b, i)| {
+                        let g = &dofs.groups()[dofs.group_of(b, i)];
+                        g.first_dof..g.first_dof + g.n_dofs
+                    })
+                    .collect();
+                Ok(synovia::linalg::InterfaceBlockParams::default().ordering(base, &groups, dofs.n_dofs()))
+            })
+            .expect("factor");
         let chol = solver.cholesky();
         let block = chol.trailing().expect("trailing block");
         layouts.push(matches!(chol.symbolic().raw(), SymbolicCholeskyRaw::Supernodal(_)));
@@ -264,9 +274,10 @@ fn trailing_ordering_over_a_bad_base_permutation_is_an_error() {
 /// direction kept; the oldest direction is dropped when the subspace is full.
 #[test]
 fn load_subspace_recycles_combinations_of_solved_loads() {
-    use synovia::fem::LoadSubspace;
+    use synovia::linalg::{CholeskyOperator, LoadSubspace};
     let solver = ElasticSolver::new(&cantilever(), ElasticParams::default()).expect("factor");
     let (a, chol) = (solver.stiffness(), solver.cholesky());
+    let op = CholeskyOperator::new(a, chol).expect("operator");
     let n = chol.n();
     let load = |k: f64| -> Vec<f64> { (0..n).map(|i| ((i as f64 + 1.0) * k).sin()).collect() };
     let direct = |f: &[f64]| {
@@ -281,26 +292,26 @@ fn load_subspace_recycles_combinations_of_solved_loads() {
     let mut sub = LoadSubspace::new(2);
     let (f1, f2, f3) = (load(0.3), load(1.7), load(2.9));
     for f in [&f1, &f2] {
-        assert!(rel(&sub.solve(a, chol, f).expect("solve"), &direct(f)) < 1e-13);
+        assert!(rel(&sub.solve(&op, f).expect("solve"), &direct(f)) < 1e-13);
     }
     assert_eq!((sub.len(), sub.counts()), (2, (0, 2)));
     let combo: Vec<f64> = f1.iter().zip(&f2).map(|(a, b)| 3.0 * a - 2.0 * b).collect();
-    let x = sub.solve(a, chol, &combo).expect("recycled");
+    let x = sub.solve(&op, &combo).expect("recycled");
     assert_eq!(sub.counts(), (1, 2), "a combination needs no solve");
     let err = rel(&x, &direct(&combo));
     assert!(err < 1e-12, "recycled solution differs by {err:e}");
     // a new direction: solved, kept, and the oldest (f1's) dropped
-    assert!(rel(&sub.solve(a, chol, &f3).expect("solve"), &direct(&f3)) < 1e-13);
+    assert!(rel(&sub.solve(&op, &f3).expect("solve"), &direct(&f3)) < 1e-13);
     assert_eq!((sub.len(), sub.counts()), (2, (1, 3)));
-    let x3 = sub.solve(a, chol, &f3.iter().map(|v| -0.5 * v).collect::<Vec<_>>()).expect("recycled");
+    let x3 = sub.solve(&op, &f3.iter().map(|v| -0.5 * v).collect::<Vec<_>>()).expect("recycled");
     assert_eq!(sub.counts(), (2, 3), "f3 is in the subspace");
     assert!(rel(&x3, &direct(&f3).iter().map(|v| -0.5 * v).collect::<Vec<_>>()) < 1e-12);
-    sub.solve(a, chol, &f1).expect("solve");
+    sub.solve(&op, &f1).expect("solve");
     assert_eq!(sub.counts(), (2, 4), "f1 left the subspace");
     // zero load, wrong length, NaN
-    assert!(sub.solve(a, chol, &vec![0.0; n]).expect("zero").iter().all(|v| *v == 0.0));
-    assert!(sub.solve(a, chol, &vec![1.0; n + 1]).is_err());
+    assert!(sub.solve(&op, &vec![0.0; n]).expect("zero").iter().all(|v| *v == 0.0));
+    assert!(sub.solve(&op, &vec![1.0; n + 1]).is_err());
     let mut bad = f1.clone();
     bad[3] = f64::NAN;
-    assert!(sub.solve(a, chol, &bad).is_err());
+    assert!(sub.solve(&op, &bad).is_err());
 }

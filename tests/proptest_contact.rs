@@ -121,8 +121,10 @@ fn every_solver_returns_a_kkt_solution_or_a_typed_error_and_they_agree() {
         let mut sols = Vec::new();
         for name in &names {
             let solver = by_name(name).map_err(|e| TestCaseError::fail(format!("{name}: {e}")))?;
-            let out = catch_unwind(AssertUnwindSafe(|| solver.solve(&problem, None)))
-                .map_err(|_| TestCaseError::fail(format!("{name} panicked on {b:?}")))?;
+            let out = catch_unwind(AssertUnwindSafe(|| {
+                solver.solve(&problem, &synovia::contact_ops::SolveContext::new())
+            }))
+            .map_err(|_| TestCaseError::fail(format!("{name} panicked on {b:?}")))?;
             match out {
                 Ok(sol) => {
                     let kkt = check_kkt(&problem, &sol.u, &sol.lambda_n, &sol.lambda_t);

@@ -2,11 +2,11 @@
 //! `pdas-fallback` solver recovers; iteration limits without fallback give `NoConvergence`.
 
 use synovia::contact_ops::kkt::check_kkt;
-use synovia::contact_ops::rows::SparseRows;
 use synovia::contact_ops::testing::BlockOnFoundation;
+use synovia::contact_ops::SparseRows;
 use synovia::contact_ops::{ContactError, ContactParams, ContactSolver};
 use synovia::contact_ops::{ContactProblem, NormalConstraints};
-use synovia::fem::{CholeskySolver, Ordering, SymmetricMatrix};
+use synovia::linalg::{Ordering, SparseCholesky, SymmetricMatrix};
 use synovia::pdas::Pdas;
 use synovia::solvers::{by_name, PdasFallback};
 use synovia::uzawa::DualMprgp;
@@ -14,8 +14,7 @@ use synovia::uzawa::DualMprgp;
 /// A frictionless interface problem with `A = I` (n × n), `B_hn = c` (rows), `κ = 1`:
 /// `S = c cᵀ`, `w = c F`.
 struct Synthetic {
-    matrix: SymmetricMatrix,
-    factor: CholeskySolver,
+    system: SparseCholesky,
     load: Vec<f64>,
     normal: NormalConstraints,
 }
@@ -28,26 +27,16 @@ impl Synthetic {
         for j in 0..n {
             matrix.add(j, j, 1.0).expect("diag");
         }
-        let mut factor = CholeskySolver::analyse(&matrix, &Ordering::Amd).expect("analyse");
-        factor.factorize(&matrix).expect("factorize");
+        let system = SparseCholesky::new(matrix, &Ordering::Amd).expect("factorise");
         let mut rows = SparseRows::new(n);
         for r in c {
             rows.push_row(r.iter().copied().enumerate());
         }
         let m = c.len();
-        Self { matrix, factor, load, normal: NormalConstraints { rows, weights: vec![1.0; m], gap } }
+        Self { system, load, normal: NormalConstraints { rows, weights: vec![1.0; m], gap } }
     }
     fn problem(&self) -> ContactProblem<'_> {
-        ContactProblem {
-            matrix: &self.matrix,
-            factor: &self.factor,
-            load: &self.load,
-            normal: &self.normal,
-            friction: None,
-            schur_cache: None,
-            load_solution: None,
-            multipliers_only: false,
-        }
+        ContactProblem { operator: &self.system, load: &self.load, normal: &self.normal, friction: None }
     }
 }
 
@@ -66,7 +55,7 @@ fn pdas_cycling_is_detected_and_the_iteration_limit_still_gives_no_convergence()
     let pdas = Pdas::default();
     let max = pdas.params.max_iterations;
     // no fallback configured: NoConvergence at the limit, with the whole residual history
-    match pdas.solve(&p, None) {
+    match pdas.solve(&p, &synovia::contact_ops::SolveContext::new()) {
         Err(ContactError::NoConvergence { solver, iterations, history }) => {
             assert_eq!(solver, "pdas");
             assert_eq!(iterations, max);
@@ -76,13 +65,13 @@ fn pdas_cycling_is_detected_and_the_iteration_limit_still_gives_no_convergence()
         }
         other => panic!("expected NoConvergence, got {other:?}"),
     }
-    let trace = pdas.solve_traced(&p, None, false);
+    let trace = pdas.solve_traced(&p, &synovia::contact_ops::SolveContext::new(), false);
     assert_eq!(trace.cycle_period, Some(3), "{trace:?}");
     assert!(trace.stagnation);
     assert!(matches!(trace.result, Err(ContactError::NoConvergence { iterations, .. }) if iterations == max));
     assert!(trace.last_iterate.is_some());
     // stop_on_cycling ends the doomed iteration as soon as the cycle is seen
-    let early = pdas.solve_traced(&p, None, true);
+    let early = pdas.solve_traced(&p, &synovia::contact_ops::SolveContext::new(), true);
     match early.result {
         Err(ContactError::NoConvergence { iterations, history, .. }) => {
             println!("cycle detected after {iterations} iterations");
@@ -98,7 +87,7 @@ fn pdas_fallback_hands_a_cycling_problem_to_dual_mprgp_and_reports_it() {
     let owned = cycling_problem();
     let p = owned.problem();
     let solver = by_name("pdas-fallback").expect("solver");
-    let sol = solver.solve(&p, None).expect("fallback solution");
+    let sol = solver.solve(&p, &synovia::contact_ops::SolveContext::new()).expect("fallback solution");
     let kkt = check_kkt(&p, &sol.u, &sol.lambda_n, &sol.lambda_t);
     println!("report {:?}\nKKT {kkt:?}", sol.report);
     assert!(kkt.satisfied(1e-7), "{kkt:?}");
@@ -108,7 +97,7 @@ fn pdas_fallback_hands_a_cycling_problem_to_dual_mprgp_and_reports_it() {
     assert!(why.contains("cycle of period 3") && why.contains("dual-mprgp"), "{why}");
     // the same solution as dual-mprgp from a cold start
     let cold = DualMprgp::new(ContactParams { max_iterations: 10_000, ..Default::default() })
-        .solve(&p, None)
+        .solve(&p, &synovia::contact_ops::SolveContext::new())
         .expect("dual-mprgp");
     for (a, b) in sol.u.iter().zip(&cold.u).chain(sol.lambda_n.iter().zip(&cold.lambda_n)) {
         assert!((a - b).abs() <= 1e-8 * (1.0 + b.abs()), "{a} vs {b}");
@@ -121,8 +110,9 @@ fn pdas_fallback_is_plain_pdas_when_pdas_converges() {
         .build::<2>()
         .expect("problem");
     let p = owned.problem();
-    let plain = Pdas::default().solve(&p, None).expect("pdas");
-    let guarded = PdasFallback::default().solve(&p, None).expect("pdas-fallback");
+    let plain = Pdas::default().solve(&p, &synovia::contact_ops::SolveContext::new()).expect("pdas");
+    let guarded =
+        PdasFallback::default().solve(&p, &synovia::contact_ops::SolveContext::new()).expect("pdas-fallback");
     assert_eq!(guarded.report.solver, "pdas");
     assert!(guarded.report.fallback.is_none() && !guarded.report.cycling_detected);
     assert_eq!(plain.u, guarded.u);
@@ -140,8 +130,12 @@ fn pdas_fallback_recovers_from_linearly_dependent_active_constraints() {
     owned.normal.weights.push(owned.normal.weights[mid]);
     owned.normal.gap.push(owned.normal.gap[mid]);
     let p = owned.problem();
-    assert!(matches!(Pdas::default().solve(&p, None), Err(ContactError::Singular { .. })));
-    let sol = PdasFallback::default().solve(&p, None).expect("fallback");
+    assert!(matches!(
+        Pdas::default().solve(&p, &synovia::contact_ops::SolveContext::new()),
+        Err(ContactError::Singular { .. })
+    ));
+    let sol =
+        PdasFallback::default().solve(&p, &synovia::contact_ops::SolveContext::new()).expect("fallback");
     let kkt = check_kkt(&p, &sol.u, &sol.lambda_n, &sol.lambda_t);
     assert!(kkt.satisfied(1e-7), "{kkt:?}");
     let why = sol.report.fallback.as_deref().expect("fallback recorded");
@@ -153,7 +147,7 @@ fn pdas_fallback_recovers_from_linearly_dependent_active_constraints() {
 fn pdas_fallback_passes_input_errors_through() {
     let mut owned = cycling_problem();
     owned.normal.gap[0] = f64::NAN;
-    let e = PdasFallback::default().solve(&owned.problem(), None);
+    let e = PdasFallback::default().solve(&owned.problem(), &synovia::contact_ops::SolveContext::new());
     assert!(matches!(e, Err(ContactError::InvalidParameter(_))), "{e:?}");
 }
 
@@ -178,7 +172,10 @@ fn uzawa_mprgp_kkt_on_a_nearly_unloaded_tresca_problem() {
     let owned = b.build::<2>().expect("problem");
     let p = owned.problem();
     for name in ["pdas", "dual-mprgp", "uzawa-mprgp"] {
-        let sol = by_name(name).expect("solver").solve(&p, None).expect("solve");
+        let sol = by_name(name)
+            .expect("solver")
+            .solve(&p, &synovia::contact_ops::SolveContext::new())
+            .expect("solve");
         let kkt = check_kkt(&p, &sol.u, &sol.lambda_n, &sol.lambda_t);
         println!("{name}: {kkt:?}");
         assert!(kkt.satisfied(1e-7), "{name}: {kkt:?}");
@@ -206,20 +203,24 @@ fn pdas_cycles_on_a_random_tresca_block_and_the_fallback_recovers() {
     };
     let owned = b.build::<2>().expect("problem");
     let p = owned.problem();
-    let trace = Pdas::default().solve_traced(&p, None, false);
+    let trace = Pdas::default().solve_traced(&p, &synovia::contact_ops::SolveContext::new(), false);
     assert!(
         matches!(trace.result, Err(ContactError::NoConvergence { iterations: 200, .. })),
         "{:?}",
         trace.result
     );
     assert_eq!(trace.cycle_period, Some(4));
-    let sol = PdasFallback::default().solve(&p, None).expect("fallback");
+    let sol =
+        PdasFallback::default().solve(&p, &synovia::contact_ops::SolveContext::new()).expect("fallback");
     let kkt = check_kkt(&p, &sol.u, &sol.lambda_n, &sol.lambda_t);
     println!("{:?}\n{kkt:?}", sol.report.fallback);
     assert!(kkt.satisfied(1e-7), "{kkt:?}");
     assert!(sol.report.cycling_detected && sol.report.fallback.is_some());
     // the other solvers agree
-    let dual = by_name("uzawa-mprgp").expect("solver").solve(&p, None).expect("uzawa");
+    let dual = by_name("uzawa-mprgp")
+        .expect("solver")
+        .solve(&p, &synovia::contact_ops::SolveContext::new())
+        .expect("uzawa");
     let scale = sol.u.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
     let du = sol.u.iter().zip(&dual.u).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs())) / scale;
     assert!(du < 1e-6, "{du}");

@@ -1,5 +1,5 @@
 //! Row screening of `StaticContact` (issue 6): with a trailing block too small for the whole
-//! contact interface (`ElasticParams::max_trailing_dofs`), the solver runs on the contact rows
+//! contact interface (`InterfaceBlockParams::max_dofs`), the solver runs on the contact rows
 //! whose dofs the block holds, the other rows are checked afterwards and added when they
 //! penetrate. The result must be the one of the unscreened problem (every row, the whole
 //! interface in the trailing block) and satisfy the KKT conditions of the full problem.
@@ -29,8 +29,9 @@ fn run<const D: usize>(
     reference: Option<&Run<D>>,
 ) -> Run<D> {
     let solver = by_name("pdas").expect("solver");
-    let params = ElasticParams { max_trailing_dofs, ..Default::default() };
-    let sc = StaticContact::new(model, pairs, params).expect("factorise");
+    let block = synovia::linalg::InterfaceBlockParams::default().with_max_dofs(max_trailing_dofs);
+    let sc = StaticContact::with_interface_block(model, pairs, ElasticParams::default(), block)
+        .expect("factorise");
     let normal = sc.solve(model, 0.0, solver.as_ref(), None, None, None).expect("normal solve");
     let base = reference.map_or(&normal, |r| &r.normal);
     let gc = sc.geometry().slip_bounds_from_pressure(&base.solution.lambda_n);

@@ -25,6 +25,9 @@ pub enum ContactError {
     /// A finite-element error (model, assembly, factorisation).
     #[error(transparent)]
     Fem(#[from] FemError),
+    /// A linear-algebra error (factorisation, solve).
+    #[error(transparent)]
+    Linalg(#[from] synovia_linalg::LinalgError),
     /// A mesh error.
     #[error(transparent)]
     Mesh(#[from] MeshError),

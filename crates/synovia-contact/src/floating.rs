@@ -50,7 +50,7 @@ pub fn check_balance(
     let load_norm = load.iter().map(|f| f * f).sum::<f64>().sqrt();
     // columns: normal rows (ν ≥ 0), friction rows with both signs
     let mut columns: Vec<Vec<f64>> = Vec::new();
-    let mut add_rows = |rows: &crate::rows::SparseRows, weights: Option<&[f64]>, both_signs: bool| {
+    let mut add_rows = |rows: &synovia_linalg::SparseRows, weights: Option<&[f64]>, both_signs: bool| {
         let per_mode: Vec<Vec<f64>> = modes.iter().map(|r| rows.mul(r)).collect();
         for row in 0..rows.nrows() {
             let w = weights.map_or(1.0, |w| w[row]);

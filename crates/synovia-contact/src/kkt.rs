@@ -51,9 +51,8 @@ pub(crate) fn inf_norm(v: &[f64]) -> f64 {
 
 /// Evaluates the KKT conditions of docs/model.md §5 for `(U, Λ_n, Λ_t)`.
 pub fn check_kkt(problem: &ContactProblem<'_>, u: &[f64], lambda_n: &[f64], lambda_t: &[f64]) -> KktReport {
-    let n = problem.matrix.n();
-    let mut r = vec![0.0; n];
-    problem.matrix.mul_vec(u, &mut r);
+    let n = problem.operator.n();
+    let mut r = problem.operator.apply(u);
     let mut bn = vec![0.0; n];
     let kl: Vec<f64> = lambda_n.iter().zip(&problem.normal.weights).map(|(l, k)| l * k).collect();
     problem.normal.rows.mul_transpose_add(&kl, &mut bn);

@@ -17,11 +17,13 @@
 //! the geometry can be rebuilt at every pose ([`operators::ContactGeometry::new_deformed`],
 //! [`StaticContact::update_geometry`]).
 //!
-//! its condensation on the contact interface ([`Interface`], docs/model.md §6.4), the
-//! [`ContactSolver`] trait implemented by `synovia-pdas` and `synovia-uzawa`, and the KKT checker
-//! [`check_kkt`].
+//! its condensation on the contact interface ([`Interface`], docs/model.md §6.4) on any
+//! [`synovia_linalg::FactorisedOperator`], the caller-owned [`SolveContext`] (warm start,
+//! kept columns, recycled solves, memory budget), the [`ContactSolver`] trait implemented by
+//! `synovia-pdas` and `synovia-uzawa`, and the KKT checker [`check_kkt`].
 #![warn(missing_docs)]
 
+pub mod context;
 pub mod error;
 pub mod floating;
 pub mod friction;
@@ -30,16 +32,16 @@ pub mod mortar;
 pub mod nested;
 pub mod operators;
 pub mod problem;
-pub mod rows;
 pub mod search;
 pub mod solver;
 pub mod static_contact;
 pub mod testing;
 
+pub use context::SolveContext;
 pub use error::{ContactError, IterationResidual};
 pub use friction::{ConstantFriction, ExponentialFriction, FrictionLaw};
 pub use kkt::{check_kkt, KktReport};
-pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints, SchurCache};
-pub use rows::SparseRows;
+pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};
 pub use static_contact::{StaticContact, StaticContactResult};
+pub use synovia_linalg::SparseRows;

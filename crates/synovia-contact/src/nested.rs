@@ -13,10 +13,11 @@
 //! The coarse problems keep `A` and `F`; a coarse row keeps its `B_hn` row and gap and carries
 //! the weights `κ` of the dropped rows assigned to it, so that its `Λ_n` is a pressure.
 
+use crate::context::SolveContext;
 use crate::error::ContactError;
 use crate::problem::{ContactProblem, NormalConstraints};
-use crate::rows::SparseRows;
 use crate::solver::{ContactSolution, ContactSolver, SolverReport};
+use synovia_linalg::SparseRows;
 
 /// A hierarchy level: the retained rows (indices into the finest rows) and their graph.
 struct Level {
@@ -89,6 +90,7 @@ fn coarsen(adjacency: &[Vec<usize>]) -> (Vec<usize>, Vec<Vec<usize>>, Vec<usize>
 pub fn nested_warm_start(
     problem: &ContactProblem<'_>,
     solver: &dyn ContactSolver,
+    context: &SolveContext,
     adjacency: &[Vec<usize>],
     min_rows: usize,
 ) -> Result<Option<(ContactSolution, usize)>, ContactError> {
@@ -122,8 +124,8 @@ pub fn nested_warm_start(
     }
     // solve from the coarsest level up to level 1; interpolate to the next finer level. The
     // levels share the load solve A⁻¹ F and the trailing solves of their rows with the problem's
-    // cache (not its columns: other rows).
-    let shared = problem.schur_cache.map(|c| c.sharing_solves());
+    // context (not its columns: other rows).
+    let shared = context.sharing_solves();
     let mut coarse_iterations = 0;
     let mut warm: Option<Vec<f64>> = None; // Λ_n on the current level's rows
     for lvl in (1..levels.len()).rev() {
@@ -148,15 +150,15 @@ pub fn nested_warm_start(
             gap.push(problem.normal.gap[r]);
         }
         let normal = NormalConstraints { rows, weights: weight, gap };
-        let sub =
-            ContactProblem { normal: &normal, friction: None, schur_cache: shared.as_ref(), ..*problem };
+        let sub = ContactProblem { normal: &normal, friction: None, ..*problem };
         let ws = warm.take().map(|ln| ContactSolution {
             u: Vec::new(),
             lambda_n: ln,
             lambda_t: Vec::new(),
             report: SolverReport::default(),
         });
-        let sol = solver.solve(&sub, ws.as_ref())?;
+        // only Λ_n of a coarse level is used: no displacement
+        let sol = solver.solve(&sub, &shared.with_start(ws, true))?;
         coarse_iterations += sol.report.iterations;
         // interpolate to level lvl − 1
         let finer = &levels[lvl - 1];

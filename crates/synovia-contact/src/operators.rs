@@ -83,8 +83,8 @@ use synovia_mesh::math::{Point, Real, Tensor, Vector};
 
 use crate::error::ContactError;
 use crate::problem::{FrictionConstraints, NormalConstraints};
-use crate::rows::SparseRows;
 use crate::search::{area_normal, FacetSearch};
+use synovia_linalg::SparseRows;
 use synovia_mesh::mesh::nodal_normals_at;
 
 /// A rigid obstacle given by a signed distance `φ` (positive in the free space outside the

@@ -1,5 +1,6 @@
 //! The [`ContactSolver`] trait that every contact solver implements, its parameters and report.
 
+use crate::context::SolveContext;
 use crate::error::{ContactError, IterationResidual};
 use crate::problem::ContactProblem;
 
@@ -69,8 +70,10 @@ pub struct ContactSolution {
 /// A solver of the contact problem of docs/model.md §5 (frictionless or Tresca).
 ///
 /// Implemented by the PDAS and AU-PDAS solvers (`synovia-pdas`) and the Uzawa solvers
-/// (`synovia-uzawa`). `warm_start` (a previous solution of a nearby problem with the same
-/// rows) seeds the multipliers and active sets.
+/// (`synovia-uzawa`). The caller's [`SolveContext`] carries the warm start (a previous
+/// solution of a nearby problem with the same rows, which seeds the multipliers and active
+/// sets), the columns of `S` kept from earlier solves and the recycled load solves; the
+/// solver reads it and leaves what it computed there for the next solve.
 pub trait ContactSolver {
     /// Short name for reports.
     fn name(&self) -> &str;
@@ -78,6 +81,6 @@ pub trait ContactSolver {
     fn solve(
         &self,
         problem: &ContactProblem<'_>,
-        warm_start: Option<&ContactSolution>,
+        context: &SolveContext,
     ) -> Result<ContactSolution, ContactError>;
 }

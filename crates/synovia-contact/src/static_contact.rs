@@ -6,23 +6,26 @@
 //! given slip bounds `g_c`), runs the solver, and maps the result back to nodal displacements
 //! per body and pressures per contact node.
 
-use synovia_fem::{ElasticParams, ElasticSolver, LoadSubspace, Model};
+use synovia_fem::{ElasticParams, ElasticSolver, Model};
+use synovia_linalg::{CholeskyOperator, InterfaceBlockParams};
 use synovia_mesh::math::{Real, Vector};
 
+use crate::context::SolveContext;
 use crate::error::ContactError;
 use crate::kkt::{check_kkt, inf_norm, KktReport};
 use crate::operators::{BodyPlacement, ContactGeometry, ContactPair};
-use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints, SchurCache};
-use crate::rows::SparseRows;
+use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints};
 use crate::solver::{ContactSolution, ContactSolver, SolverReport};
+use synovia_linalg::SparseRows;
 
 /// A factorised model with its contact geometry.
 ///
 /// The dofs of the contact interface are ordered last in the factorisation (a dense trailing
-/// block for the interface Schur complement, see [`ElasticSolver::new_for_contact`]). An
-/// interface with more than [`ElasticParams::max_trailing_dofs`] dofs keeps only the contact
-/// nodes of smallest initial gap (with their partner and master nodes) in the block, up to
-/// [`ElasticParams::screened_trailing_dofs`]; each solve then screens the contact rows: it
+/// block for the interface Schur complement, [`InterfaceBlockParams`],
+/// [`synovia_linalg::Ordering::Trailing`]). An interface with more than
+/// [`InterfaceBlockParams::max_dofs`] dofs keeps only the contact nodes of smallest initial gap
+/// (with their partner and master nodes) in the block, up to
+/// [`InterfaceBlockParams::screened_dofs`]; each solve then screens the contact rows: it
 /// solves on the rows in the block, checks the others with the computed displacement and adds
 /// those that penetrate until none does, so the result is the one of the full problem.
 #[derive(Debug)]
@@ -30,10 +33,9 @@ pub struct StaticContact<const D: usize> {
     elastic: ElasticSolver<D>,
     geometry: ContactGeometry<D>,
     nested_min_rows: Option<usize>,
-    /// Columns of `S` kept between solves on the same geometry ([`SchurCache`]).
-    schur_cache: SchurCache,
-    /// Solved loads `A⁻¹ F` kept for loads in their span ([`LoadSubspace`]).
-    load_subspace: std::sync::Mutex<LoadSubspace>,
+    /// What the solves reuse: columns of `S` kept between solves on the same geometry, the
+    /// recycled load solves `A⁻¹ F` ([`SolveContext`], with its memory budget).
+    context: SolveContext,
 }
 
 /// The result of one static contact solve.
@@ -67,16 +69,45 @@ impl<const D: usize> StaticContact<D> {
         pairs: &[ContactPair<D>],
         params: ElasticParams,
     ) -> Result<Self, ContactError> {
+        Self::with_interface_block(model, pairs, params, InterfaceBlockParams::default())
+    }
+
+    /// [`StaticContact::new`] with the given choice of the interface dofs ordered last
+    /// ([`InterfaceBlockParams`]: the size of the dense interface block, and of the screened
+    /// block of a larger interface).
+    ///
+    /// # Errors
+    /// As [`StaticContact::new`].
+    pub fn with_interface_block(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        params: ElasticParams,
+        block: InterfaceBlockParams,
+    ) -> Result<Self, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
-        let elastic =
-            ElasticSolver::new_for_contact(model, params, &interface_nodes(model, pairs, &geometry)?)?;
-        Ok(Self {
-            elastic,
-            geometry,
-            nested_min_rows: Some(32),
-            schur_cache: SchurCache::new(),
-            load_subspace: std::sync::Mutex::new(LoadSubspace::new(LOAD_SUBSPACE_CAPACITY)),
-        })
+        let interface = interface_nodes(model, pairs, &geometry)?;
+        let elastic = ElasticSolver::new_with_ordering(model, params, true, &|dofs, base| {
+            let groups: Vec<std::ops::Range<usize>> = interface
+                .iter()
+                .map(|&(b, i)| {
+                    let g = &dofs.groups()[dofs.group_of(b, i)];
+                    g.first_dof..g.first_dof + g.n_dofs
+                })
+                .collect();
+            Ok(block.ordering(base, &groups, dofs.n_dofs()))
+        })?;
+        Ok(Self { elastic, geometry, nested_min_rows: Some(32), context: SolveContext::new() })
+    }
+
+    /// The context of the solves (kept columns, recycled load solves, memory budget).
+    pub fn context(&self) -> &SolveContext {
+        &self.context
+    }
+
+    /// Replaces the context (e.g. one with another memory budget,
+    /// [`SolveContext::with_memory_budget`]).
+    pub fn set_context(&mut self, context: SolveContext) {
+        self.context = context;
     }
 
     /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
@@ -90,7 +121,7 @@ impl<const D: usize> StaticContact<D> {
         displacement: &[Vec<Vector<D>>],
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new_deformed(model, pairs, displacement)?;
-        self.schur_cache.clear();
+        self.context.clear_rows();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -99,7 +130,7 @@ impl<const D: usize> StaticContact<D> {
     /// `A`: the bodies' stiffness in their own frames does not change with the placement, so a
     /// sequence of poses (a gait cycle) needs one factorisation. The contact parts' dofs stay
     /// the interface dofs ordered last, so Schur columns of the new rows still use the dense
-    /// trailing block (for an interface above [`ElasticParams::max_trailing_dofs`], the block
+    /// trailing block (for an interface above [`InterfaceBlockParams::max_dofs`], the block
     /// chosen by the initial gaps at construction; rows outside it are screened as in
     /// [`StaticContact::solve`]). Loads, prescribed displacements and results are in the
     /// bodies' frames.
@@ -114,7 +145,7 @@ impl<const D: usize> StaticContact<D> {
         placements: &[BodyPlacement<D>],
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new_placed(model, pairs, placements)?;
-        self.schur_cache.clear();
+        self.context.clear_rows();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -126,9 +157,9 @@ impl<const D: usize> StaticContact<D> {
     }
 
     /// `(reused, solved)`: solves whose `A⁻¹ F` came from the recycled load subspace and
-    /// those that needed a solve with the factor ([`LoadSubspace::counts`]).
+    /// those that needed a solve with the factor ([`SolveContext::recycled_counts`]).
     pub fn load_solves(&self) -> (usize, usize) {
-        self.load_subspace.lock().unwrap_or_else(|e| e.into_inner()).counts()
+        self.context.recycled_counts()
     }
 
     /// The elastic solver (dofs, stiffness, factorisation, timings).
@@ -161,7 +192,7 @@ impl<const D: usize> StaticContact<D> {
     }
 
     /// [`StaticContact::solve`] without the final displacement: the multipliers `Λ_n`, `Λ_t`
-    /// and the solver report (the solution's `u` is empty, [`ContactProblem::multipliers_only`]),
+    /// and the solver report (the solution's `u` is empty, [`SolveContext::multipliers_only`]),
     /// and the coarse-level iterations of the nested warm start. Saves one solve with the
     /// factor (half a solve on a condensed interface) and the KKT check per call: for the
     /// iterates of a search over loads (e.g. the approach that balances a given force,
@@ -214,24 +245,16 @@ impl<const D: usize> StaticContact<D> {
                 n_tangential
             )));
         }
-        let factor = self.elastic.cholesky();
-        let load_solution = self.recycled_load_solution(&load)?;
-        let problem = ContactProblem {
-            matrix: self.elastic.system_matrix(),
-            factor,
-            load: &load,
-            normal: &normal,
-            friction,
-            schur_cache: None,
-            load_solution: load_solution.as_deref(),
-            multipliers_only: false,
-        };
+        let operator = self.operator()?;
+        let mut context = SolveContext::new();
+        context.set_load_solution(self.recycled_load_solution(&operator, &load)?);
+        let problem = ContactProblem { operator: &operator, load: &load, normal: &normal, friction };
         let mut solution = solution;
         if solution.u.is_empty() {
             let mut nu: Vec<f64> =
                 solution.lambda_n.iter().zip(&normal.weights).map(|(l, k)| l * k).collect();
             nu.extend_from_slice(&solution.lambda_t);
-            solution.u = crate::problem::Interface::new(problem)?.displacement(&nu)?;
+            solution.u = crate::problem::Interface::new(problem, &context)?.displacement(&nu)?;
         }
         let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
         self.finish(solution, kkt, &lifts, friction_op, 0, 0)
@@ -254,22 +277,15 @@ impl<const D: usize> StaticContact<D> {
         if let Some(st) = stabilisation {
             crate::floating::check_balance(st, &load, &normal, friction)?;
         }
-        let (matrix, factor) = (self.elastic.system_matrix(), self.elastic.cholesky());
+        let operator = self.operator()?;
         // A⁻¹ F: recycled when F is a combination of loads solved before (crate docs of
-        // synovia_fem::recycling); the proximal iteration's loads change every iteration
-        let load_solution = self.recycled_load_solution(&load)?;
+        // synovia_linalg::recycling); the proximal iteration's loads change every iteration
+        let mut context = self.context.with_start(None, multipliers_only && stabilisation.is_none());
+        context.set_load_solution(self.recycled_load_solution(&operator, &load)?);
+        let context = context;
         macro_rules! problem_with {
             ($rhs:expr) => {
-                ContactProblem {
-                    matrix,
-                    factor,
-                    load: $rhs,
-                    normal: &normal,
-                    friction,
-                    schur_cache: Some(&self.schur_cache),
-                    load_solution: load_solution.as_deref(),
-                    multipliers_only: multipliers_only && stabilisation.is_none(),
-                }
+                ContactProblem { operator: &operator, load: $rhs, normal: &normal, friction }
             };
         }
         let cell_node = friction_op.as_ref().map_or(&[][..], |f| &f.cell_node[..]);
@@ -277,7 +293,7 @@ impl<const D: usize> StaticContact<D> {
         let mut warm = warm_start.cloned();
         let Some(st) = stabilisation else {
             let problem = problem_with!(&load);
-            let (solution, it) = self.run(&problem, solver, warm.as_ref(), cell_node)?;
+            let (solution, it) = self.run(&problem, solver, &context, warm.as_ref(), cell_node)?;
             if multipliers_only {
                 return Ok(Solved::Multipliers(Box::new(solution), it));
             }
@@ -294,7 +310,7 @@ impl<const D: usize> StaticContact<D> {
         for iteration in 1..=PROXIMAL_MAX_ITERATIONS {
             let rhs: Vec<f64> = st.spring_mul(&u_k).iter().zip(&load).map(|(s, f)| s + f).collect();
             let problem = problem_with!(&rhs);
-            let (solution, it) = self.run(&problem, solver, warm.as_ref(), cell_node)?;
+            let (solution, it) = self.run(&problem, solver, &context, warm.as_ref(), cell_node)?;
             coarse_iterations += it;
             let step: Vec<f64> = solution.u.iter().zip(&u_k).map(|(a, b)| a - b).collect();
             let residual = inf_norm(&st.spring_mul(&step));
@@ -353,23 +369,31 @@ impl<const D: usize> StaticContact<D> {
         Ok(Assembled { load, lifts, normal, friction_op })
     }
 
-    /// `A⁻¹ F` through the [`LoadSubspace`] (recycled when `F` is a combination of loads
-    /// solved before, [`synovia_fem::recycling`]); `None` for a semi-coercive model, whose
-    /// proximal iteration changes the load every iteration.
-    fn recycled_load_solution(&self, load: &[f64]) -> Result<Option<Vec<f64>>, ContactError> {
+    /// The factorised operator `A` (or `A + S` of a semi-coercive model).
+    fn operator(&self) -> Result<CholeskyOperator<'_>, ContactError> {
+        Ok(CholeskyOperator::new(self.elastic.system_matrix(), self.elastic.cholesky())?)
+    }
+
+    /// `A⁻¹ F` through the context's recycled load solves (recycled when `F` is a combination
+    /// of loads solved before, [`synovia_linalg::recycling`]); `None` for a semi-coercive
+    /// model, whose proximal iteration changes the load every iteration.
+    fn recycled_load_solution(
+        &self,
+        operator: &CholeskyOperator<'_>,
+        load: &[f64],
+    ) -> Result<Option<Vec<f64>>, ContactError> {
         if self.elastic.stabilisation().is_some() {
             return Ok(None);
         }
-        let mut subspace = self.load_subspace.lock().unwrap_or_else(|e| e.into_inner());
-        Ok(Some(subspace.solve(self.elastic.system_matrix(), self.elastic.cholesky(), load)?))
+        Ok(Some(self.context.recycled_load_solve(operator, load)?))
     }
 
     /// Runs `solver` on `problem` (with the nested iteration when there is no warm start) and
     /// returns the solution with the iterations spent on coarse levels.
     ///
     /// Row screening: when the factor's trailing block holds the dofs of only some normal
-    /// rows (an interface larger than [`ElasticParams::max_trailing_dofs`], of which the
-    /// [`ElasticParams::screened_trailing_dofs`] of the smallest gaps are ordered last), the solver runs
+    /// rows (an interface larger than [`InterfaceBlockParams::max_dofs`], of which the
+    /// [`InterfaceBlockParams::screened_dofs`] of the smallest gaps are ordered last), the solver runs
     /// on the sub-problem of those *candidate* rows (plus the rows of friction cells and the
     /// rows loaded in the warm start), whose interface Schur complement comes from the dense
     /// trailing block. The excluded rows are then checked with the computed `U`: if none
@@ -381,18 +405,22 @@ impl<const D: usize> StaticContact<D> {
         &self,
         problem: &ContactProblem<'_>,
         solver: &dyn ContactSolver,
+        context: &SolveContext,
         warm: Option<&ContactSolution>,
         cell_node: &[usize],
     ) -> Result<(ContactSolution, usize), ContactError> {
         let nested = |p: &ContactProblem<'_>, adjacency: &[Vec<usize>]| match (warm, self.nested_min_rows) {
-            (None, Some(min_rows)) => crate::nested::nested_warm_start(p, solver, adjacency, min_rows),
+            (None, Some(min_rows)) => {
+                crate::nested::nested_warm_start(p, solver, context, adjacency, min_rows)
+            }
             _ => Ok(None),
         };
         let m = problem.n_normal();
         let Some(mut candidate) = self.trailing_rows(problem.normal) else {
             let coarse = nested(problem, &self.geometry.adjacency)?;
             let start = warm.or(coarse.as_ref().map(|(w, _)| w));
-            let solution = solver.solve(problem, start)?;
+            let solution =
+                solver.solve(problem, &context.with_start(start.cloned(), context.multipliers_only()))?;
             return Ok((solution, coarse.map_or(0, |(_, it)| it)));
         };
         for &r in cell_node {
@@ -412,7 +440,7 @@ impl<const D: usize> StaticContact<D> {
             let rows: Vec<usize> = (0..m).filter(|&r| candidate[r]).collect();
             let normal = restrict_rows(problem.normal, &rows);
             // the screening check below needs U, whatever the caller asked for
-            let sub = ContactProblem { normal: &normal, multipliers_only: false, ..*problem };
+            let sub = ContactProblem { normal: &normal, ..*problem };
             let start = match &current {
                 Some(w) if w.lambda_n.len() == m => Some(ContactSolution {
                     u: w.u.clone(),
@@ -430,7 +458,7 @@ impl<const D: usize> StaticContact<D> {
                     })
                 }
             };
-            let solution = solver.solve(&sub, start.as_ref())?;
+            let solution = solver.solve(&sub, &context.with_start(start, false))?;
             let mut lambda_n = vec![0.0; m];
             for (&r, l) in rows.iter().zip(&solution.lambda_n) {
                 lambda_n[r] = *l;
@@ -566,9 +594,6 @@ fn interface_nodes<const D: usize>(
     }
     Ok(out)
 }
-
-/// Directions kept by the [`LoadSubspace`] of a [`StaticContact`].
-const LOAD_SUBSPACE_CAPACITY: usize = 6;
 
 /// The rows `rows` of `normal` (with their weights and gaps).
 fn restrict_rows(normal: &NormalConstraints, rows: &[usize]) -> NormalConstraints {

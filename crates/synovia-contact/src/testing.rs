@@ -8,7 +8,8 @@
 
 use std::sync::Arc;
 
-use synovia_fem::{CholeskySolver, DofMap, ElasticParams, ElasticSolver, Model, SymmetricMatrix};
+use synovia_fem::{DofMap, ElasticParams, ElasticSolver, Model};
+use synovia_linalg::{SparseCholesky, SparseRows};
 use synovia_material::{isotropic, plane_strain};
 use synovia_mesh::generators::{box_mesh, rectangle, Grading};
 use synovia_mesh::math::{Point, Vector};
@@ -16,15 +17,12 @@ use synovia_mesh::BoundaryKind;
 
 use crate::error::ContactError;
 use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints};
-use crate::rows::SparseRows;
 
-/// An owned contact problem (matrix, factorisation, load, operators).
+/// An owned contact problem (matrix and factorisation, load, operators).
 #[derive(Debug, Clone)]
 pub struct OwnedProblem {
-    /// `A`.
-    pub matrix: SymmetricMatrix,
-    /// Its factorisation.
-    pub factor: CholeskySolver,
+    /// `A` and its factorisation.
+    pub system: SparseCholesky,
     /// `F`.
     pub load: Vec<f64>,
     /// Normal constraints.
@@ -37,14 +35,10 @@ impl OwnedProblem {
     /// The borrowed problem view.
     pub fn problem(&self) -> ContactProblem<'_> {
         ContactProblem {
-            matrix: &self.matrix,
-            factor: &self.factor,
+            operator: &self.system,
             load: &self.load,
             normal: &self.normal,
             friction: self.friction.as_ref(),
-            schur_cache: None,
-            load_solution: None,
-            multipliers_only: false,
         }
     }
 }
@@ -190,8 +184,7 @@ impl BlockOnFoundation {
         let friction =
             self.slip_bound.map(|_| FrictionConstraints { rows: bt, components: D - 1, shift: shift_t });
         Ok(OwnedProblem {
-            matrix: solver.stiffness().clone(),
-            factor: solver.cholesky().clone(),
+            system: SparseCholesky { matrix: solver.stiffness().clone(), factor: solver.cholesky().clone() },
             load,
             normal: NormalConstraints { rows: bn, weights: kappa, gap },
             friction,
@@ -233,7 +226,7 @@ mod tests {
         // same rows (boundary nodes do not move), different stiffness
         assert_eq!(a.normal.gap, b.normal.gap);
         assert_eq!(a.normal.weights, b.normal.weights);
-        assert_ne!(a.matrix.diagonal(), b.matrix.diagonal());
+        assert_ne!(a.system.matrix.diagonal(), b.system.matrix.diagonal());
         let bad = BlockOnFoundation { jitter: 0.7, ..base }.build::<2>();
         assert!(matches!(bad, Err(ContactError::InvalidParameter(_))));
     }

@@ -15,8 +15,8 @@ use crate::element::{body_force_into, traction_into, SimplexGeometry};
 use crate::error::FemError;
 use crate::model::{BodyId, Model};
 use crate::quadrature::QuadratureRule;
-use crate::solver::Ordering;
-use crate::sparse::SymmetricMatrix;
+use synovia_linalg::Ordering;
+use synovia_linalg::SymmetricMatrix;
 
 /// Node-group adjacency of the model's cells (each group adjacent to the groups it shares a
 /// cell with, itself excluded), sorted.

@@ -13,8 +13,8 @@ use crate::element::stiffness_into;
 use crate::error::FemError;
 use crate::model::Model;
 use crate::post::{body_fields, BodyFields};
-use crate::solver::{CholeskySolver, Ordering};
-use crate::sparse::SymmetricMatrix;
+use synovia_linalg::SymmetricMatrix;
+use synovia_linalg::{CholeskySolver, Ordering};
 
 /// Which fill-reducing ordering to use.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -28,35 +28,36 @@ pub enum OrderingChoice {
     Metis,
 }
 
+/// A choice of the fill-reducing ordering from the dof map and the default ordering
+/// ([`ElasticSolver::new_with_ordering`]).
+pub type Reorder<'a, const D: usize> = dyn Fn(&DofMap<D>, Ordering) -> Result<Ordering, FemError> + 'a;
+
 /// Parameters of the elastic solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct ElasticParams {
     /// Fill-reducing ordering (default: [`OrderingChoice::Auto`]).
     pub ordering: OrderingChoice,
     /// Quadrature degree of the load integrals (default: 2).
     pub load_degree: usize,
-    /// Largest number of contact-interface dofs that [`ElasticSolver::new_for_contact`] orders
-    /// last all together (default 8000; 0 switches the condensed interface off). The trailing
-    /// block is dense: `k²` entries (512 MB at 8000) and `k³/3` flops in the factorisation;
-    /// measured in `docs/performance.md`.
-    pub max_trailing_dofs: usize,
-    /// For an interface with more than [`Self::max_trailing_dofs`] dofs: the number of dofs of
-    /// its leading nodes (in the given priority order; for `synovia_contact::StaticContact`
-    /// the contact nodes of smallest initial gap) that are ordered last instead (default
-    /// 6000, capped at [`Self::max_trailing_dofs`]; 0: no trailing block for such an
-    /// interface). The contact solve screens its rows against this block (exactly: rows
-    /// outside it are added when they come into contact).
-    pub screened_trailing_dofs: usize,
 }
 
 impl Default for ElasticParams {
     fn default() -> Self {
-        Self {
-            ordering: OrderingChoice::Auto,
-            load_degree: 2,
-            max_trailing_dofs: 8000,
-            screened_trailing_dofs: 6000,
-        }
+        Self { ordering: OrderingChoice::Auto, load_degree: 2 }
+    }
+}
+
+impl ElasticParams {
+    /// Sets [`Self::ordering`].
+    pub fn with_ordering(mut self, ordering: OrderingChoice) -> Self {
+        self.ordering = ordering;
+        self
+    }
+    /// Sets [`Self::load_degree`].
+    pub fn with_load_degree(mut self, load_degree: usize) -> Self {
+        self.load_degree = load_degree;
+        self
     }
 }
 
@@ -137,24 +138,23 @@ impl<const D: usize> ElasticSolver<D> {
     /// Validates the model, builds the dofs, checks coercivity (docs/model.md §4), assembles `K̃`, and
     /// factorises it.
     pub fn new(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
-        Self::build(model, params, false, &[])
+        Self::build(model, params, false, None)
     }
 
-    /// The factorisation for contact problems: like [`ElasticSolver::new_semi_coercive`], and
-    /// the reduced dofs of the `interface` nodes (the nodes of the contact parts, in priority
-    /// order) are ordered last ([`Ordering::Trailing`]), so that the interface Schur complement
-    /// `S = C A⁻¹ Cᵀ` is evaluated with the dense trailing block `L₂₂` of the factor,
-    /// `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` (docs/model.md §6.4), instead of solves with the whole factor
-    /// ([`CholeskySolver::trailing`]). When the interface has more than
-    /// [`ElasticParams::max_trailing_dofs`] dofs, only the longest prefix of `interface` with at
-    /// most [`ElasticParams::screened_trailing_dofs`] dofs is ordered last (the contact solve
-    /// then screens its rows, see `synovia_contact::StaticContact`).
-    pub fn new_for_contact(
+    /// Like [`ElasticSolver::new_semi_coercive`] (or [`ElasticSolver::new`] when
+    /// `semi_coercive` is `false`), with the fill-reducing ordering chosen by `reorder` from the
+    /// dof map and the default ordering of [`ElasticParams::ordering`] (e.g. a contact problem
+    /// orders its interface dofs last, `synovia_contact::StaticContact`).
+    ///
+    /// # Errors
+    /// As [`ElasticSolver::new`], and the errors of `reorder`.
+    pub fn new_with_ordering(
         model: &Model<D>,
         params: ElasticParams,
-        interface: &[(crate::model::BodyId, usize)],
+        semi_coercive: bool,
+        reorder: &Reorder<'_, D>,
     ) -> Result<Self, FemError> {
-        Self::build(model, params, true, interface)
+        Self::build(model, params, semi_coercive, Some(reorder))
     }
 
     /// Like [`ElasticSolver::new`], but a semi-coercive model (bodies whose rigid motions no
@@ -164,14 +164,14 @@ impl<const D: usize> ElasticSolver<D> {
     /// refuses such a model ([`FemError::SemiCoercive`]): without contact it has no unique
     /// solution.
     pub fn new_semi_coercive(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
-        Self::build(model, params, true, &[])
+        Self::build(model, params, true, None)
     }
 
     fn build(
         model: &Model<D>,
         params: ElasticParams,
         allow_floating: bool,
-        interface: &[(crate::model::BodyId, usize)],
+        reorder: Option<&Reorder<'_, D>>,
     ) -> Result<Self, FemError> {
         let t0 = Instant::now();
         let dofs = DofMap::new(model)?;
@@ -189,44 +189,8 @@ impl<const D: usize> ElasticSolver<D> {
             (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => Ordering::Amd,
             _ => metis,
         };
-        if !interface.is_empty() {
-            let mut seen = vec![false; dofs.groups().len()];
-            let mut total = 0;
-            for &(b, i) in interface {
-                let n_nodes = model.body(b)?.mesh.n_nodes();
-                if i >= n_nodes {
-                    return Err(FemError::InvalidParameter(format!(
-                        "interface node {i} of body #{} is out of range (it has {n_nodes} nodes)",
-                        b.0
-                    )));
-                }
-                let g = dofs.group_of(b, i);
-                if !std::mem::replace(&mut seen[g], true) {
-                    total += dofs.groups()[g].n_dofs;
-                }
-            }
-            // the whole interface if it fits, else its longest prefix within the screened budget
-            let budget = if total <= params.max_trailing_dofs {
-                total
-            } else {
-                params.screened_trailing_dofs.min(params.max_trailing_dofs)
-            };
-            let mut last = Vec::new();
-            seen.fill(false);
-            for &(b, i) in interface {
-                let g = dofs.group_of(b, i);
-                if std::mem::replace(&mut seen[g], true) {
-                    continue;
-                }
-                let grp = &dofs.groups()[g];
-                if last.len() + grp.n_dofs > budget {
-                    break;
-                }
-                last.extend(grp.first_dof..grp.first_dof + grp.n_dofs);
-            }
-            if !last.is_empty() && last.len() < dofs.n_dofs() {
-                ordering = Ordering::Trailing { base: Box::new(ordering), last };
-            }
+        if let Some(reorder) = reorder {
+            ordering = reorder(&dofs, ordering)?;
         }
         let stabilisation = if floating.is_empty() {
             None

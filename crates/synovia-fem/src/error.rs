@@ -103,12 +103,10 @@ pub enum FemError {
         /// Actual size.
         got: usize,
     },
-    /// The system matrix is not positive definite (Cholesky met a non-positive pivot).
-    #[error("the system matrix is not positive definite: non-positive pivot at (permuted) index {index}")]
-    NotPositiveDefinite {
-        /// Pivot index in the factorisation order.
-        index: usize,
-    },
+    /// A failure of the linear algebra (factorisation, solve; e.g. a matrix that is not
+    /// positive definite).
+    #[error(transparent)]
+    Linalg(#[from] synovia_linalg::LinalgError),
     /// A sparse-matrix or factorisation failure that is not a numerical one (memory, sizes).
     #[error("sparse linear algebra failed: {0}")]
     Sparse(String),

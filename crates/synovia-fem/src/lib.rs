@@ -7,8 +7,8 @@
 //! `(f, v) = ∫ F · v dx + ∫_{¹Γ_τ} P · v ds`. The unknowns are reduced by the constraints of the
 //! boundary parts (Dirichlet `u = u₂(t)`, clamped, symmetry `u · n = 0` along any normal) and by
 //! bonded interfaces, `u = u_p(t) + P ũ` ([`dofs`]), so the system `K̃ ũ = F̃` stays symmetric
-//! positive definite and is factorised once by [`CholeskySolver`] (faer, AMD or METIS ordering)
-//! and reused for every load case.
+//! positive definite and is factorised once by [`CholeskySolver`] (faer, AMD or METIS ordering;
+//! crate `synovia-linalg`) and reused for every load case.
 //!
 //! Data path: [`Model`] (bodies, materials, boundary data) → [`DofMap`] (reduced unknowns,
 //! coercivity check) → [`assembly::pattern`] (fixed pattern) → [`assembly::assemble_matrix`]
@@ -23,18 +23,15 @@ pub mod error;
 pub mod model;
 pub mod post;
 pub mod quadrature;
-pub mod recycling;
-pub mod solver;
-pub mod sparse;
 
 pub use dofs::{DofMap, FloatingComponent};
 pub use elastic::{
-    solve_elastic, ElasticInfo, ElasticParams, ElasticSolution, ElasticSolver, OrderingChoice, Stabilisation,
+    solve_elastic, ElasticInfo, ElasticParams, ElasticSolution, ElasticSolver, OrderingChoice, Reorder,
+    Stabilisation,
 };
 pub use error::FemError;
 pub use model::{Body, BodyId, ComponentMask, Model, TractionField, VectorField};
 pub use post::BodyFields;
 pub use quadrature::QuadratureRule;
-pub use recycling::LoadSubspace;
-pub use solver::{CholeskyInfo, CholeskySolver, Ordering, TrailingBlock};
-pub use sparse::SymmetricMatrix;
+/// The linear algebra the elastic solve uses (re-exported from `synovia-linalg`).
+pub use synovia_linalg::{CholeskyInfo, CholeskySolver, LinalgError, Ordering, SymmetricMatrix};

@@ -4,7 +4,7 @@ use std::time::Instant;
 
 use synovia_contact::{
     ContactError, ContactParams, ContactProblem, ContactSolution, ContactSolver, IterationResidual,
-    SolverReport,
+    SolveContext, SolverReport,
 };
 
 use crate::sets::{finish, CellState, Sets, State};
@@ -64,12 +64,12 @@ impl ContactSolver for AuPdas {
     fn solve(
         &self,
         problem: &ContactProblem<'_>,
-        warm_start: Option<&ContactSolution>,
+        context: &SolveContext,
     ) -> Result<ContactSolution, ContactError> {
         let start = Instant::now();
         let name = self.name();
-        let mut st = State::new(problem, &self.params)?;
-        let mut nu = st.initial_nu(problem, warm_start)?;
+        let mut st = State::new(problem, context, &self.params)?;
+        let mut nu = st.initial_nu(problem, context.warm_start())?;
         let mut y = st.values(&nu)?;
         let mut sets =
             Sets { normal: st.classify_normal(&nu, &y, None), cells: st.classify_cells(&nu, &y, None) };

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use synovia_contact::{
     ContactError, ContactParams, ContactProblem, ContactSolution, ContactSolver, IterationResidual,
-    SolverReport,
+    SolveContext, SolverReport,
 };
 
 use crate::sets::{finish, CellState, Sets, State};
@@ -110,7 +110,7 @@ impl Pdas {
     pub fn solve_traced(
         &self,
         problem: &ContactProblem<'_>,
-        warm_start: Option<&ContactSolution>,
+        context: &SolveContext,
         stop_on_cycling: bool,
     ) -> PdasTrace {
         let mut trace = PdasTrace {
@@ -120,7 +120,7 @@ impl Pdas {
             stagnation: false,
         };
         let mut last_nu = None;
-        trace.result = self.iterate(problem, warm_start, stop_on_cycling, &mut trace, &mut last_nu);
+        trace.result = self.iterate(problem, context, stop_on_cycling, &mut trace, &mut last_nu);
         if let Some((nu, u)) = last_nu {
             let (lambda_n, lambda_t) = problem.split_multipliers(&nu);
             trace.last_iterate =
@@ -132,15 +132,15 @@ impl Pdas {
     fn iterate(
         &self,
         problem: &ContactProblem<'_>,
-        warm_start: Option<&ContactSolution>,
+        context: &SolveContext,
         stop_on_cycling: bool,
         trace: &mut PdasTrace,
         last_nu: &mut Option<(Vec<f64>, Vec<f64>)>,
     ) -> Result<ContactSolution, ContactError> {
         let start = Instant::now();
         let name = "pdas";
-        let mut st = State::new(problem, &self.params)?;
-        let mut nu = st.initial_nu(problem, warm_start)?;
+        let mut st = State::new(problem, context, &self.params)?;
+        let mut nu = st.initial_nu(problem, context.warm_start())?;
         let mut y = st.values(&nu)?;
         let mut sets =
             Sets { normal: st.classify_normal(&nu, &y, None), cells: st.classify_cells(&nu, &y, None) };
@@ -256,8 +256,8 @@ impl ContactSolver for Pdas {
     fn solve(
         &self,
         problem: &ContactProblem<'_>,
-        warm_start: Option<&ContactSolution>,
+        context: &SolveContext,
     ) -> Result<ContactSolution, ContactError> {
-        self.solve_traced(problem, warm_start, false).result
+        self.solve_traced(problem, context, false).result
     }
 }

@@ -6,7 +6,9 @@
 //! `y = w − S ν`, offsets `g = (d, s)`, complementarity parameters `ρ`.
 
 use faer::linalg::solvers::Solve;
-use synovia_contact::{ContactError, ContactParams, ContactProblem, ContactSolution, Interface};
+use synovia_contact::{
+    ContactError, ContactParams, ContactProblem, ContactSolution, Interface, SolveContext,
+};
 
 /// Relative width of the switching band: a row whose switching quantity lies within
 /// `SWITCH_BAND × scale` of its threshold keeps its previous state. Both states are then
@@ -143,7 +145,11 @@ pub(crate) fn check_params(params: &ContactParams) -> Result<(), ContactError> {
 impl<'p> State<'p> {
     /// Validates the problem and parameters, detects empty rows (an empty normal row with
     /// `d_r < 0` is infeasible) and computes `w` (one solve).
-    pub fn new(problem: &ContactProblem<'p>, params: &ContactParams) -> Result<Self, ContactError> {
+    pub fn new(
+        problem: &ContactProblem<'p>,
+        context: &'p SolveContext,
+        params: &ContactParams,
+    ) -> Result<Self, ContactError> {
         check_params(params)?;
         problem.validate()?;
         let m = problem.n_normal();
@@ -189,7 +195,7 @@ impl<'p> State<'p> {
                 rho[r]
             )));
         }
-        let iface = Interface::new(*problem)?;
+        let iface = Interface::new(*problem, context)?;
         Ok(Self {
             iface,
             m,

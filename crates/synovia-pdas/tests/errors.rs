@@ -14,10 +14,11 @@ fn solvers(params: ContactParams) -> [Box<dyn ContactSolver>; 2] {
 fn max_iterations_gives_no_convergence_with_history() {
     let owned = tresca_2d();
     let p = owned.problem();
-    let needed = Pdas::default().solve(&p, None).expect("pdas").report.iterations;
+    let needed =
+        Pdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("pdas").report.iterations;
     assert!(needed > 1);
     for s in solvers(ContactParams { max_iterations: 1, ..Default::default() }) {
-        match s.solve(&p, None) {
+        match s.solve(&p, &synovia_contact::SolveContext::new()) {
             Err(ContactError::NoConvergence { solver, iterations, history }) => {
                 println!("{solver}: {iterations} iteration(s), history {history:?}");
                 assert_eq!(solver, s.name());
@@ -40,7 +41,7 @@ fn empty_row_with_negative_gap_is_infeasible() {
     owned.normal.gap.push(-1e-3);
     let p = owned.problem();
     for s in solvers(ContactParams::default()) {
-        match s.solve(&p, None) {
+        match s.solve(&p, &synovia_contact::SolveContext::new()) {
             Err(ContactError::Infeasible(msg)) => {
                 println!("{}: {msg}", s.name());
                 assert!(msg.contains(&format!("normal row {m}")), "{msg}");
@@ -57,7 +58,7 @@ fn empty_row_with_nonnegative_gap_is_harmless() {
     owned.normal.weights.push(0.1);
     owned.normal.gap.push(0.0);
     let p = owned.problem();
-    let sol = Pdas::default().solve(&p, None).expect("pdas");
+    let sol = Pdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("pdas");
     common::assert_kkt(&p, &sol, "empty row, d = 0");
     assert_eq!(sol.lambda_n.last().copied(), Some(0.0));
 }
@@ -73,7 +74,7 @@ fn duplicated_active_row_is_singular() {
     owned.normal.gap.push(owned.normal.gap[mid]);
     let p = owned.problem();
     for s in solvers(ContactParams::default()) {
-        match s.solve(&p, None) {
+        match s.solve(&p, &synovia_contact::SolveContext::new()) {
             Err(ContactError::Singular { solver, iteration, size }) => {
                 println!("{solver}: singular at iteration {iteration}, size {size}");
                 assert_eq!(solver, s.name());
@@ -96,14 +97,20 @@ fn invalid_parameters_are_rejected() {
     for params in bad {
         for s in solvers(params) {
             assert!(
-                matches!(s.solve(&p, None), Err(ContactError::InvalidParameter(_))),
+                matches!(
+                    s.solve(&p, &synovia_contact::SolveContext::new()),
+                    Err(ContactError::InvalidParameter(_))
+                ),
                 "{} accepted {params:?}",
                 s.name()
             );
         }
     }
     // a warm start of the wrong size
-    let mut sol = Pdas::default().solve(&p, None).expect("pdas");
+    let mut sol = Pdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("pdas");
     sol.lambda_n.pop();
-    assert!(matches!(Pdas::default().solve(&p, Some(&sol)), Err(ContactError::InvalidParameter(_))));
+    assert!(matches!(
+        Pdas::default().solve(&p, &synovia_contact::SolveContext::warm(sol.clone())),
+        Err(ContactError::InvalidParameter(_))
+    ));
 }

@@ -23,14 +23,14 @@ fn check_partial(sol: &ContactSolution, m: usize, label: &str) {
 fn frictionless_2d() {
     let owned = frictionless(16).build::<2>().expect("problem");
     let p = owned.problem();
-    let sol = Pdas::default().solve(&p, None).expect("pdas");
+    let sol = Pdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("pdas");
     assert_kkt(&p, &sol, "pdas 2D frictionless");
     check_partial(&sol, p.n_normal(), "pdas 2D frictionless");
     assert_eq!(sol.report.solver, "pdas");
     assert_eq!(sol.report.history.len(), sol.report.iterations);
 
     // AU-PDAS reduces to PDAS without friction
-    let au = AuPdas::default().solve(&p, None).expect("au-pdas");
+    let au = AuPdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("au-pdas");
     assert_kkt(&p, &au, "au-pdas 2D frictionless");
     assert_eq!(au.report.iterations, sol.report.iterations);
     assert_same(&sol, &au, 1e-12, "au-pdas vs pdas, 2D frictionless");
@@ -40,10 +40,10 @@ fn frictionless_2d() {
 fn frictionless_3d() {
     let owned = frictionless(8).build::<3>().expect("problem");
     let p = owned.problem();
-    let sol = Pdas::default().solve(&p, None).expect("pdas");
+    let sol = Pdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("pdas");
     assert_kkt(&p, &sol, "pdas 3D frictionless");
     check_partial(&sol, p.n_normal(), "pdas 3D frictionless");
-    let au = AuPdas::default().solve(&p, None).expect("au-pdas");
+    let au = AuPdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("au-pdas");
     assert_kkt(&p, &au, "au-pdas 3D frictionless");
     assert_same(&sol, &au, 1e-12, "au-pdas vs pdas, 3D frictionless");
 }
@@ -57,7 +57,7 @@ fn frictionless_rho_independence() {
         .map(|&rho_scale| {
             let mut s = Pdas::default();
             s.params.rho_scale = rho_scale;
-            let sol = s.solve(&p, None).expect("pdas");
+            let sol = s.solve(&p, &synovia_contact::SolveContext::new()).expect("pdas");
             assert_kkt(&p, &sol, &format!("rho_scale {rho_scale}"));
             println!("rho_scale {rho_scale}: {} iterations", sol.report.iterations);
             sol
@@ -73,7 +73,7 @@ fn mesh_independence_2d() {
     for n in [8, 16, 32, 64] {
         let owned = frictionless(n).build::<2>().expect("problem");
         let p = owned.problem();
-        let sol = Pdas::default().solve(&p, None).expect("pdas");
+        let sol = Pdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("pdas");
         assert_kkt(&p, &sol, &format!("n = {n}"));
         println!(
             "n = {n:3}: {} PDAS iterations, {} of {} rows active, {} solves, {:.1} ms",

@@ -9,7 +9,7 @@ use synovia_pdas::{AuPdas, Pdas};
 
 fn solve_checked(owned: &OwnedProblem, solver: &dyn ContactSolver, label: &str) -> ContactSolution {
     let p = owned.problem();
-    let sol = match solver.solve(&p, None) {
+    let sol = match solver.solve(&p, &synovia_contact::SolveContext::new()) {
         Ok(s) => s,
         Err(e) => panic!("{label}: {e}"),
     };
@@ -117,7 +117,7 @@ fn au_pdas_agrees_with_pdas_3d() {
 fn warm_start(owned: &OwnedProblem, solver: &dyn ContactSolver, label: &str) {
     let p = owned.problem();
     let cold = solve_checked(owned, solver, label);
-    let warm = match solver.solve(&p, Some(&cold)) {
+    let warm = match solver.solve(&p, &synovia_contact::SolveContext::warm(cold.clone())) {
         Ok(s) => s,
         Err(e) => panic!("{label} warm: {e}"),
     };

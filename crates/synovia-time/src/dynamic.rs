@@ -793,22 +793,18 @@ impl<const D: usize> DynamicStepper<D> {
                 None
             };
             let friction = friction_op.as_ref().map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0);
-            let problem = ContactProblem {
-                matrix: &self.matrix,
-                factor: &self.factor,
-                load: rhs,
-                normal: &normal,
-                friction,
-                schur_cache: None,
-                load_solution: None,
-                multipliers_only: false,
-            };
+            let operator = synovia_linalg::CholeskyOperator::new(&self.matrix, &self.factor)?;
+            let problem = ContactProblem { operator: &operator, load: rhs, normal: &normal, friction };
             let (cell_node, slip_bound) = match (&friction_op, friction.is_some()) {
                 (Some(op), true) => (op.cell_node.clone(), op.slip_bound.clone()),
                 _ => (Vec::new(), Vec::new()),
             };
             let warm = if self.params.warm_start { self.warm_start(&cell_node) } else { None };
-            let solution = solver.solve(&problem, warm.as_ref()).map_err(contact_err)?;
+            let context = match warm {
+                Some(w) => synovia_contact::SolveContext::warm(w),
+                None => synovia_contact::SolveContext::new(),
+            };
+            let solution = solver.solve(&problem, &context).map_err(contact_err)?;
             iterations += solution.report.iterations;
             let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
             // Σ_c ‖B_Ht U − s‖_c (scaled friction work)

@@ -27,6 +27,9 @@ pub enum TimeError {
     /// A finite-element error.
     #[error(transparent)]
     Fem(#[from] FemError),
+    /// A linear-algebra error (factorisation, solve).
+    #[error(transparent)]
+    Linalg(#[from] synovia_linalg::LinalgError),
     /// An output error.
     #[error(transparent)]
     Io(#[from] IoError),

@@ -6,7 +6,7 @@
 use std::ops::Range;
 use std::time::Instant;
 
-use synovia_contact::{ContactError, ContactProblem, Interface};
+use synovia_contact::{ContactError, ContactProblem, Interface, SolveContext};
 
 use crate::qp::Hessian;
 
@@ -27,15 +27,19 @@ impl<'p> SchurOperator<'p> {
     pub const DENSE_LIMIT: usize = 3000;
 
     /// Validates the problem, computes `w` and, if `m ≤ DENSE_LIMIT`, all columns of `S`.
-    pub fn new(problem: ContactProblem<'p>) -> Result<Self, ContactError> {
+    pub fn new(problem: ContactProblem<'p>, context: &'p SolveContext) -> Result<Self, ContactError> {
         let dense = problem.n_rows() <= Self::DENSE_LIMIT;
-        Self::with_storage(problem, dense)
+        Self::with_storage(problem, context, dense)
     }
 
     /// As [`SchurOperator::new`] with the storage chosen explicitly (`dense = false`:
     /// matrix-free).
-    pub fn with_storage(problem: ContactProblem<'p>, dense: bool) -> Result<Self, ContactError> {
-        let mut interface = Interface::new(problem)?;
+    pub fn with_storage(
+        problem: ContactProblem<'p>,
+        context: &'p SolveContext,
+        dense: bool,
+    ) -> Result<Self, ContactError> {
+        let mut interface = Interface::new(problem, context)?;
         if dense {
             let all: Vec<usize> = (0..problem.n_rows()).collect();
             interface.ensure_columns(&all)?;
@@ -116,9 +120,9 @@ impl<'p> SchurOperator<'p> {
         let t0 = Instant::now();
         let mut full = vec![0.0; m];
         full[cols].copy_from_slice(v);
-        let mut x = vec![0.0; self.problem.matrix.n()];
+        let mut x = vec![0.0; self.problem.operator.n()];
         self.problem.apply_transpose_add(&full, &mut x);
-        self.problem.factor.solve_in_place(&mut x)?;
+        self.problem.operator.solve_in_place(&mut x)?;
         self.extra_solves += 1;
         for (o, r) in out.iter_mut().zip(rows) {
             *o = self.problem.row(r).map(|(c, a)| a * x[c]).sum();
@@ -138,12 +142,22 @@ impl<'p> SchurOperator<'p> {
                 } else {
                     let row: Vec<(usize, f64)> = self.problem.row(r).collect();
                     let cc: f64 = row.iter().map(|(_, a)| a * a).sum();
-                    let mut cac = 0.0;
-                    for &(i, a) in &row {
-                        for &(k, b) in &row {
-                            cac += a * b * self.problem.matrix.get(i, k);
+                    let op = self.problem.operator;
+                    let cac = if row.iter().all(|&(i, _)| op.entry(i, i).is_some()) {
+                        let mut cac = 0.0;
+                        for &(i, a) in &row {
+                            for &(k, b) in &row {
+                                cac += a * b * op.entry(i, k).unwrap_or(0.0);
+                            }
                         }
-                    }
+                        cac
+                    } else {
+                        // a matrix-free operator: c_rᵀ A c_r by one product
+                        let mut c = vec![0.0; op.n()];
+                        row.iter().for_each(|&(i, a)| c[i] += a);
+                        let ac = op.apply(&c);
+                        row.iter().map(|&(i, a)| a * ac[i]).sum()
+                    };
                     if cac > 0.0 {
                         cc * cc / cac
                     } else {

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use synovia_contact::{
     ContactError, ContactParams, ContactProblem, ContactSolution, ContactSolver, IterationResidual,
-    SolverReport,
+    SolveContext, SolverReport,
 };
 
 use crate::common::{
@@ -106,7 +106,7 @@ impl ContactSolver for UzawaMprgp {
     fn solve(
         &self,
         problem: &ContactProblem<'_>,
-        warm_start: Option<&ContactSolution>,
+        context: &SolveContext,
     ) -> Result<ContactSolution, ContactError> {
         let t0 = Instant::now();
         check_params(&self.params)?;
@@ -116,9 +116,9 @@ impl ContactSolver for UzawaMprgp {
                 self.inner_tolerance, self.max_inner
             )));
         }
-        let mut op = SchurOperator::new(*problem)?;
+        let mut op = SchurOperator::new(*problem, context)?;
         let (mn, m, c) = (problem.n_normal(), problem.n_rows(), problem.components());
-        let mut nu = initial_multipliers(problem, warm_start)?;
+        let mut nu = initial_multipliers(problem, context.warm_start())?;
         let rho = problem.default_rho(self.params.rho_scale);
         let offsets = problem.offsets();
         let diag = op.diagonal();

@@ -42,7 +42,8 @@ fn solve_checked(
     p: &ContactProblem<'_>,
     warm: Option<&ContactSolution>,
 ) -> ContactSolution {
-    let sol = match solver.solve(p, warm) {
+    let context = synovia_contact::SolveContext::new().with_start(warm.cloned(), false);
+    let sol = match solver.solve(p, &context) {
         Ok(s) => s,
         Err(e) => panic!("{} failed: {e}", solver.name()),
     };
@@ -163,7 +164,7 @@ fn too_few_iterations_is_no_convergence() {
             Box::new(UzawaMprgp { params: few, inner_tolerance: 1e-12, max_inner: 100 }),
         ];
         for s in &solvers {
-            match s.solve(&p, None) {
+            match s.solve(&p, &synovia_contact::SolveContext::new()) {
                 Err(ContactError::NoConvergence { solver, iterations, history }) => {
                     assert_eq!(solver, s.name());
                     assert_eq!(iterations, 3);
@@ -183,15 +184,30 @@ fn invalid_parameters_and_warm_starts() {
     let owned = problem(2, true);
     let p = owned.problem();
     let bad = ContactParams { tolerance: 0.0, ..ContactParams::default() };
-    assert!(matches!(DualMprgp { params: bad }.solve(&p, None), Err(ContactError::InvalidParameter(_))));
-    assert!(matches!(UzawaMprgp::new(bad).solve(&p, None), Err(ContactError::InvalidParameter(_))));
+    assert!(matches!(
+        DualMprgp { params: bad }.solve(&p, &synovia_contact::SolveContext::new()),
+        Err(ContactError::InvalidParameter(_))
+    ));
+    assert!(matches!(
+        UzawaMprgp::new(bad).solve(&p, &synovia_contact::SolveContext::new()),
+        Err(ContactError::InvalidParameter(_))
+    ));
     let no_inner = UzawaMprgp { max_inner: 0, ..UzawaMprgp::default() };
-    assert!(matches!(no_inner.solve(&p, None), Err(ContactError::InvalidParameter(_))));
+    assert!(matches!(
+        no_inner.solve(&p, &synovia_contact::SolveContext::new()),
+        Err(ContactError::InvalidParameter(_))
+    ));
     // a warm start of another problem
     let other = problem(2, false);
     let sol = solve_checked(&dual(1e-10), &other.problem(), None);
-    assert!(matches!(dual(1e-10).solve(&p, Some(&sol)), Err(ContactError::InvalidParameter(_))));
-    assert!(matches!(uzawa(1e-10).solve(&p, Some(&sol)), Err(ContactError::InvalidParameter(_))));
+    assert!(matches!(
+        dual(1e-10).solve(&p, &synovia_contact::SolveContext::warm(sol.clone())),
+        Err(ContactError::InvalidParameter(_))
+    ));
+    assert!(matches!(
+        uzawa(1e-10).solve(&p, &synovia_contact::SolveContext::warm(sol.clone())),
+        Err(ContactError::InvalidParameter(_))
+    ));
 }
 
 #[test]
@@ -204,7 +220,7 @@ fn infeasible_constraint_is_reported() {
         owned.normal.gap.push(-0.01);
         let p = owned.problem();
         for s in [&dual(1e-10) as &dyn ContactSolver, &uzawa(1e-10)] {
-            match s.solve(&p, None) {
+            match s.solve(&p, &synovia_contact::SolveContext::new()) {
                 Err(ContactError::Infeasible(msg)) => println!("{dim}D {}: {msg}", s.name()),
                 other => panic!("{dim}D {}: expected Infeasible, got {other:?}", s.name()),
             }
@@ -225,8 +241,9 @@ fn infeasible_constraint_is_reported() {
 fn matrix_free_schur_complement_matches_dense() {
     let owned = problem(3, true);
     let p = owned.problem();
-    let mut dense = SchurOperator::with_storage(p, true).expect("dense S");
-    let mut free = SchurOperator::with_storage(p, false).expect("matrix-free S");
+    let (ctx_dense, ctx_free) = (synovia_contact::SolveContext::new(), synovia_contact::SolveContext::new());
+    let mut dense = SchurOperator::with_storage(p, &ctx_dense, true).expect("dense S");
+    let mut free = SchurOperator::with_storage(p, &ctx_free, false).expect("matrix-free S");
     assert!(dense.is_dense() && !free.is_dense());
     let m = dense.n_rows();
     let v: Vec<f64> = (0..m).map(|i| ((i * 37) % 11) as f64 / 11.0 - 0.5).collect();

@@ -8,7 +8,7 @@
 
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 
-use crate::error::FemError;
+use crate::error::LinalgError;
 
 /// Symmetric sparse matrix, lower triangle (row ≥ column) in CSC.
 #[derive(Debug, Clone)]
@@ -19,7 +19,7 @@ pub struct SymmetricMatrix {
 
 impl SymmetricMatrix {
     /// Builds the pattern from, for each column `j`, its sorted row indices `≥ j`.
-    pub fn from_columns(n: usize, columns: Vec<Vec<usize>>) -> Result<Self, FemError> {
+    pub fn from_columns(n: usize, columns: Vec<Vec<usize>>) -> Result<Self, LinalgError> {
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::with_capacity(columns.iter().map(Vec::len).sum());
         col_ptr.push(0);
@@ -74,14 +74,14 @@ impl SymmetricMatrix {
     /// Adds `v` to entry `(i, j)` of the symmetric matrix (either triangle). Entries outside
     /// the pattern are an error.
     #[inline]
-    pub fn add(&mut self, i: usize, j: usize, v: f64) -> Result<(), FemError> {
+    pub fn add(&mut self, i: usize, j: usize, v: f64) -> Result<(), LinalgError> {
         let (r, c) = if i >= j { (i, j) } else { (j, i) };
         match self.position(r, c) {
             Some(p) => {
                 self.values[p] += v;
                 Ok(())
             }
-            None => Err(FemError::Sparse(format!("entry ({r}, {c}) is outside the pattern"))),
+            None => Err(LinalgError::Sparse(format!("entry ({r}, {c}) is outside the pattern"))),
         }
     }
 
@@ -124,9 +124,9 @@ impl SymmetricMatrix {
     }
 
     /// `self += alpha · other` for a matrix with the same pattern.
-    pub fn add_scaled(&mut self, alpha: f64, other: &SymmetricMatrix) -> Result<(), FemError> {
+    pub fn add_scaled(&mut self, alpha: f64, other: &SymmetricMatrix) -> Result<(), LinalgError> {
         if other.values.len() != self.values.len() || other.n() != self.n() {
-            return Err(FemError::Sparse("add_scaled: patterns differ".into()));
+            return Err(LinalgError::Sparse("add_scaled: patterns differ".into()));
         }
         for (a, b) in self.values.iter_mut().zip(&other.values) {
             *a += alpha * b;
@@ -154,9 +154,9 @@ impl SymmetricMatrix {
     /// Builds from a full symmetric or a lower-triangular `sprs` matrix. Errors on a
     /// non-square matrix, non-finite entries, and a full matrix that is not symmetric (an
     /// upper entry differing from its lower mirror by more than `1e-12 max |a_ij|`).
-    pub fn from_sprs(m: &sprs::CsMat<f64>) -> Result<Self, FemError> {
+    pub fn from_sprs(m: &sprs::CsMat<f64>) -> Result<Self, LinalgError> {
         if m.rows() != m.cols() {
-            return Err(FemError::Sparse(format!("matrix is {}×{}, not square", m.rows(), m.cols())));
+            return Err(LinalgError::Sparse(format!("matrix is {}×{}, not square", m.rows(), m.cols())));
         }
         let n = m.rows();
         let mut upper: std::collections::HashMap<(usize, usize), f64> = std::collections::HashMap::new();
@@ -164,7 +164,7 @@ impl SymmetricMatrix {
         let mut amax: f64 = 0.0;
         for (v, (i, j)) in m.iter() {
             if !v.is_finite() {
-                return Err(FemError::Sparse(format!("entry ({i}, {j}) is {v}")));
+                return Err(LinalgError::Sparse(format!("entry ({i}, {j}) is {v}")));
             }
             amax = amax.max(v.abs());
             match i.cmp(&j) {
@@ -179,7 +179,7 @@ impl SymmetricMatrix {
                 let (a, b) =
                     (lower.get(&(i, j)).copied().unwrap_or(0.0), upper.get(&(i, j)).copied().unwrap_or(0.0));
                 if (a - b).abs() > tol {
-                    return Err(FemError::Sparse(format!(
+                    return Err(LinalgError::Sparse(format!(
                         "matrix is not symmetric: a[{i}][{j}] = {a:e} but a[{j}][{i}] = {b:e}"
                     )));
                 }

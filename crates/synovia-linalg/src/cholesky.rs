@@ -17,7 +17,7 @@ use faer::sparse::linalg::cholesky::{
 };
 use faer::{Conj, MatMut, Par, Side};
 
-use crate::error::FemError;
+use crate::error::LinalgError;
 use crate::sparse::SymmetricMatrix;
 
 /// Fill-reducing ordering of the Cholesky factorisation.
@@ -102,14 +102,14 @@ pub struct CholeskySolver {
 
 impl CholeskySolver {
     /// Symbolic analysis of the pattern of `a` with the given ordering.
-    pub fn analyse(a: &SymmetricMatrix, ordering: &Ordering) -> Result<Self, FemError> {
+    pub fn analyse(a: &SymmetricMatrix, ordering: &Ordering) -> Result<Self, LinalgError> {
         let t0 = Instant::now();
         let n = a.n();
         let (perm, trailing_dofs) = match ordering {
             Ordering::Trailing { base, last } => {
                 let base_perm = match base.as_ref() {
                     Ordering::Trailing { .. } => {
-                        return Err(FemError::InvalidParameter("nested trailing orderings".into()))
+                        return Err(LinalgError::InvalidParameter("nested trailing orderings".into()))
                     }
                     other => match explicit_order(n, other)? {
                         Some(p) => p,
@@ -120,7 +120,7 @@ impl CholeskySolver {
                 let mut is_last = vec![false; n];
                 for &d in last {
                     if d >= n || is_last[d] {
-                        return Err(FemError::InvalidParameter(format!(
+                        return Err(LinalgError::InvalidParameter(format!(
                             "trailing dofs must be distinct and < {n} (dof {d})"
                         )));
                     }
@@ -150,7 +150,7 @@ impl CholeskySolver {
                 )
             }
         }
-        .map_err(|e| FemError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
+        .map_err(|e| LinalgError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
         let len = symbolic.len_val();
         let info = CholeskyInfo { symbolic_s: t0.elapsed().as_secs_f64(), numeric_s: 0.0, factor_nnz: len };
         Ok(Self {
@@ -164,17 +164,17 @@ impl CholeskySolver {
     }
 
     /// Numeric factorisation of `a` (same pattern as analysed), reusing the symbolic analysis.
-    pub fn factorize(&mut self, a: &SymmetricMatrix) -> Result<(), FemError> {
+    pub fn factorize(&mut self, a: &SymmetricMatrix) -> Result<(), LinalgError> {
         let t0 = Instant::now();
         if a.n() != self.symbolic.nrows() {
-            return Err(FemError::Length { what: "matrix", expected: self.symbolic.nrows(), got: a.n() });
+            return Err(LinalgError::Length { what: "matrix", expected: self.symbolic.nrows(), got: a.n() });
         }
         self.factorized = false;
         let len = self.symbolic.len_val();
         self.factor.clear();
-        self.factor
-            .try_reserve_exact(len)
-            .map_err(|_| FemError::Sparse(format!("out of memory for a Cholesky factor of {len} entries")))?;
+        self.factor.try_reserve_exact(len).map_err(|_| {
+            LinalgError::Sparse(format!("out of memory for a Cholesky factor of {len} entries"))
+        })?;
         self.factor.resize(len, 0.0);
         // Threads pay only for large factors: below `nnz(L)² / n = 1e10` (≈ flops / 2) the
         // sequential factorisation is faster (docs/performance.md, "Parallel assembly").
@@ -182,7 +182,7 @@ impl CholeskySolver {
         let par = if work < 1e10 { Par::Seq } else { faer::get_global_parallelism() };
         let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
         let mut mem =
-            MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;
+            MemBuffer::try_new(req).map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
         self.symbolic
             .factorize_numeric_llt::<f64>(
                 &mut self.factor,
@@ -195,7 +195,7 @@ impl CholeskySolver {
             )
             .map_err(|e| match e {
                 faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index } => {
-                    FemError::NotPositiveDefinite { index }
+                    LinalgError::NotPositiveDefinite { index }
                 }
             })?;
         self.factorized = true;
@@ -214,7 +214,7 @@ impl CholeskySolver {
     }
 
     /// Copies the last `k = dofs.len()` columns of `L` (rows ≥ `n − k`) into a dense `L₂₂`.
-    fn extract_trailing(&self, dofs: &[usize]) -> Result<TrailingBlock, FemError> {
+    fn extract_trailing(&self, dofs: &[usize]) -> Result<TrailingBlock, LinalgError> {
         use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
         let n = self.symbolic.nrows();
         let k = dofs.len();
@@ -277,7 +277,7 @@ impl CholeskySolver {
     ///
     /// # Errors
     /// As [`CholeskySolver::solve_in_place`].
-    pub fn solve_trailing_supported_in_place(&self, b: &mut [f64]) -> Result<(), FemError> {
+    pub fn solve_trailing_supported_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
         use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
         use faer::sparse::linalg::triangular_solve::solve_lower_triangular_transpose_in_place;
         use faer::sparse::SparseColMatRef;
@@ -287,7 +287,7 @@ impl CholeskySolver {
             return self.solve_in_place(b);
         };
         if b.len() != n {
-            return Err(FemError::Length { what: "right-hand side", expected: n, got: b.len() });
+            return Err(LinalgError::Length { what: "right-hand side", expected: n, got: b.len() });
         }
         let (fwd, inv) = perm.arrays();
         let k = block.dofs.len();
@@ -313,7 +313,7 @@ impl CholeskySolver {
             SymbolicCholeskyRaw::Supernodal(sym) => {
                 let req = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
                 let mut mem = MemBuffer::try_new(req)
-                    .map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;
+                    .map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
                 SupernodalLltRef::new(sym, &self.factor).l_transpose_solve_with_conj(
                     Conj::No,
                     zm,
@@ -329,18 +329,18 @@ impl CholeskySolver {
     }
 
     /// Solves `A x = b` in place for one right-hand side.
-    pub fn solve_in_place(&self, b: &mut [f64]) -> Result<(), FemError> {
+    pub fn solve_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
         let n = b.len();
         self.solve_many_in_place(MatMut::from_column_major_slice_mut(b, n, 1))
     }
 
     /// Solves `A X = B` in place for several right-hand sides (columns of `b`).
-    pub fn solve_many_in_place(&self, b: MatMut<'_, f64>) -> Result<(), FemError> {
+    pub fn solve_many_in_place(&self, b: MatMut<'_, f64>) -> Result<(), LinalgError> {
         if !self.factorized {
-            return Err(FemError::Sparse("solve called before a successful factorisation".into()));
+            return Err(LinalgError::Sparse("solve called before a successful factorisation".into()));
         }
         if b.nrows() != self.symbolic.nrows() {
-            return Err(FemError::Length {
+            return Err(LinalgError::Length {
                 what: "right-hand side",
                 expected: self.symbolic.nrows(),
                 got: b.nrows(),
@@ -349,7 +349,7 @@ impl CholeskySolver {
         let par = Par::Seq;
         let req = self.symbolic.solve_in_place_scratch::<f64>(b.ncols(), par);
         let mut mem =
-            MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (scratch)".into()))?;
+            MemBuffer::try_new(req).map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
         LltRef::new(&self.symbolic, &self.factor).solve_in_place_with_conj(
             Conj::No,
             b,
@@ -375,7 +375,7 @@ impl CholeskySolver {
 
 /// The forward permutation of an ordering that is given or computed outside faer (`None`:
 /// faer's AMD inside the symbolic analysis). Not for [`Ordering::Trailing`].
-fn explicit_order(n: usize, ordering: &Ordering) -> Result<Option<Vec<usize>>, FemError> {
+fn explicit_order(n: usize, ordering: &Ordering) -> Result<Option<Vec<usize>>, LinalgError> {
     match ordering {
         Ordering::Amd | Ordering::Trailing { .. } => Ok(None),
         Ordering::Custom(p) => Ok(Some(p.clone())),
@@ -384,27 +384,27 @@ fn explicit_order(n: usize, ordering: &Ordering) -> Result<Option<Vec<usize>>, F
 }
 
 /// faer's AMD ordering of the pattern of `a`, as a forward permutation.
-fn amd_order(a: &SymmetricMatrix) -> Result<Vec<usize>, FemError> {
+fn amd_order(a: &SymmetricMatrix) -> Result<Vec<usize>, LinalgError> {
     use faer::sparse::linalg::amd;
     let n = a.n();
     let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
     let req = amd::order_scratch::<usize>(n, a.nnz());
     let mut mem =
-        MemBuffer::try_new(req).map_err(|_| FemError::Sparse("out of memory (AMD scratch)".into()))?;
+        MemBuffer::try_new(req).map_err(|_| LinalgError::Sparse("out of memory (AMD scratch)".into()))?;
     amd::order(&mut fwd, &mut inv, a.pattern().as_ref(), amd::Control::default(), MemStack::new(&mut mem))
-        .map_err(|e| FemError::Sparse(format!("AMD ordering: {e:?}")))?;
+        .map_err(|e| LinalgError::Sparse(format!("AMD ordering: {e:?}")))?;
     Ok(fwd)
 }
 
 /// The inverse of the forward permutation `fwd` of `0..n`; an error if it is not one.
-fn inverse_permutation(fwd: &[usize], n: usize) -> Result<Vec<usize>, FemError> {
+fn inverse_permutation(fwd: &[usize], n: usize) -> Result<Vec<usize>, LinalgError> {
     if fwd.len() != n {
-        return Err(FemError::Length { what: "ordering", expected: n, got: fwd.len() });
+        return Err(LinalgError::Length { what: "ordering", expected: n, got: fwd.len() });
     }
     let mut inv = vec![usize::MAX; n];
     for (i, &p) in fwd.iter().enumerate() {
         if p >= n || inv[p] != usize::MAX {
-            return Err(FemError::InvalidParameter("ordering is not a permutation".into()));
+            return Err(LinalgError::InvalidParameter("ordering is not a permutation".into()));
         }
         inv[p] = i;
     }
@@ -416,7 +416,7 @@ fn metis_order(
     n: usize,
     blocks: &[std::ops::Range<usize>],
     adjacency: &[Vec<usize>],
-) -> Result<Vec<usize>, FemError> {
+) -> Result<Vec<usize>, LinalgError> {
     // keep only blocks with dofs
     let live: Vec<usize> = (0..blocks.len()).filter(|&k| !blocks[k].is_empty()).collect();
     let mut new_id = vec![usize::MAX; blocks.len()];
@@ -427,7 +427,7 @@ fn metis_order(
     if nv == 0 {
         return Ok(Vec::new());
     }
-    let too_big = |_| FemError::InvalidParameter("graph too large for METIS' 32-bit indices".into());
+    let too_big = |_| LinalgError::InvalidParameter("graph too large for METIS' 32-bit indices".into());
     let mut xadj: Vec<i32> = Vec::with_capacity(nv + 1);
     let mut adjncy: Vec<i32> = Vec::new();
     xadj.push(0);
@@ -445,16 +445,16 @@ fn metis_order(
     let mut options = [0i32; metis_sys::METIS_NOPTIONS as usize];
     let status = metis_node_nd(&mut nvtxs, &mut xadj, &mut adjncy, &mut options, &mut perm, &mut iperm);
     if status != metis_sys::rstatus_et_METIS_OK {
-        return Err(FemError::Sparse(format!("METIS_NodeND failed with status {status}")));
+        return Err(LinalgError::Sparse(format!("METIS_NodeND failed with status {status}")));
     }
     let mut fwd = Vec::with_capacity(n);
     for &p in &perm {
-        let k = live
-            [usize::try_from(p).map_err(|_| FemError::Sparse("METIS returned a negative index".into()))?];
+        let k = live[usize::try_from(p)
+            .map_err(|_| LinalgError::Sparse("METIS returned a negative index".into()))?];
         fwd.extend(blocks[k].clone());
     }
     if fwd.len() != n {
-        return Err(FemError::Sparse(format!("block ranges cover {} of {n} dofs", fwd.len())));
+        return Err(LinalgError::Sparse(format!("block ranges cover {} of {n} dofs", fwd.len())));
     }
     Ok(fwd)
 }
@@ -489,5 +489,70 @@ fn metis_node_nd(
             perm.as_mut_ptr(),
             iperm.as_mut_ptr(),
         )
+    }
+}
+
+/// Which dofs of a contact interface a factorisation orders last ([`Ordering::Trailing`]), so
+/// that the interface Schur complement comes from the dense trailing block `L₂₂`
+/// (docs/model.md §6.4). The block is dense: `k²` entries (512 MB at `k = 8000`) and `k³/3`
+/// flops in the factorisation (measured in `docs/performance.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct InterfaceBlockParams {
+    /// Largest number of interface dofs ordered last all together (default 8000; 0 switches
+    /// the dense interface block off).
+    pub max_dofs: usize,
+    /// For an interface with more than [`Self::max_dofs`] dofs: the number of dofs of its
+    /// leading groups (in priority order; for a contact problem the contact nodes of smallest
+    /// initial gap) that are ordered last instead (default 6000, capped at
+    /// [`Self::max_dofs`]; 0: no block for such an interface). The contact solve then screens
+    /// its rows against this block (exactly: rows outside it are added when they come into
+    /// contact).
+    pub screened_dofs: usize,
+}
+
+impl Default for InterfaceBlockParams {
+    fn default() -> Self {
+        Self { max_dofs: 8000, screened_dofs: 6000 }
+    }
+}
+
+impl InterfaceBlockParams {
+    /// Sets [`Self::max_dofs`].
+    pub fn with_max_dofs(mut self, max_dofs: usize) -> Self {
+        self.max_dofs = max_dofs;
+        self
+    }
+    /// Sets [`Self::screened_dofs`].
+    pub fn with_screened_dofs(mut self, screened_dofs: usize) -> Self {
+        self.screened_dofs = screened_dofs;
+        self
+    }
+    /// The dofs to order last, from the interface's dof groups in priority order (repeated
+    /// groups count once): all of them if they fit in [`Self::max_dofs`], else the longest
+    /// prefix of whole groups within [`Self::screened_dofs`].
+    pub fn select(&self, groups: &[std::ops::Range<usize>]) -> Vec<usize> {
+        let mut seen = std::collections::HashSet::new();
+        let unique: Vec<&std::ops::Range<usize>> = groups.iter().filter(|g| seen.insert(g.start)).collect();
+        let total: usize = unique.iter().map(|g| g.len()).sum();
+        let budget = if total <= self.max_dofs { total } else { self.screened_dofs.min(self.max_dofs) };
+        let mut last = Vec::new();
+        for g in unique {
+            if last.len() + g.len() > budget {
+                break;
+            }
+            last.extend(g.clone());
+        }
+        last
+    }
+    /// `base` with the [`Self::select`]ed dofs of `groups` ordered last, or `base` itself when
+    /// none (or all `n`) are selected.
+    pub fn ordering(&self, base: Ordering, groups: &[std::ops::Range<usize>], n: usize) -> Ordering {
+        let last = self.select(groups);
+        if last.is_empty() || last.len() >= n {
+            base
+        } else {
+            Ordering::Trailing { base: Box::new(base), last }
+        }
     }
 }

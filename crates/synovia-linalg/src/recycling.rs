@@ -20,9 +20,8 @@
 //! `10⁻¹³` the direction gets one step of iterative refinement (one more solve, once per
 //! direction), and the bound decides with the measured `ρ` in any case.
 
-use crate::error::FemError;
-use crate::solver::CholeskySolver;
-use crate::sparse::SymmetricMatrix;
+use crate::error::LinalgError;
+use crate::operator::FactorisedOperator;
 
 /// Relative residual bound `‖A x − F‖ / ‖F‖` of a recycled solution.
 const RECYCLED_RESIDUAL: f64 = 1e-12;
@@ -69,25 +68,23 @@ impl LoadSubspace {
         self.residuals.clear();
     }
 
-    /// `A⁻¹ load` for the matrix `matrix` factorised by `factor`: from the subspace when the
+    /// `A⁻¹ load` for the factorised operator `operator`: from the subspace when the
     /// residual bound of the [module documentation](self) allows it, otherwise by a solve with
-    /// `factor` (the load's new direction is then kept).
+    /// the operator (the load's new direction is then kept).
     ///
     /// # Errors
-    /// [`FemError::InvalidParameter`] if `load`, `matrix` and `factor` do not have the same
+    /// [`LinalgError::InvalidParameter`] if `load` and `operator` do not have the same
     /// dimension or `load` is not finite; the solve's errors.
     pub fn solve(
         &mut self,
-        matrix: &SymmetricMatrix,
-        factor: &CholeskySolver,
+        operator: &dyn FactorisedOperator,
         load: &[f64],
-    ) -> Result<Vec<f64>, FemError> {
-        let n = factor.n();
-        if load.len() != n || matrix.n() != n || load.iter().any(|v| !v.is_finite()) {
-            return Err(FemError::InvalidParameter(format!(
-                "load of length {} (finite entries needed) for a matrix of dimension {} and a factor of dimension {n}",
+    ) -> Result<Vec<f64>, LinalgError> {
+        let n = operator.n();
+        if load.len() != n || load.iter().any(|v| !v.is_finite()) {
+            return Err(LinalgError::InvalidParameter(format!(
+                "load of length {} (finite entries needed) for an operator of dimension {n}",
                 load.len(),
-                matrix.n()
             )));
         }
         if self.basis.first().is_some_and(|q| q.len() != n) {
@@ -112,7 +109,7 @@ impl LoadSubspace {
             return Ok(x);
         }
         let mut x = load.to_vec();
-        factor.solve_in_place(&mut x)?;
+        operator.solve_in_place(&mut x)?;
         self.solved += 1;
         if self.capacity > 0 && rnorm >= NEW_DIRECTION * norm {
             if self.basis.len() == self.capacity {
@@ -134,16 +131,15 @@ impl LoadSubspace {
             let inv = 1.0 / rnorm;
             residual.iter_mut().for_each(|v| *v *= inv);
             z.iter_mut().for_each(|v| *v *= inv);
-            let mut az = vec![0.0; n];
-            matrix.mul_vec(&z, &mut az);
+            let mut az = operator.apply(&z);
             let mut rho = residual_norm(&az, &residual);
             if rho > REFINE_ABOVE {
                 // cancellation in z (a small ‖r‖): one step of iterative refinement,
                 // z ← z + A⁻¹ (q − A z), one more solve for this direction only
                 let mut correction: Vec<f64> = residual.iter().zip(&az).map(|(q, a)| q - a).collect();
-                factor.solve_in_place(&mut correction)?;
+                operator.solve_in_place(&mut correction)?;
                 z.iter_mut().zip(&correction).for_each(|(z, c)| *z += c);
-                matrix.mul_vec(&z, &mut az);
+                az = operator.apply(&z);
                 rho = residual_norm(&az, &residual);
             }
             self.basis.push(residual);

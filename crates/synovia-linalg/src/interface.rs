@@ -1,0 +1,272 @@
+//! Columns of the interface Schur complement `S = C A⁻¹ Cᵀ` (docs/model.md §6.4): by batched
+//! solves for any [`FactorisedOperator`], and from the dense trailing block `L₂₂` of a
+//! Cholesky factor with the interface dofs ordered last.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use crate::cholesky::{CholeskySolver, TrailingBlock};
+use crate::error::LinalgError;
+use crate::operator::{CholeskyOperator, FactorisedOperator, RowStack};
+
+/// Solves of single interface rows kept between interfaces that share rows (the coarse levels
+/// of a nested iteration, a frictionless and a Tresca solve, the passes of a screened solve):
+/// `x_c = L₂₂⁻ᵀ L₂₂⁻¹ c` for the rows `c` on the trailing block of a Cholesky factor, keyed by
+/// the row's entries and the block. Holds at most [`BlockSolveStore::budget_bytes`]; a solve
+/// that would exceed it empties the store first, so it never grows without bound.
+#[derive(Debug)]
+pub struct BlockSolveStore {
+    inner: Mutex<BlockSolves>,
+    budget_bytes: usize,
+}
+
+#[derive(Debug, Default)]
+struct BlockSolves {
+    block: usize,
+    solves: HashMap<u64, Arc<Vec<f64>>>,
+    bytes: usize,
+}
+
+impl Default for BlockSolveStore {
+    fn default() -> Self {
+        Self::with_budget(Self::DEFAULT_BUDGET_BYTES)
+    }
+}
+
+impl BlockSolveStore {
+    /// Default budget: 512 MiB.
+    pub const DEFAULT_BUDGET_BYTES: usize = 512 << 20;
+
+    /// An empty store holding at most `budget_bytes` of solves.
+    pub fn with_budget(budget_bytes: usize) -> Self {
+        Self { inner: Mutex::new(BlockSolves::default()), budget_bytes }
+    }
+    /// The budget in bytes.
+    pub fn budget_bytes(&self) -> usize {
+        self.budget_bytes
+    }
+    /// Bytes held now.
+    pub fn bytes(&self) -> usize {
+        self.lock().bytes
+    }
+    /// Forgets every solve.
+    pub fn clear(&self) {
+        *self.lock() = BlockSolves::default();
+    }
+    fn lock(&self) -> std::sync::MutexGuard<'_, BlockSolves> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+    fn get(&self, block: usize, key: u64) -> Option<Arc<Vec<f64>>> {
+        let store = self.lock();
+        if store.block != block {
+            return None;
+        }
+        store.solves.get(&key).cloned()
+    }
+    fn put(&self, block: usize, key: u64, x: Arc<Vec<f64>>) {
+        let bytes = x.len() * std::mem::size_of::<f64>();
+        let mut store = self.lock();
+        if store.block != block || store.bytes + bytes > self.budget_bytes {
+            *store = BlockSolves { block, ..Default::default() };
+        }
+        if bytes <= self.budget_bytes {
+            store.bytes += bytes;
+            store.solves.insert(key, x);
+        }
+    }
+}
+
+/// The columns of `wanted` not yet in `columns`, sorted and without repeats.
+pub(crate) fn missing_columns(wanted: &[usize], columns: &[Option<Vec<f64>>]) -> Vec<usize> {
+    let mut v: Vec<usize> = wanted.iter().copied().filter(|&j| columns[j].is_none()).collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// Runs `columns` on the two halves of `cols` on two threads when there is enough work (at
+/// least 64 columns and `worth_splitting`), else on all of them at once: triangular solves with
+/// many right-hand sides do not parallelise well inside faer, so the right-hand sides are
+/// split instead.
+pub(crate) fn in_two_halves(
+    cols: &[usize],
+    worth_splitting: bool,
+    columns: impl Fn(&[usize]) -> Result<Vec<(usize, Vec<f64>)>, LinalgError> + Sync,
+) -> Result<Vec<(usize, Vec<f64>)>, LinalgError> {
+    if cols.len() < 64 || !worth_splitting {
+        return columns(cols);
+    }
+    let (a, b) = cols.split_at(cols.len() / 2);
+    let (ra, rb) = std::thread::scope(|scope| {
+        let ha = scope.spawn(|| columns(a));
+        let rb = columns(b);
+        (ha.join(), rb)
+    });
+    let mut ra = ra.map_err(|_| LinalgError::Sparse("a column worker panicked".into()))??;
+    ra.extend(rb?);
+    Ok(ra)
+}
+
+/// Columns `j ∈ cols` of `S = C A⁻¹ Cᵀ`: batched solves, 32 right-hand sides at a time.
+pub(crate) fn columns_by_solves<O: FactorisedOperator + ?Sized>(
+    op: &O,
+    rows: RowStack<'_>,
+    cols: &[usize],
+) -> Result<Vec<(usize, Vec<f64>)>, LinalgError> {
+    let n = op.n();
+    if rows.ncols() != n {
+        return Err(LinalgError::Length { what: "interface rows (columns)", expected: n, got: rows.ncols() });
+    }
+    let mut out = Vec::with_capacity(cols.len());
+    for chunk in cols.chunks(32) {
+        let k = chunk.len();
+        let mut rhs = vec![0.0; n * k];
+        for (c, &j) in chunk.iter().enumerate() {
+            for (i, v) in rows.row(j) {
+                rhs[c * n + i] += v;
+            }
+        }
+        op.solve_many_in_place(&mut rhs, k)?;
+        for (c, &j) in chunk.iter().enumerate() {
+            out.push((j, rows.mul(&rhs[c * n..(c + 1) * n])));
+        }
+    }
+    Ok(out)
+}
+
+/// Rows of `C` as `(trailing position, value)` lists (`None`: a row with a dof outside the
+/// trailing block).
+type TrailingRows = Vec<Option<Vec<(usize, f64)>>>;
+
+/// The rows of `C` in the positions of the factor's trailing block, with the block, when at
+/// most a fifth of the rows (and not all) have a dof outside it; `None` otherwise.
+pub(crate) fn trailing_rows(
+    factor: &CholeskySolver,
+    rows: RowStack<'_>,
+) -> Option<(Arc<TrailingBlock>, TrailingRows)> {
+    let block = factor.trailing()?;
+    let m = rows.n_rows();
+    let mapped: TrailingRows = (0..m)
+        .map(|r| {
+            rows.row(r)
+                .map(|(i, v)| match block.position.get(i).copied() {
+                    Some(p) if p != usize::MAX => Some((p, v)),
+                    _ => None,
+                })
+                .collect::<Option<Vec<_>>>()
+        })
+        .collect();
+    let outside = mapped.iter().filter(|r| r.is_none()).count();
+    (outside * 5 <= m && outside < m).then(|| (block.clone(), mapped))
+}
+
+/// [`FactorisedOperator::interface_columns`] of a Cholesky factor: with a trailing block,
+/// whole-factor columns for the rows outside the block (all of them as soon as a trailing
+/// column is needed), then the trailing columns `S_ij = c_i · L₂₂⁻ᵀ L₂₂⁻¹ c_j`, completed in
+/// the outside rows by symmetry `S_ij = S_ji`; without one, batched whole solves.
+pub(crate) fn cholesky_interface_columns(
+    op: &CholeskyOperator<'_>,
+    rows: RowStack<'_>,
+    wanted: &[usize],
+    columns: &mut [Option<Vec<f64>>],
+    kept: &BlockSolveStore,
+) -> Result<usize, LinalgError> {
+    let missing = missing_columns(wanted, columns);
+    if missing.is_empty() {
+        return Ok(0);
+    }
+    let Some((block, mapped)) = trailing_rows(op.factor(), rows) else {
+        let computed = in_two_halves(&missing, true, |cols| columns_by_solves(op, rows, cols))?;
+        let solved = computed.len();
+        for (j, col) in computed {
+            columns[j] = Some(col);
+        }
+        return Ok(solved);
+    };
+    let mut solved = 0;
+    let (inside, mut outside): (Vec<usize>, Vec<usize>) = missing.iter().partition(|&&j| mapped[j].is_some());
+    if !inside.is_empty() {
+        outside = (0..mapped.len()).filter(|&j| mapped[j].is_none() && columns[j].is_none()).collect();
+    }
+    if !outside.is_empty() {
+        let computed = in_two_halves(&outside, true, |cols| columns_by_solves(op, rows, cols))?;
+        solved += computed.len();
+        for (j, col) in computed {
+            columns[j] = Some(col);
+        }
+    }
+    if inside.is_empty() {
+        return Ok(solved);
+    }
+    // trailing solves kept in the store (rows shared with earlier interfaces), the others
+    let block_id = block_fingerprint(&block);
+    let keys: Vec<u64> = inside.iter().map(|&j| row_fingerprint(mapped[j].as_deref())).collect();
+    let mut solves: Vec<Option<Arc<Vec<f64>>>> = keys.iter().map(|&key| kept.get(block_id, key)).collect();
+    let todo: Vec<usize> = (0..inside.len()).filter(|&a| solves[a].is_none()).collect();
+    let todo_rows: Vec<usize> = todo.iter().map(|&a| inside[a]).collect();
+    let computed = in_two_halves(&todo_rows, block.dofs.len() >= 256, |cols| {
+        Ok(trailing_solves(&block, &mapped, cols))
+    })?;
+    for (&a, (_, x)) in todo.iter().zip(computed) {
+        let x = Arc::new(x);
+        kept.put(block_id, keys[a], x.clone());
+        solves[a] = Some(x);
+    }
+    for (&j, x) in inside.iter().zip(&solves) {
+        let Some(x) = x else { continue };
+        let col = mapped
+            .iter()
+            .enumerate()
+            .map(|(i, row)| match row {
+                Some(row) => row.iter().map(|&(p, v)| v * x[p]).sum(),
+                // outside the block: S_ij = S_ji from the whole-factor column i
+                None => columns[i].as_ref().map_or(0.0, |c| c[j]),
+            })
+            .collect();
+        columns[j] = Some(col);
+    }
+    Ok(solved + todo.len())
+}
+
+/// The trailing-block solves `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` (in trailing positions) of the rows
+/// `j ∈ cols` (`rows`: the rows of `C` in trailing positions; every `j ∈ cols` must be one):
+/// dense triangular solves with all right-hand sides at once.
+fn trailing_solves(
+    block: &TrailingBlock,
+    rows: &[Option<Vec<(usize, f64)>>],
+    cols: &[usize],
+) -> Vec<(usize, Vec<f64>)> {
+    let mut rhs = faer::Mat::<f64>::zeros(block.dofs.len(), cols.len());
+    for (c, &j) in cols.iter().enumerate() {
+        for &(p, v) in rows[j].iter().flatten() {
+            rhs[(p, c)] += v;
+        }
+    }
+    block.solve_in_place(rhs.as_mut());
+    cols.iter().enumerate().map(|(c, &j)| (j, rhs.col(c).iter().copied().collect())).collect()
+}
+
+/// A fingerprint of a trailing block: its address, size and corner entries.
+fn block_fingerprint(block: &TrailingBlock) -> usize {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (block as *const TrailingBlock as usize).hash(&mut h);
+    let k = block.dofs.len();
+    k.hash(&mut h);
+    if k > 0 {
+        block.factor[(0, 0)].to_bits().hash(&mut h);
+        block.factor[(k - 1, k - 1)].to_bits().hash(&mut h);
+    }
+    h.finish() as usize
+}
+
+/// A fingerprint of a row in trailing positions.
+fn row_fingerprint(row: Option<&[(usize, f64)]>) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for &(p, v) in row.into_iter().flatten() {
+        p.hash(&mut h);
+        v.to_bits().hash(&mut h);
+    }
+    h.finish()
+}
