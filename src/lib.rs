@@ -17,7 +17,7 @@
 //! | [`time`] (`synovia-time`) | load histories, rigid motions, quasi-static and dynamic time stepping |
 //!
 //! See `docs/architecture.md` for the crate graph and the path of data from mesh to solution,
-//! and the specification `docs/model.md` for the equations.
+//! and `docs/model.md`, the project's statement of the model and algorithms, for the equations.
 //!
 //! ## A complete small model
 //!

@@ -24,7 +24,7 @@
 //! i.e. the contact problem with `A + S` (factorised once) and load `F + S U_k`. A fixed point
 //! is a minimiser of `L` (the optimality conditions coincide when `S (U_{k+1} − U_k) = 0`);
 //! the equilibrium residual of the original problem is exactly `−S (U_{k+1} − U_k)`, which
-//! is the stopping test. With `S = ε diag(A)`, `ε = 10⁻⁸`, the iteration contracts by about
+//! is the stopping test. With `S = ε diag(A)`, `ε = 10⁻⁵` (`Stabilisation::EPSILON`), the iteration contracts by about
 //! `ε ×` (number of nodes) per step on the modes the contact restrains.
 
 use synovia_fem::Stabilisation;

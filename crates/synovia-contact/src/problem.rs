@@ -179,7 +179,7 @@ impl<'a> ContactProblem<'a> {
     }
 
     /// Complementarity parameters per interface row, from the scaling of `A`:
-    /// `ρ_r = scale · mean diag(A) / ‖C_r‖²` in force-multiplier units, which is the spec's
+    /// `ρ_r = scale · mean diag(A) / ‖C_r‖²` in force-multiplier units, which is docs/model.md (5.16)
     /// `ρ ≈ mean diag(A) / κ` for the normal rows. The solution does not depend on `ρ`.
     pub fn default_rho(&self, scale: f64) -> Vec<f64> {
         let diag = self.operator.diagonal();

@@ -15,7 +15,7 @@ use crate::qp::{solve_qp, ConvexBlock, QpOptions, QpState};
 use crate::schur::{ScaledBlock, SchurOperator};
 
 /// Solves the Tresca (or frictionless) contact problem through its dual in the force
-/// multipliers `ν = (κ Λ_n, Λ_t)` on the interface (docs/model.md §6.4):
+/// multipliers `ν = (κ Λ_n, Λ_t)` on the interface (docs/model.md §6.3, with `S` and `w` of §6.4):
 ///
 /// ```text
 /// min_ν ½ νᵀ S ν − νᵀ (w − g)   s.t.  ν_n ≥ 0,  ‖ν_t,c‖ ≤ 1 per friction cell,

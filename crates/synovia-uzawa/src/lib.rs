@@ -35,7 +35,7 @@
 //! * [`UzawaMprgp`] (`"uzawa-mprgp"`, docs/model.md §6.3) — the outer Uzawa iteration
 //!   `Λ_t ← π(Λ_t + ω D⁻¹ (y_t − s))` on the friction multiplier, the inner normal contact
 //!   problem solved by MPRGP on its dual in `ν_n`.
-//! * [`DualMprgp`] (`"dual-mprgp"`, docs/model.md §6.4) — the whole dual QP above by MPRGP (2D:
+//! * [`DualMprgp`] (`"dual-mprgp"`, docs/model.md §6.3, on the condensation of §6.4) — the whole dual QP above by MPRGP (2D:
 //!   `ν_n ≥ 0`, `−1 ≤ ν_t ≤ 1`) or MPGP (3D: half-lines and unit discs).
 //!
 //! Both contact solvers evaluate `S` through [`SchurOperator`]: all columns once (one solve
