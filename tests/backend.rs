@@ -125,3 +125,29 @@ fn a_context_reuses_columns_and_stays_within_its_budget() {
         assert!(small.bytes() <= small.memory_budget(), "{} > {}", small.bytes(), small.memory_budget());
     }
 }
+
+/// Multipliers-only solves (`SolveContext::set_multipliers_only`) of every solver give the
+/// multipliers of the full solve and an empty `U`; the KKT check of a solution without `U`
+/// reports infinite residuals instead of panicking.
+#[test]
+fn multipliers_only_solves_of_every_solver_match_full_solves() {
+    for friction in [None, Some(0.05)] {
+        let owned = BlockOnFoundation { n: 12, slip_bound: friction, ..Default::default() }
+            .build::<2>()
+            .expect("problem");
+        let p = owned.problem();
+        for name in ["pdas", "au-pdas", "uzawa-mprgp", "dual-mprgp", "pdas-fallback"] {
+            let solver = by_name(name).expect("solver");
+            let full = solver.solve(&p, &SolveContext::new()).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let mut context = SolveContext::new();
+            context.set_multipliers_only(true);
+            let only = solver.solve(&p, &context).unwrap_or_else(|e| panic!("{name}, multipliers only: {e}"));
+            assert!(only.u.is_empty() && !full.u.is_empty(), "{name}");
+            let scale = full.lambda_n.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let d = full.lambda_n.iter().zip(&only.lambda_n).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(d <= 1e-8 * scale, "{name}, friction {friction:?}: Λ_n differs by {d:e}");
+            let kkt = check_kkt(&p, &only.u, &only.lambda_n, &only.lambda_t);
+            assert!(kkt.max().is_infinite(), "{name}: {kkt:?}");
+        }
+    }
+}

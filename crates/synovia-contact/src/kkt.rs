@@ -50,8 +50,25 @@ pub(crate) fn inf_norm(v: &[f64]) -> f64 {
 }
 
 /// Evaluates the KKT conditions of docs/model.md §5 for `(U, Λ_n, Λ_t)`.
+///
+/// A solution whose vectors do not fit the problem (e.g. the empty `U` of a multipliers-only
+/// solve, or multipliers of another row set) cannot satisfy the conditions: every residual is
+/// then `+∞`.
 pub fn check_kkt(problem: &ContactProblem<'_>, u: &[f64], lambda_n: &[f64], lambda_t: &[f64]) -> KktReport {
     let n = problem.operator.n();
+    if u.len() != n || lambda_n.len() != problem.n_normal() || lambda_t.len() != problem.n_tangential() {
+        let inf = f64::INFINITY;
+        return KktReport {
+            equilibrium: inf,
+            penetration: inf,
+            negative_pressure: inf,
+            complementarity: inf,
+            friction_bound: inf,
+            stick_slip: inf,
+            slip_direction: inf,
+            displacement_scale: 0.0,
+        };
+    }
     let mut r = problem.operator.apply(u);
     let mut bn = vec![0.0; n];
     let kl: Vec<f64> = lambda_n.iter().zip(&problem.normal.weights).map(|(l, k)| l * k).collect();

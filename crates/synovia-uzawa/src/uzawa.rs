@@ -234,8 +234,12 @@ impl ContactSolver for UzawaMprgp {
                 // The multiplier-scale test above is absolute in Λ_t; on nearly unloaded
                 // problems the displacements are tiny and the stick condition must also hold
                 // relative to them (the scale of `check_kkt`): otherwise keep iterating.
-                let kkt = synovia_contact::check_kkt(problem, &sol.u, &sol.lambda_n, &sol.lambda_t);
-                if kkt.max() <= 100.0 * tol || mt == 0 {
+                // (a multipliers-only solve has no U to check: its multiplier test above holds)
+                if mt == 0
+                    || sol.u.is_empty()
+                    || synovia_contact::check_kkt(problem, &sol.u, &sol.lambda_n, &sol.lambda_t).max()
+                        <= 100.0 * tol
+                {
                     sol.report.time_s = t0.elapsed().as_secs_f64();
                     return Ok(sol);
                 }
