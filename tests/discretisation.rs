@@ -140,8 +140,11 @@ fn the_re_pairing_hook_gets_the_previous_nodes() {
     }
 }
 
+/// A closure giving the rows of a pair.
+type RowsFn = Box<dyn Fn(&PairContext<'_, 2>) -> Vec<ContactRow<2>> + Send + Sync>;
+
 /// Rows built by a closure, to check the geometry's validation.
-struct Rows(Box<dyn Fn(&PairContext<'_, 2>) -> Vec<ContactRow<2>> + Send + Sync>);
+struct Rows(RowsFn);
 
 impl std::fmt::Debug for Rows {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
