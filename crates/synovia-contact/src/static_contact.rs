@@ -80,8 +80,9 @@ impl<const D: usize> StaticContact<D> {
     }
 
     /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
-    /// ([`ContactGeometry::updated`], [`ContactGeometry::new_deformed`]: re-pairing of node-to-segment pairs, normals and
-    /// weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
+    /// ([`ContactGeometry::updated`]: each discretisation's re-pairing hook, as
+    /// [`ContactGeometry::new_deformed`] by default: re-pairing of node-to-segment pairs, normals
+    /// and weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
     /// previous geometry, e.g. to carry contact data over with [`ContactGeometry::transfer`].
     pub fn update_geometry(
         &mut self,
