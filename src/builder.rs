@@ -687,8 +687,8 @@ impl<const D: usize> JointModel<D> {
             )));
         }
         self.assign_kind(pair.body, &pair.part, BoundaryKind::Contact)?;
-        if let synovia_contact::operators::Partner::Body { body, part, .. } = &pair.partner {
-            self.assign_kind(*body, part, BoundaryKind::Contact)?;
+        if let Some((body, part)) = pair.partner_part() {
+            self.assign_kind(body, part, BoundaryKind::Contact)?;
         }
         self.pairs.push(pair);
         Ok(self)

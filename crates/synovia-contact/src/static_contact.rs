@@ -111,8 +111,9 @@ impl<const D: usize> StaticContact<D> {
     }
 
     /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
-    /// ([`ContactGeometry::new_deformed`]: re-pairing of node-to-segment pairs, normals and
-    /// weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
+    /// ([`ContactGeometry::updated`]: each discretisation's re-pairing hook, as
+    /// [`ContactGeometry::new_deformed`] by default: re-pairing of node-to-segment pairs, normals
+    /// and weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
     /// previous geometry, e.g. to carry contact data over with [`ContactGeometry::transfer`].
     pub fn update_geometry(
         &mut self,
@@ -120,7 +121,7 @@ impl<const D: usize> StaticContact<D> {
         pairs: &[ContactPair<D>],
         displacement: &[Vec<Vector<D>>],
     ) -> Result<ContactGeometry<D>, ContactError> {
-        let geometry = ContactGeometry::new_deformed(model, pairs, displacement)?;
+        let geometry = self.geometry.updated(model, pairs, displacement)?;
         self.context.clear_rows();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
@@ -558,7 +559,6 @@ fn interface_nodes<const D: usize>(
     pairs: &[ContactPair<D>],
     geometry: &ContactGeometry<D>,
 ) -> Result<Vec<(synovia_fem::BodyId, usize)>, ContactError> {
-    use crate::operators::Partner;
     let mut out = Vec::new();
     let mut seen = std::collections::HashSet::new();
     let mut by_gap: Vec<usize> = (0..geometry.len()).collect();
@@ -585,11 +585,8 @@ fn interface_nodes<const D: usize>(
     };
     for pair in pairs {
         add(pair.body, &pair.part)?;
-        match &pair.partner {
-            Partner::Body { body, part, .. }
-            | Partner::Segment { body, part, .. }
-            | Partner::Mortar { body, part, .. } => add(*body, part)?,
-            Partner::Rigid(_) => {}
+        if let Some((body, part)) = pair.partner_part() {
+            add(body, part)?;
         }
     }
     Ok(out)
