@@ -20,7 +20,7 @@ use std::time::Instant;
 use synovia::contact::{StaticContact, StaticContactResult};
 use synovia::contact_ops::ContactSolver;
 use synovia::fem::{ElasticParams, Model};
-use synovia::hertz::{hertz2d_model, Hertz2d};
+use synovia_models::hertz::{hertz2d_model, Hertz2d};
 use synovia::mesh::math::Real;
 use synovia::time::quasistatic::{QuasiStaticOutput, QuasiStaticParams, QuasiStaticStepper};
 use synovia::time::results::StepRecord;

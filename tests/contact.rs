@@ -7,7 +7,7 @@ use std::sync::Arc;
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::{ContactPair, FnObstacle, PlaneObstacle, SphereObstacle};
 use synovia::contact_ops::{ContactError, ContactParams};
-use synovia::hertz::{cattaneo_mindlin_2d, hertz2d, hertz2d_model, hertz3d, Hertz2d, Hertz3d};
+use synovia_models::hertz::{cattaneo_mindlin_2d, hertz2d, hertz2d_model, hertz3d, Hertz2d, Hertz3d};
 use synovia::prelude::*;
 use synovia::solvers::{by_name, by_name_with, SOLVER_NAMES};
 

@@ -3,7 +3,7 @@
 
 use synovia::contact::StaticContact;
 use synovia::contact_ops::ContactSolution;
-use synovia::hertz::{hertz2d_model, Hertz2d};
+use synovia_models::hertz::{hertz2d_model, Hertz2d};
 use synovia::prelude::*;
 
 fn max_rel(a: &[f64], b: &[f64]) -> f64 {

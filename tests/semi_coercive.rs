@@ -5,7 +5,7 @@
 //! Numbers printed with `--nocapture` are the ones in `docs/reliability.md`.
 
 use synovia::contact_ops::ContactError;
-use synovia::hertz::fit_elliptic;
+use synovia_models::hertz::fit_elliptic;
 use synovia::prelude::*;
 use synovia::solvers::by_name;
 use synovia::time::TimeError;
