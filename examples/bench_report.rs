@@ -45,9 +45,9 @@ use std::time::Instant;
 use serde_json::{json, Value};
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::ContactPair;
+use synovia::prelude::*;
 use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 use synovia_models::knee2d::{cycle_times, Knee2d};
-use synovia::prelude::*;
 
 mod bench_common;
 use bench_common::{parse_args, peak_rss_bytes, spawn_case, Invocation, Res};

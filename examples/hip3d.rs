@@ -17,8 +17,8 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use synovia_models::hip3d::{Hip3d, BODY_WEIGHT_N};
 use synovia::io::{Encoding, TimeSeriesWriter};
+use synovia_models::hip3d::{Hip3d, BODY_WEIGHT_N};
 use synovia_models::knee2d::KneeError;
 
 fn main() -> Result<(), KneeError> {

@@ -10,9 +10,9 @@ use std::time::Instant;
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::{ContactGeometry, ContactPair};
 use synovia::fem::ComponentMask;
-use synovia_models::hertz::{hertz2d_block, hertz3d_block, HertzBlock2d, HertzBlock3d};
 use synovia::prelude::*;
 use synovia::solvers::by_name;
+use synovia_models::hertz::{hertz2d_block, hertz3d_block, HertzBlock2d, HertzBlock3d};
 
 const PATCH_DELTA: f64 = 1e-3;
 
@@ -405,8 +405,8 @@ fn mortar_geometry_rows_search_distance_and_errors() {
 /// 2 %.
 #[test]
 fn mortar_ironing_with_coulomb_friction_and_repairing() {
-    use synovia_models::hertz::refined_axis;
     use synovia::time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
+    use synovia_models::hertz::refined_axis;
     const MU: f64 = 0.3;
     const PUSH: f64 = 0.005;
     const DRAG: f64 = 0.5;

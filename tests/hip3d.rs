@@ -2,8 +2,8 @@
 //! second force peak): the contact resultant balances the hip force within 0.5 %, the contact
 //! solution satisfies the KKT conditions, and the pressures are in the physiological range.
 
-use synovia_models::hip3d::{hip_force, Hip3d, BODY_WEIGHT_N};
 use synovia::prelude::LoadHistory;
+use synovia_models::hip3d::{hip_force, Hip3d, BODY_WEIGHT_N};
 
 #[test]
 fn hip_force_table_is_double_peaked() {

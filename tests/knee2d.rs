@@ -3,8 +3,8 @@
 //! 0.5 % and the contact solution satisfies the KKT conditions; the same for the total knee
 //! replacement variant (`Knee2d::tkr_coarse`, 21 poses).
 
-use synovia_models::knee2d::{cycle_times, iso14243_axial_force, iso14243_flexion, Knee2d};
 use synovia::prelude::LoadHistory;
+use synovia_models::knee2d::{cycle_times, iso14243_axial_force, iso14243_flexion, Knee2d};
 
 #[test]
 fn iso_tables_have_the_standard_features() {

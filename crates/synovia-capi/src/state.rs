@@ -126,8 +126,8 @@ impl<const D: usize> State<D> {
     /// is left to the caller). Parts are tagged 0, 1, … body by body in file order; nodes are
     /// numbered body by body.
     pub fn from_scenario(sc: &Scenario) -> Result<Self, Fail> {
-        let built =
-            synovia_scenario::build::build::<D>(sc).map_err(|e| Fail::new(SynStatus::Scenario, e.to_string()))?;
+        let built = synovia_scenario::build::build::<D>(sc)
+            .map_err(|e| Fail::new(SynStatus::Scenario, e.to_string()))?;
         let model = ArrayModel::from_joint(built.joint);
         // the solver parameters that the scenario gave the JointModel
         let mut params = Params::default();

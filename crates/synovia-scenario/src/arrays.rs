@@ -224,11 +224,9 @@ impl<const D: usize> ArrayModel<D> {
             for k in 0..=D {
                 let g = index(a.elements[e * (D + 1) + k], n_nodes, "node of element", e)?;
                 match node_body[g] {
-                    Some(o) if o != b => {
-                        return Err(ArrayError::InvalidArgument(format!(
-                            "node {g} belongs to elements of bodies {o} and {b}: each body needs its own nodes"
-                        )))
-                    }
+                    Some(o) if o != b => return Err(ArrayError::InvalidArgument(format!(
+                        "node {g} belongs to elements of bodies {o} and {b}: each body needs its own nodes"
+                    ))),
                     _ => node_body[g] = Some(b),
                 }
                 cells[b].push(g);
@@ -384,7 +382,10 @@ impl<const D: usize> ArrayModel<D> {
     }
 
     fn part(&self, tag: i32) -> Result<(BodyId, String), ArrayError> {
-        self.parts.get(&tag).cloned().ok_or_else(|| ArrayError::InvalidArgument(format!("no part has tag {tag}")))
+        self.parts
+            .get(&tag)
+            .cloned()
+            .ok_or_else(|| ArrayError::InvalidArgument(format!("no part has tag {tag}")))
     }
 
     /// A part that has no condition yet (`TractionFree`).
@@ -402,7 +403,9 @@ impl<const D: usize> ArrayModel<D> {
             })
             .map_err(|e| ArrayError::Rejected(e.to_string()))?;
         if kind != BoundaryKind::TractionFree {
-            return Err(ArrayError::Rejected(format!("part tag {tag} (`{part}`) is already of kind {kind:?}")));
+            return Err(ArrayError::Rejected(format!(
+                "part tag {tag} (`{part}`) is already of kind {kind:?}"
+            )));
         }
         Ok((body, part))
     }
