@@ -224,9 +224,11 @@ impl<const D: usize> ArrayModel<D> {
             for k in 0..=D {
                 let g = index(a.elements[e * (D + 1) + k], n_nodes, "node of element", e)?;
                 match node_body[g] {
-                    Some(o) if o != b => return Err(ArrayError::InvalidArgument(format!(
+                    Some(o) if o != b => {
+                        return Err(ArrayError::InvalidArgument(format!(
                         "node {g} belongs to elements of bodies {o} and {b}: each body needs its own nodes"
-                    ))),
+                    )))
+                    }
                     _ => node_body[g] = Some(b),
                 }
                 cells[b].push(g);
