@@ -37,7 +37,9 @@ pub mod static_contact;
 pub mod testing;
 
 pub use error::{ContactError, IterationResidual};
-pub use friction::{ConstantFriction, ExponentialFriction, FrictionLaw};
+pub use friction::{
+    project_on_disc, slip_speeds, ConstantFriction, ExponentialFriction, FrictionLaw, PairFrictionLaws,
+};
 pub use kkt::{check_kkt, KktReport};
 pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints, SchurCache};
 pub use rows::SparseRows;
