@@ -23,6 +23,12 @@
 //! term), so no coercivity check is needed; it is assembled on one sparsity pattern and
 //! factorised once (symbolic and numeric) for the whole run.
 //!
+//! **One pipeline**: the step problem is solved by the static contact machinery,
+//! [`StaticContact::with_system_matrix`] on `A` and [`StaticContact::solve_load`] with `F̄` per
+//! step (contact rows, row screening, Schur-column cache, KKT check), the same code as a static
+//! or quasi-static solve; this module only adds what is dynamic (mass and damping, `F̄`, the
+//! levels, slip speeds, the `Δt²` scaling, energies).
+//!
 //! **Contact in displacements**: `[U^{i+1}_n] ≤ d` with the initial gap `d` (minus the normal
 //! part of the lift at `t_{i+1}`). Because the equation was multiplied by `Δt²`, the contact
 //! multipliers of the step problem are `Λ̄_n = Δt² λ_n`: the physical contact pressure is
@@ -36,9 +42,9 @@
 //! area (check the units: every term of the step problem is `kg·m²`); synovia uses the slip
 //! bound `ḡ_c = Δt² g_c = F_c(|[u'_t]|^i) |Λ̄_n^i|` in the step problem, i.e. the Coulomb law with the scaled pressure of level `i`. The deceleration of a
 //! sliding block (`μ g`, see the tests) confirms the scaling. The slip speed `|[u'_t]|^i` is
-//! `|[U^i_t] − [U^{i−1}_t]| / Δt` at each contact node and the law `F_c` is any
-//! [`FrictionLaw`] per pair ([`DynamicStepper::set_friction_law`]; default
-//! `ConstantFriction(pair.friction)`). Optionally a Coulomb fixed point per step recomputes
+//! `|[U^i_t] − [U^{i−1}_t]| / Δt` at each contact node ([`slip_speeds`]) and the law `F_c` is any
+//! [`FrictionLaw`] per pair ([`DynamicStepper::set_friction_law`], [`PairFrictionLaws`], shared
+//! with the quasi-static stepper; default: the pair's constant coefficient). Optionally a Coulomb fixed point per step recomputes
 //! `ḡ_c` from the new level until it stops changing ([`DynamicParams::coulomb_iterations`]).
 //!
 //! ## Reduced unknowns and moving lifts

@@ -19,8 +19,11 @@
 //!   Λ_t − π(Λ_t + ρ B_Ht (U − U(t_{i−1})))     = 0
 //!   ```
 //!
-//!   with `B_Ht` built on the cells of `supp g_c`, `g_c,r = F_c |Λ_n,r(t_{i−1})|`
-//!   ([`ContactGeometry::slip_bounds_from_pressure`] of the previous level, docs/model.md §3, `r = 1`),
+//!   with `B_Ht` built on the cells of `supp g_c`, `g_c,r = F_c(v_r) |Λ_n,r(t_{i−1})|`
+//!   (docs/model.md §3, `r = 1`) with the friction law `F_c` of the pair
+//!   ([`QuasiStaticStepper::set_friction_law`], default its constant coefficient, then exactly
+//!   [`ContactGeometry::slip_bounds_from_pressure`] of the previous level) and the slip rate
+//!   `v_r = ‖Δ[u_t]_r‖ / Δt` of the previous level ([`QuasiStaticStepper::slip_rate`]),
 //!   and slip measured from the previous level `U(t_{i−1})` (incremental slip, docs/model.md §3; with
 //!   [`QuasiStaticParams::incremental_slip`] `= false` the report's total-displacement form
 //!   `Λ_t − π(Λ_t + ρ B_Ht U)` is used instead, slip measured from the reference state).
@@ -29,7 +32,7 @@
 //!   node of each cell ([`StaticContactResult::cell_node`]), since the friction cells
 //!   `supp g_c` change from level to level; new cells start from `Λ_t = 0`.
 //! * **Coulomb fixed point** ([`QuasiStaticParams::coulomb_fixed_point`], docs/model.md §3): the level
-//!   is re-solved with `g_c^{k+1} = F_c |Λ_n^k|` from the current iterate until
+//!   is re-solved with `g_c^{k+1} = F_c(v^k) |Λ_n^k|` (pressure and slip rate of the current iterate) until
 //!   `max_r |g^{k+1}_r − g^k_r| / max_r |g^{k+1}_r| ≤ fixed_point_tolerance`; the accepted
 //!   solution is the last one (computed with `g^k`). After `max_fixed_point` solves without
 //!   convergence the run stops with [`TimeError::FixedPoint`].
