@@ -7,7 +7,7 @@
 
 use std::sync::Arc;
 
-use synovia_contact::operators::{ContactPair, PlaneObstacle};
+use synovia_contact::operators::ContactPair;
 use synovia_contact::{ContactParams, StaticContact};
 use synovia_fem::assembly::{assemble_matrix, body_stiffnesses};
 use synovia_fem::element::stiffness_into;
