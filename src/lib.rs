@@ -85,7 +85,7 @@ pub mod prelude {
     pub use crate::builder::{Analysis, BodyMaterial, BodyRef, JointError, JointModel, RunResult, StepView};
     pub use crate::session::{JointSession, SolveReport};
     pub use synovia_contact::operators::{CylinderObstacle, FnObstacle, PlaneObstacle, SphereObstacle};
-    pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction};
+    pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction, FrictionLaw};
     pub use synovia_fem::{
         solve_elastic, BodyFields, BodyId, ComponentMask, ElasticParams, ElasticSolution, ElasticSolver,
         FemError, Model,

@@ -43,7 +43,9 @@ pub mod testing;
 pub use context::SolveContext;
 pub use discretisation::{ContactDiscretisation, ContactRow, PairContext};
 pub use error::{ContactError, IterationResidual};
-pub use friction::{ConstantFriction, ExponentialFriction, FrictionLaw};
+pub use friction::{
+    project_on_disc, slip_speeds, ConstantFriction, ExponentialFriction, FrictionLaw, PairFrictionLaws,
+};
 pub use kkt::{check_kkt, KktReport};
 pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};
