@@ -12,7 +12,7 @@
 //! - `resolve_new_loads`: the same model and factorisation after the Tresca solve, re-solved with
 //!   a new push (+5 %) and shift (× 1.5), warm-started from the previous solution;
 //!   `time_s` = that re-solve;
-//! - `hemisphere3d_friction`: the hemisphere of [`synovia::hertz::Hertz3d`] on a rigid flat with
+//! - `hemisphere3d_friction`: the hemisphere of [`synovia_models::hertz::Hertz3d`] on a rigid flat with
 //!   friction, normal then Tresca step as above; `time_s = tresca_s`;
 //! - `knee2d_gait`: [`Knee2d`] (default mesh) over a quasi-static gait cycle of
 //!   [`cycle_times`]`(steps)` poses ([`Knee2d::run`]: the femur in its body frame, one
@@ -45,9 +45,9 @@ use std::time::Instant;
 use serde_json::{json, Value};
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::ContactPair;
-use synovia::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
-use synovia::knee2d::{cycle_times, Knee2d};
 use synovia::prelude::*;
+use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
+use synovia_models::knee2d::{cycle_times, Knee2d};
 
 mod bench_common;
 use bench_common::{parse_args, peak_rss_bytes, spawn_case, Invocation, Res};

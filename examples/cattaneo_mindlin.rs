@@ -11,7 +11,7 @@
 //!
 //! Run: `cargo run --release --example cattaneo_mindlin [pdas|au-pdas|uzawa-mprgp|dual-mprgp]`
 
-use synovia::hertz::{cattaneo_mindlin_2d, Hertz2d};
+use synovia_models::hertz::{cattaneo_mindlin_2d, Hertz2d};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = std::env::args().nth(1).unwrap_or_else(|| "pdas".to_string());

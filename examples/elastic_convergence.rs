@@ -1,13 +1,13 @@
 //! # Elastic convergence study with a manufactured solution (docs/model.md §8)
 //!
 //! Two bodies bonded along `x = ½` — one isotropic, one fully anisotropic — are loaded so that
-//! `u_k = a_k sin(b_k · x + c_k)` is the exact solution (see `synovia::verification`). P1
+//! `u_k = a_k sin(b_k · x + c_k)` is the exact solution (see `synovia_models::verification`). P1
 //! elements converge with rate 1 in the energy norm and rate 2 in `L²`; this example measures
 //! both in 2D and 3D over successive refinements and prints one JSON line at the end.
 //!
 //! Run: `cargo run --release --example elastic_convergence`
 
-use synovia::verification::{bonded_mms, fitted_rate, rates, ConvergenceRow};
+use synovia_models::verification::{bonded_mms, fitted_rate, rates, ConvergenceRow};
 
 fn table(dim: usize, rows: &[ConvergenceRow]) {
     println!("\n{dim}D bonded iso/aniso manufactured solution");

@@ -17,7 +17,7 @@
 //!
 //! Run: `cargo run --release --example hertz2d [pdas|au-pdas|uzawa-mprgp|dual-mprgp]`
 
-use synovia::hertz::{hertz2d, hertz2d_write, ContactRun, Hertz2d};
+use synovia_models::hertz::{hertz2d, hertz2d_write, ContactRun, Hertz2d};
 
 fn table(title: &str, runs: &[ContactRun]) {
     println!("\n{title}");

@@ -2,7 +2,7 @@
 //!
 //! The half-disc indenter (R = 1, E = 1, ν = 0.3, plane strain) pressed onto an elastic block
 //! (E = 1, ν = 0.3, 2 × 1, clamped at its base) whose mesh is refined toward the contact point
-//! to another mesh size ([`synovia::hertz::HertzBlock2d`]); the interface is node-to-segment
+//! to another mesh size ([`synovia_models::hertz::HertzBlock2d`]); the interface is node-to-segment
 //! with the R*-tree contact search, or dual mortar. Both ways (a finer indenter than the block
 //! and the reverse, mesh-size ratio 2.5), both choices of the slave side, both operators;
 //! prints `a`, `p₀` and the pressure L² error against the Hertz line contact for the computed
@@ -10,7 +10,7 @@
 //!
 //! Run: `cargo run --release --example hertz2d_nonmatching [pdas|au-pdas|uzawa-mprgp|dual-mprgp]`
 
-use synovia::hertz::{hertz2d_block, HertzBlock2d};
+use synovia_models::hertz::{hertz2d_block, HertzBlock2d};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = std::env::args().nth(1).unwrap_or_else(|| "pdas".into());

@@ -9,7 +9,7 @@
 //!
 //! Run: `cargo run --release --example hertz3d [pdas|au-pdas|uzawa-mprgp|dual-mprgp]`
 
-use synovia::hertz::{hertz3d, Hertz3d};
+use synovia_models::hertz::{hertz3d, Hertz3d};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = std::env::args().nth(1).unwrap_or_else(|| "pdas".to_string());

@@ -3,7 +3,7 @@
 //! A hemisphere indenter (R = 1, E = 1, ν = 0.3, refined toward its pole) pressed 0.01 onto an
 //! elastic block `[−1, 1]² × [−1, 0]` (E = 1, ν = 0.3, clamped at its base) whose Kuhn mesh is
 //! refined by bisection toward the contact point to another mesh size
-//! ([`synovia::hertz::HertzBlock3d`]). Two meshings — a finer indenter than the block (ratio
+//! ([`synovia_models::hertz::HertzBlock3d`]). Two meshings — a finer indenter than the block (ratio
 //! 2.7) and a finer block than the indenter (ratio 2.1) — each with dual mortar (finer side
 //! slave, then coarser side slave) and with node-to-facet (finer side slave). Prints a table of
 //! `a`, `p₀` and the pressure L² error against the Hertz point contact for the computed force
@@ -11,7 +11,7 @@
 //!
 //! Run: `cargo run --release --example hertz3d_nonmatching [pdas|au-pdas|uzawa-mprgp|dual-mprgp]`
 
-use synovia::hertz::{hertz3d_block, HertzBlock3d};
+use synovia_models::hertz::{hertz3d_block, HertzBlock3d};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let name = std::env::args().nth(1).unwrap_or_else(|| "pdas".into());

@@ -1,11 +1,11 @@
 //! # 3D hip contact: femoral head in the acetabulum over the gait cycle
 //!
-//! A ball-in-socket model ([`synovia::hip3d`]): femoral head (bone `15–23 mm` + 2 mm cartilage)
+//! A ball-in-socket model ([`synovia_models::hip3d`]): femoral head (bone `15–23 mm` + 2 mm cartilage)
 //! in the acetabulum (2 mm cartilage + bone to 32 mm, 0.2 mm radial clearance), P1 tetrahedra,
 //! cartilage E = 10 MPa, ν = 0.45, bone E = 800 MPa, ν = 0.3, frictionless node-to-facet
 //! contact between the cartilage surfaces. The head's inner bone sphere is pushed into the
 //! socket (`−z`) until the contact resultant equals the hip joint force of an approximate
-//! Paul/Bergmann-type walking curve (`synovia::hip3d::HIP_FORCE`, 750 N body weight, peaks
+//! Paul/Bergmann-type walking curve (`synovia_models::hip3d::HIP_FORCE`, 750 N body weight, peaks
 //! 2.8 and 3 BW). See `docs/knee2d.md`.
 //!
 //! Every level checks the load balance (≤ 0.5 %) and the KKT conditions, prints the peak and
@@ -17,9 +17,9 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
-use synovia::hip3d::{Hip3d, BODY_WEIGHT_N};
 use synovia::io::{Encoding, TimeSeriesWriter};
-use synovia::knee2d::KneeError;
+use synovia_models::hip3d::{Hip3d, BODY_WEIGHT_N};
+use synovia_models::knee2d::KneeError;
 
 fn main() -> Result<(), KneeError> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "out/hip3d".to_string());

@@ -1,13 +1,13 @@
 //! # Sagittal tibiofemoral contact over the ISO 14243-1 gait cycle
 //!
-//! A plane-strain sagittal slice of one knee compartment ([`synovia::knee2d`]): a femoral
+//! A plane-strain sagittal slice of one knee compartment ([`synovia_models::knee2d`]): a femoral
 //! condyle (bone arc, subchondral radius 20 mm, with a 2.5 mm cartilage layer) on a tibial
 //! plateau (bone block with a 2.5 mm cartilage layer), cartilage E = 10 MPa, ν = 0.45, bone
 //! E = 800 MPa, ν = 0.3; frictionless node-to-segment contact between the two (non-matching)
 //! cartilage surfaces. The femur is flexed by the ISO 14243-1:2009 flexion angle (rotation about
 //! the condyle centre) and pushed down until the contact resultant equals the ISO axial force
 //! divided by an effective condyle width of 30 mm. Both ISO curves are approximations digitised
-//! from the standard (`synovia::knee2d::ISO14243_*`). See `docs/knee2d.md`.
+//! from the standard (`synovia_models::knee2d::ISO14243_*`). See `docs/knee2d.md`.
 //!
 //! Every step checks the load balance (contact resultant vs applied load, ≤ 0.5 %) and the KKT
 //! conditions of the contact solution, prints the peak cartilage pressure, and writes
@@ -20,7 +20,7 @@ use std::time::Instant;
 
 mod knee_common;
 use knee_common::{csv_text, plot, run_cycle};
-use synovia::knee2d::{hertz_estimate, Knee2d, KneeError};
+use synovia_models::knee2d::{hertz_estimate, Knee2d, KneeError};
 
 fn main() -> Result<(), KneeError> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "out/knee2d".to_string());

@@ -20,10 +20,10 @@ use std::time::Instant;
 use synovia::contact::{StaticContact, StaticContactResult};
 use synovia::contact_ops::ContactSolver;
 use synovia::fem::{ElasticParams, Model};
-use synovia::hertz::{hertz2d_model, Hertz2d};
 use synovia::mesh::math::Real;
 use synovia::time::quasistatic::{QuasiStaticOutput, QuasiStaticParams, QuasiStaticStepper};
 use synovia::time::results::StepRecord;
+use synovia_models::hertz::{hertz2d_model, Hertz2d};
 
 /// Shift of the top for which one Tresca step from the frictionless normal state gives
 /// `Q/(μP) = target` (secant); the loading is monotone, so the quasi-static path reaches the

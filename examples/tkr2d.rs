@@ -1,6 +1,6 @@
 //! # Total knee replacement (sagittal slice) over the ISO 14243-1 gait cycle
 //!
-//! The sagittal model of `synovia::knee2d` with the implant materials ([`Knee2d::tkr`]): a
+//! The sagittal model of `synovia_models::knee2d` with the implant materials ([`Knee2d::tkr`]): a
 //! 4 mm CoCr femoral component (E = 210 GPa, ν = 0.3, outer radius 24 mm) on the femoral bone
 //! arc, on a 9 mm UHMWPE tibial insert (E = 700 MPa, ν = 0.46) on a metal tray block
 //! (Ti-6Al-4V, E = 110 GPa, ν = 0.3); frictionless node-to-segment contact between the
@@ -17,7 +17,7 @@ use std::time::Instant;
 
 mod knee_common;
 use knee_common::{csv_text, plot, run_cycle};
-use synovia::knee2d::{hertz_estimate, Knee2d, KneeError};
+use synovia_models::knee2d::{hertz_estimate, Knee2d, KneeError};
 
 fn main() -> Result<(), KneeError> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "out/tkr2d".to_string());

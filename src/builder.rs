@@ -687,15 +687,16 @@ impl<const D: usize> JointModel<D> {
             )));
         }
         self.assign_kind(pair.body, &pair.part, BoundaryKind::Contact)?;
-        if let synovia_contact::operators::Partner::Body { body, part, .. } = &pair.partner {
-            self.assign_kind(*body, part, BoundaryKind::Contact)?;
+        if let Some((body, part)) = pair.partner_part() {
+            self.assign_kind(body, part, BoundaryKind::Contact)?;
         }
         self.pairs.push(pair);
         Ok(self)
     }
 
-    /// Replaces the friction law of a contact pair in dynamic runs (default: its constant
-    /// coefficient); quasi-static runs use the constant coefficient of the pair.
+    /// Replaces the friction law of a contact pair in quasi-static and dynamic runs (default: its
+    /// constant coefficient; docs/model.md §3, [`QuasiStaticStepper::set_friction_law`],
+    /// [`DynamicStepper::set_friction_law`]).
     ///
     /// # Errors
     /// [`JointError::Invalid`] for an unknown pair.
@@ -882,6 +883,11 @@ impl<const D: usize> JointModel<D> {
     }
 
     /// The parameters a [`JointSession`] needs (elastic, quasi-static, nested iteration).
+    /// The friction laws set with [`JointModel::friction_law`], by pair name.
+    pub(crate) fn pair_friction_laws(&self) -> &[(String, Arc<dyn FrictionLaw>)] {
+        &self.friction_laws
+    }
+
     pub(crate) fn session_params(&self) -> (ElasticParams, QuasiStaticParams, Option<usize>) {
         (self.elastic_params, self.quasistatic_params, self.nested)
     }
@@ -910,6 +916,9 @@ impl<const D: usize> JointModel<D> {
         contact.set_nested_iteration(self.nested);
         let n_dofs = contact.elastic().info().n_dofs;
         let mut stepper = QuasiStaticStepper::from_contact(&self.model, contact, self.quasistatic_params)?;
+        for (pair, law) in &self.friction_laws {
+            stepper.set_friction_law(pair, law.clone())?;
+        }
         let geometry = stepper.geometry().clone();
         let setup_s = start.elapsed().as_secs_f64();
         let mut failure: Option<JointError> = None;

@@ -16,6 +16,10 @@
 //! | [`uzawa`] (`synovia-uzawa`) | Uzawa with MPRGP, and the dual QP on the interface |
 //! | [`time`] (`synovia-time`) | load histories, rigid motions, quasi-static and dynamic time stepping |
 //!
+//! The demonstration and verification models (Hertz, Cattaneo–Mindlin, the 2D knee, the 3D
+//! hip, manufactured solutions) are in the crate `synovia-models`; TOML scenario files and
+//! array inputs are turned into models by the crate `synovia-scenario`.
+//!
 //! See `docs/architecture.md` for the crate graph and the path of data from mesh to solution,
 //! and `docs/model.md`, the project's statement of the model and algorithms, for the equations.
 //!
@@ -53,7 +57,8 @@
 //! ```
 //!
 //! The same model can be written as a TOML scenario and run with the `synovia` command
-//! (crate `synovia-cli`, format in `docs/scenario.md`).
+//! (crate `synovia-cli`; format and translation in the crate `synovia-scenario`, documented in
+//! `docs/scenario.md`).
 #![warn(missing_docs)]
 
 pub use synovia_contact as contact_ops;
@@ -71,20 +76,16 @@ pub mod contact {
     pub use synovia_contact::static_contact::*;
 }
 pub mod builder;
-pub mod hertz;
-pub mod hip3d;
-pub mod knee2d;
 pub mod output;
 pub mod session;
 pub mod solvers;
-pub mod verification;
 
 /// The types most programs need.
 pub mod prelude {
     pub use crate::builder::{Analysis, BodyMaterial, BodyRef, JointError, JointModel, RunResult, StepView};
     pub use crate::session::{JointSession, SolveReport};
     pub use synovia_contact::operators::{CylinderObstacle, FnObstacle, PlaneObstacle, SphereObstacle};
-    pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction};
+    pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction, FrictionLaw};
     pub use synovia_fem::{
         solve_elastic, BodyFields, BodyId, ComponentMask, ElasticParams, ElasticSolution, ElasticSolver,
         FemError, Model,

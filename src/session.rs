@@ -113,7 +113,11 @@ impl<'a, const D: usize> JointSession<'a, D> {
         } else {
             let mut contact = StaticContact::new(model, joint.pairs(), elastic_params)?;
             contact.set_nested_iteration(nested);
-            Engine::Contact(Box::new(QuasiStaticStepper::from_contact(model, contact, quasistatic_params)?))
+            let mut stepper = QuasiStaticStepper::from_contact(model, contact, quasistatic_params)?;
+            for (pair, law) in joint.pair_friction_laws() {
+                stepper.set_friction_law(pair, law.clone())?;
+            }
+            Engine::Contact(Box::new(stepper))
         };
         let geometry = match &engine {
             Engine::Contact(s) => s.geometry().clone(),

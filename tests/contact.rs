@@ -7,9 +7,9 @@ use std::sync::Arc;
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::{ContactPair, FnObstacle, PlaneObstacle, SphereObstacle};
 use synovia::contact_ops::{ContactError, ContactParams};
-use synovia::hertz::{cattaneo_mindlin_2d, hertz2d, hertz2d_model, hertz3d, Hertz2d, Hertz3d};
 use synovia::prelude::*;
 use synovia::solvers::{by_name, by_name_with, SOLVER_NAMES};
+use synovia_models::hertz::{cattaneo_mindlin_2d, hertz2d, hertz2d_model, hertz3d, Hertz2d, Hertz3d};
 
 #[test]
 fn hertz_2d_cylinder_on_rigid_flat_matches_the_analytic_solution() {

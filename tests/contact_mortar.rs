@@ -10,9 +10,9 @@ use std::time::Instant;
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::{ContactGeometry, ContactPair};
 use synovia::fem::ComponentMask;
-use synovia::hertz::{hertz2d_block, hertz3d_block, HertzBlock2d, HertzBlock3d};
 use synovia::prelude::*;
 use synovia::solvers::by_name;
+use synovia_models::hertz::{hertz2d_block, hertz3d_block, HertzBlock2d, HertzBlock3d};
 
 const PATCH_DELTA: f64 = 1e-3;
 
@@ -334,7 +334,7 @@ fn all_solvers_agree<const D: usize>(model: &Model<D>, sc: &StaticContact<D>, sh
 /// mortar operators, in 2D and 3D, frictionless and with Tresca friction (stick and slip).
 #[test]
 fn all_solvers_run_on_mortar_operators() {
-    use synovia::hertz::{hertz2d_block_model, hertz3d_block_model};
+    use synovia_models::hertz::{hertz2d_block_model, hertz3d_block_model};
     let p = HertzBlock2d {
         levels: 6,
         block_h: 0.012,
@@ -361,7 +361,7 @@ fn all_solvers_run_on_mortar_operators() {
 #[test]
 fn mortar_geometry_rows_search_distance_and_errors() {
     use synovia::contact_ops::ContactError;
-    use synovia::hertz::hertz2d_block_model;
+    use synovia_models::hertz::hertz2d_block_model;
     let p = HertzBlock2d {
         levels: 4,
         block_h: 0.02,
@@ -405,8 +405,8 @@ fn mortar_geometry_rows_search_distance_and_errors() {
 /// 2 %.
 #[test]
 fn mortar_ironing_with_coulomb_friction_and_repairing() {
-    use synovia::hertz::refined_axis;
     use synovia::time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
+    use synovia_models::hertz::refined_axis;
     const MU: f64 = 0.3;
     const PUSH: f64 = 0.005;
     const DRAG: f64 = 0.5;

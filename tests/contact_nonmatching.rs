@@ -10,10 +10,10 @@ use synovia::contact_ops::operators::{ContactGeometry, ContactPair};
 use synovia::fem::element::{stress_tensor, SimplexGeometry};
 use synovia::fem::post::body_fields;
 use synovia::fem::ComponentMask;
-use synovia::hertz::{hertz2d_block, refined_axis, HertzBlock2d};
 use synovia::prelude::*;
 use synovia::solvers::by_name;
 use synovia::time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
+use synovia_models::hertz::{hertz2d_block, refined_axis, HertzBlock2d};
 
 /// Two stacked blocks `[0, 1] × [−½, 0]` (below, `n_lower` cells across) and `[0, 1] × [0, ½]`
 /// (above, `n_upper` cells across), side rollers (`u_x = 0`), the lower clamped at its base, the
@@ -344,8 +344,8 @@ fn ironing_with_coulomb_friction_on_non_matching_meshes() {
 #[test]
 fn all_solvers_run_on_node_to_segment_operators() {
     use synovia::contact_ops::ContactParams;
-    use synovia::hertz::hertz2d_block_model;
     use synovia::solvers::{by_name_with, SOLVER_NAMES};
+    use synovia_models::hertz::hertz2d_block_model;
     let p = HertzBlock2d { levels: 6, block_h: 0.012, block_h_far: 0.2, window: 0.15, ..Default::default() };
     let (model, mut pairs) = hertz2d_block_model(&p).expect("model");
     pairs[0].friction = 0.3;
@@ -388,8 +388,8 @@ fn all_solvers_run_on_node_to_segment_operators() {
 /// pairings follow the slave nodes (`node_map`, `transfer_result`).
 #[test]
 fn search_distance_drops_nodes_and_results_follow_the_slave_nodes() {
-    use synovia::hertz::hertz2d_block_model;
     use synovia::time::quasistatic::transfer_result;
+    use synovia_models::hertz::hertz2d_block_model;
     let p = HertzBlock2d { levels: 4, block_h: 0.02, block_h_far: 0.2, window: 0.15, ..Default::default() };
     let (model, mut pairs) = hertz2d_block_model(&p).expect("model");
     pairs[0].friction = 0.3;

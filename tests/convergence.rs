@@ -2,7 +2,7 @@
 //! problem over four refinements in 2D and 3D (docs/model.md §8): energy-norm rate ≥ 0.95, L² rate ≥ 1.9
 //! between every pair of consecutive meshes.
 
-use synovia::verification::{bonded_mms, rates, ConvergenceRow};
+use synovia_models::verification::{bonded_mms, rates, ConvergenceRow};
 
 fn check(dim: usize, rows: &[ConvergenceRow]) {
     let re = rates(rows, |r| r.energy_error);

@@ -3,8 +3,8 @@
 
 use synovia::contact::StaticContact;
 use synovia::contact_ops::ContactSolution;
-use synovia::hertz::{hertz2d_model, Hertz2d};
 use synovia::prelude::*;
+use synovia_models::hertz::{hertz2d_model, Hertz2d};
 
 fn max_rel(a: &[f64], b: &[f64]) -> f64 {
     let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(1e-300);

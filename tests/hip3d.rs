@@ -1,9 +1,9 @@
-//! The 3D hip model (`synovia::hip3d`) on a coarse mesh at two load levels (swing and the
+//! The 3D hip model (`synovia_models::hip3d`) on a coarse mesh at two load levels (swing and the
 //! second force peak): the contact resultant balances the hip force within 0.5 %, the contact
 //! solution satisfies the KKT conditions, and the pressures are in the physiological range.
 
-use synovia::hip3d::{hip_force, Hip3d, BODY_WEIGHT_N};
 use synovia::prelude::LoadHistory;
+use synovia_models::hip3d::{hip_force, Hip3d, BODY_WEIGHT_N};
 
 #[test]
 fn hip_force_table_is_double_peaked() {

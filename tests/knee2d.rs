@@ -1,10 +1,10 @@
-//! The sagittal knee model (`synovia::knee2d`) on a coarse mesh over the whole ISO 14243-1
+//! The sagittal knee model (`synovia_models::knee2d`) on a coarse mesh over the whole ISO 14243-1
 //! gait cycle (41 poses): at every step the contact resultant balances the applied load within
 //! 0.5 % and the contact solution satisfies the KKT conditions; the same for the total knee
 //! replacement variant (`Knee2d::tkr_coarse`, 21 poses).
 
-use synovia::knee2d::{cycle_times, iso14243_axial_force, iso14243_flexion, Knee2d};
 use synovia::prelude::LoadHistory;
+use synovia_models::knee2d::{cycle_times, iso14243_axial_force, iso14243_flexion, Knee2d};
 
 #[test]
 fn iso_tables_have_the_standard_features() {

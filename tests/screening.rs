@@ -7,8 +7,8 @@
 use synovia::contact::{StaticContact, StaticContactResult};
 use synovia::contact_ops::operators::ContactPair;
 use synovia::fem::{ElasticParams, Model};
-use synovia::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 use synovia::solvers::by_name;
+use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 
 /// The frictionless solve at `t = 0`, the Tresca solve at `t = shift` with the slip bounds
 /// of the normal solve and slip measured from its displacements (both from the reference when

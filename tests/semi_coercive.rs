@@ -5,11 +5,11 @@
 //! Numbers printed with `--nocapture` are the ones in `docs/reliability.md`.
 
 use synovia::contact_ops::ContactError;
-use synovia::hertz::fit_elliptic;
 use synovia::prelude::*;
 use synovia::solvers::by_name;
 use synovia::time::TimeError;
 use synovia_mesh::generators::{half_disc_refined, hemisphere_refined};
+use synovia_models::hertz::fit_elliptic;
 
 const E: f64 = 1.0;
 const NU: f64 = 0.3;

@@ -5,7 +5,7 @@ use std::fmt::Write as _;
 
 use plotters::prelude::*;
 use synovia::io::{Encoding, TimeSeriesWriter};
-use synovia::knee2d::{cycle_times, Knee2d, KneeError, KneeStep};
+use synovia_models::knee2d::{cycle_times, Knee2d, KneeError, KneeStep};
 
 /// Runs `model` over `n` poses of the ISO cycle with PDAS: prints one table row per pose, checks
 /// the load balance (≤ 0.5 %) and the KKT conditions at every pose, and writes the contact state
@@ -120,7 +120,7 @@ pub fn plot(
         .y_desc("peak contact pressure (MPa)")
         .draw()
         .map_err(|e| e.to_string())?;
-    let table = synovia::knee2d::ISO14243_AXIAL_FORCE;
+    let table = synovia_models::knee2d::ISO14243_AXIAL_FORCE;
     chart
         .draw_series(LineSeries::new(table.iter().copied(), &BLUE))
         .map_err(|e| e.to_string())?

@@ -26,11 +26,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use synovia::material::{isotropic, plane_strain, Material};
-use synovia_cli::scenario::Scenario;
+use synovia_scenario::arrays::{ConditionKind, ModelArrays};
+use synovia_scenario::scenario::Scenario;
 
 mod state;
 
-use state::{Arrays, CondKind, State};
+use state::State;
 
 /// Status code returned by every `syn_*` function that can fail (0 = success).
 ///
@@ -487,7 +488,7 @@ pub unsafe extern "C" fn syn_model_from_arrays(
         // SAFETY: for all seven arrays, the caller guarantees each pointer is NULL or valid for its
         // `*_len` values during this call; the slices do not outlive it.
         let arr = unsafe {
-            Arrays {
+            ModelArrays {
                 coords: input(a.coords, a.coords_len, "coords")?,
                 elements: input(a.elements, a.elements_len, "elements")?,
                 element_body: input(a.element_body, a.element_body_len, "element_body")?,
@@ -497,14 +498,12 @@ pub unsafe extern "C" fn syn_model_from_arrays(
                 poisson: input(a.poisson, a.poisson_len, "poisson")?,
             }
         };
-        let mat_err =
-            |e: synovia::material::MaterialError| Fail::new(SynStatus::ModelRejected, e.to_string());
         let model = match a.dimension {
             2 => AnyModel::D2(State::<2>::from_arrays(&arr, |e, nu| {
-                Ok(Arc::new(plane_strain(e, nu).map_err(mat_err)?) as Arc<dyn Material<2>>)
+                Ok(Arc::new(plane_strain(e, nu)?) as Arc<dyn Material<2>>)
             })?),
             3 => AnyModel::D3(State::<3>::from_arrays(&arr, |e, nu| {
-                Ok(Arc::new(isotropic(e, nu).map_err(mat_err)?) as Arc<dyn Material<3>>)
+                Ok(Arc::new(isotropic(e, nu)?) as Arc<dyn Material<3>>)
             })?),
             d => {
                 return Err(Fail::new(
@@ -603,10 +602,10 @@ pub unsafe extern "C" fn syn_model_part_tag(
 /// clamped part is a no-op).
 #[no_mangle]
 pub extern "C" fn syn_model_clamp(model: *mut SynModel, tag: i32) -> SynStatus {
-    guard(|| with_model(model, |m| dispatch!(m, s => s.set_condition(tag, CondKind::Clamped, &[]))))
+    guard(|| with_model(model, |m| dispatch!(m, s => s.set_condition(tag, ConditionKind::Clamped, &[]))))
 }
 
-fn set_values(model: *mut SynModel, tag: i32, kind: CondKind, v: &[f64]) -> Result<(), Fail> {
+fn set_values(model: *mut SynModel, tag: i32, kind: ConditionKind, v: &[f64]) -> Result<(), Fail> {
     with_model(model, |m| dispatch!(m, s => s.set_condition(tag, kind, v)))
 }
 
@@ -630,7 +629,7 @@ pub unsafe extern "C" fn syn_model_set_displacement(
         if value.is_null() {
             return Err(Fail::new(SynStatus::NullPointer, "`value` is NULL"));
         }
-        set_values(model, tag, CondKind::Displacement, v)
+        set_values(model, tag, ConditionKind::Displacement, v)
     })
 }
 
@@ -652,7 +651,7 @@ pub unsafe extern "C" fn syn_model_set_traction(
         if value.is_null() {
             return Err(Fail::new(SynStatus::NullPointer, "`value` is NULL"));
         }
-        set_values(model, tag, CondKind::Traction, v)
+        set_values(model, tag, ConditionKind::Traction, v)
     })
 }
 
@@ -660,7 +659,7 @@ pub unsafe extern "C" fn syn_model_set_traction(
 /// makes it a traction part; later calls change the value.
 #[no_mangle]
 pub extern "C" fn syn_model_set_pressure(model: *mut SynModel, tag: i32, p: f64) -> SynStatus {
-    guard(|| set_values(model, tag, CondKind::Pressure, &[p]))
+    guard(|| set_values(model, tag, ConditionKind::Pressure, &[p]))
 }
 
 /// Adds a body–body contact pair between part `slave_tag` (body k) and part `master_tag`

@@ -4,53 +4,34 @@
 //!
 //! Nothing here touches raw pointers; `lib.rs` turns C arguments into slices and strings first.
 
-use std::collections::{BTreeMap, HashMap};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use synovia::builder::{BodyMaterial, JointError, JointModel};
-use synovia::contact_ops::operators::{ContactPair, PlaneObstacle};
 use synovia::contact_ops::{ContactSolver, StaticContact, StaticContactResult};
-use synovia::fem::{BodyId, ComponentMask, ElasticParams, ElasticSolver, OrderingChoice};
+use synovia::fem::{ElasticParams, ElasticSolver, OrderingChoice};
 use synovia::material::Material;
-use synovia::mesh::math::{Point, Real, Vector};
-use synovia::mesh::{BoundaryKind, Mesh};
+use synovia::mesh::math::{Real, Vector};
 use synovia::time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
 use synovia::time::results::{PairRecord, StepRecord};
 use synovia::time::TimeError;
-use synovia_cli::scenario::Scenario;
+use synovia_scenario::arrays::{ArrayError, ArrayModel, ConditionChange, ConditionKind, ModelArrays};
+use synovia_scenario::scenario::Scenario;
 
 use crate::{Fail, SynStatus};
 
-/// Contact solver nested iteration default of [`JointModel`] (`Some(32)`).
+/// Contact solver nested iteration default of [`JointModel`](synovia::builder::JointModel)
+/// (`Some(32)`).
 const DEFAULT_NESTED: Option<usize> = Some(32);
 
-/// Condition values that C may change between solves (read by the model's closures at every
-/// solve; at most 3 components).
-#[derive(Debug, Default)]
-pub(crate) struct Values([AtomicU64; 3]);
-
-impl Values {
-    fn set(&self, v: &[Real]) {
-        for (slot, x) in self.0.iter().zip(v) {
-            slot.store(x.to_bits(), Ordering::Relaxed);
-        }
+impl From<ArrayError> for Fail {
+    fn from(e: ArrayError) -> Self {
+        let status = match &e {
+            ArrayError::SizeMismatch(_) => SynStatus::SizeMismatch,
+            ArrayError::IndexOutOfRange(_) => SynStatus::IndexOutOfRange,
+            ArrayError::InvalidArgument(_) => SynStatus::InvalidArgument,
+            ArrayError::Rejected(_) => SynStatus::ModelRejected,
+        };
+        Fail::new(status, e.to_string())
     }
-    fn get(&self, i: usize) -> Real {
-        self.0.get(i).map_or(0.0, |a| Real::from_bits(a.load(Ordering::Relaxed)))
-    }
-    fn vector<const D: usize>(&self) -> Vector<D> {
-        Vector::<D>::from_fn(|i, _| self.get(i))
-    }
-}
-
-/// A condition set through the C API on a part.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum CondKind {
-    Clamped,
-    Displacement,
-    Traction,
-    Pressure,
 }
 
 /// The solver's parameters (those of [`JointModel`] that it does not expose).
@@ -93,13 +74,8 @@ pub(crate) struct Solved<const D: usize> {
 
 /// One model behind a handle.
 pub(crate) struct State<const D: usize> {
-    joint: JointModel<D>,
-    /// Per body: local node → global node.
-    node_map: Vec<Vec<usize>>,
-    n_global: usize,
-    /// Part tag → (body, part name).
-    parts: BTreeMap<i32, (BodyId, String)>,
-    conditions: HashMap<i32, (CondKind, Arc<Values>)>,
+    /// The model with its global node numbering, part tags and live condition values.
+    model: ArrayModel<D>,
     params: Params,
     solver: Option<Solver<D>>,
     last: Option<Solved<D>>,
@@ -114,10 +90,6 @@ pub(crate) struct Info {
     pub kkt: Real,
     pub n_dofs: usize,
     pub contact_nodes: usize,
-}
-
-fn model_err(e: JointError) -> Fail {
-    Fail::new(SynStatus::ModelRejected, e.to_string())
 }
 
 fn finite(v: &[Real], what: &str) -> Result<(), Fail> {
@@ -136,179 +108,27 @@ fn check_len(len: usize, expected: usize, what: &str) -> Result<(), Fail> {
     }
 }
 
-/// The arrays of a model given by C (already turned into slices).
-pub(crate) struct Arrays<'a> {
-    pub coords: &'a [f64],
-    pub elements: &'a [i32],
-    pub element_body: &'a [i32],
-    pub facets: &'a [i32],
-    pub facet_tags: &'a [i32],
-    pub young: &'a [f64],
-    pub poisson: &'a [f64],
-}
-
-fn index(v: i32, n: usize, what: &str, at: usize) -> Result<usize, Fail> {
-    usize::try_from(v).ok().filter(|&i| i < n).ok_or_else(|| {
-        Fail::new(SynStatus::IndexOutOfRange, format!("{what} {at}: index {v} is out of range 0..{n}"))
-    })
-}
-
 impl<const D: usize> State<D> {
     /// A model from arrays (see `syn_model_from_arrays`); `material(E, ν)` makes the material
     /// of a body.
     pub fn from_arrays(
-        a: &Arrays<'_>,
-        material: impl Fn(Real, Real) -> Result<Arc<dyn Material<D>>, Fail>,
+        a: &ModelArrays<'_>,
+        material: impl Fn(Real, Real) -> Result<Arc<dyn Material<D>>, synovia::material::MaterialError>,
     ) -> Result<Self, Fail> {
-        if a.coords.len() % D != 0 {
-            return Err(Fail::new(
-                SynStatus::SizeMismatch,
-                format!("coords has {} values, not a multiple of the dimension {D}", a.coords.len()),
-            ));
-        }
-        let n_nodes = a.coords.len() / D;
-        if a.elements.len() % (D + 1) != 0 {
-            return Err(Fail::new(
-                SynStatus::SizeMismatch,
-                format!("elements has {} indices, not a multiple of {} (P1 cells)", a.elements.len(), D + 1),
-            ));
-        }
-        let n_elements = a.elements.len() / (D + 1);
-        check_len(a.element_body.len(), n_elements, "element_body (one body id per element)")?;
-        if a.facets.len() % D != 0 {
-            return Err(Fail::new(
-                SynStatus::SizeMismatch,
-                format!("facets has {} indices, not a multiple of {D}", a.facets.len()),
-            ));
-        }
-        let n_facets = a.facets.len() / D;
-        check_len(a.facet_tags.len(), n_facets, "facet_tags (one tag per facet)")?;
-        check_len(a.poisson.len(), a.young.len(), "poisson (one per body, as young)")?;
-        let n_bodies = a.young.len();
-        if n_bodies == 0 || n_elements == 0 {
-            return Err(Fail::new(
-                SynStatus::InvalidArgument,
-                "the model needs at least one body and one element",
-            ));
-        }
-        finite(a.coords, "coords")?;
-        // bodies: their elements and nodes (a node belongs to one body)
-        let mut node_body: Vec<Option<usize>> = vec![None; n_nodes];
-        let mut cells: Vec<Vec<usize>> = vec![Vec::new(); n_bodies];
-        for e in 0..n_elements {
-            let b = index(a.element_body[e], n_bodies, "element_body of element", e)?;
-            for k in 0..=D {
-                let g = index(a.elements[e * (D + 1) + k], n_nodes, "node of element", e)?;
-                match node_body[g] {
-                    Some(o) if o != b => {
-                        return Err(Fail::new(
-                            SynStatus::InvalidArgument,
-                            format!("node {g} belongs to elements of bodies {o} and {b}: each body needs its own nodes"),
-                        ))
-                    }
-                    _ => node_body[g] = Some(b),
-                }
-                cells[b].push(g);
-            }
-        }
-        let mut local = vec![usize::MAX; n_nodes];
-        let mut node_map: Vec<Vec<usize>> = vec![Vec::new(); n_bodies];
-        for (g, b) in node_body.iter().enumerate() {
-            if let Some(b) = *b {
-                local[g] = node_map[b].len();
-                node_map[b].push(g);
-            }
-        }
-        // facets by tag; every tag on one body
-        let mut tags: BTreeMap<i32, (usize, Vec<Vec<usize>>)> = BTreeMap::new();
-        for f in 0..n_facets {
-            let mut nodes = Vec::with_capacity(D);
-            let mut body = None;
-            for k in 0..D {
-                let g = index(a.facets[f * D + k], n_nodes, "node of facet", f)?;
-                let b = node_body[g].ok_or_else(|| {
-                    Fail::new(SynStatus::InvalidArgument, format!("facet {f}: node {g} is in no element"))
-                })?;
-                if body.is_some_and(|o| o != b) {
-                    return Err(Fail::new(SynStatus::InvalidArgument, format!("facet {f} joins two bodies")));
-                }
-                body = Some(b);
-                nodes.push(local[g]);
-            }
-            let b = body.unwrap_or(0);
-            let tag = a.facet_tags[f];
-            let entry = tags.entry(tag).or_insert_with(|| (b, Vec::new()));
-            if entry.0 != b {
-                return Err(Fail::new(
-                    SynStatus::InvalidArgument,
-                    format!(
-                        "tag {tag} is on facets of bodies {} and {b}: a tag names a part of one body",
-                        entry.0
-                    ),
-                ));
-            }
-            entry.1.push(nodes);
-        }
-        let mut joint = JointModel::<D>::new();
-        let mut parts = BTreeMap::new();
-        for b in 0..n_bodies {
-            if cells[b].is_empty() {
-                return Err(Fail::new(SynStatus::InvalidArgument, format!("body {b} has no elements")));
-            }
-            let nodes: Vec<Point<D>> =
-                node_map[b].iter().map(|&g| Point::<D>::from_fn(|i, _| a.coords[g * D + i])).collect();
-            let flat: Vec<usize> = cells[b].iter().map(|&g| local[g]).collect();
-            let mut mesh = Mesh::<D>::new(nodes, flat)
-                .map_err(|e| Fail::new(SynStatus::ModelRejected, format!("body {b}: {e}")))?;
-            for (tag, (tb, facets)) in &tags {
-                if *tb == b {
-                    mesh.add_boundary_part_from_facets(&part_name(*tag), BoundaryKind::TractionFree, facets)
-                        .map_err(|e| {
-                            Fail::new(SynStatus::ModelRejected, format!("body {b}, tag {tag}: {e}"))
-                        })?;
-                }
-            }
-            let m = material(a.young[b], a.poisson[b])?;
-            let id =
-                joint.add_body(&format!("body_{b}"), mesh, BodyMaterial::Elastic(m)).map_err(model_err)?;
-            for (tag, (tb, _)) in &tags {
-                if *tb == b {
-                    parts.insert(*tag, (id, part_name(*tag)));
-                }
-            }
-        }
-        Ok(Self {
-            joint,
-            node_map,
-            n_global: n_nodes,
-            parts,
-            conditions: HashMap::new(),
-            params: Params::default(),
-            solver: None,
-            last: None,
-        })
+        Ok(Self::new(ArrayModel::from_arrays(a, material)?, Params::default()))
+    }
+
+    fn new(model: ArrayModel<D>, params: Params) -> Self {
+        Self { model, params, solver: None, last: None }
     }
 
     /// A model from a scenario (its bodies, parts, conditions, pairs and solver; the analysis
     /// is left to the caller). Parts are tagged 0, 1, … body by body in file order; nodes are
     /// numbered body by body.
     pub fn from_scenario(sc: &Scenario) -> Result<Self, Fail> {
-        let built =
-            synovia_cli::build::build::<D>(sc).map_err(|e| Fail::new(SynStatus::Scenario, e.to_string()))?;
-        let joint = built.joint;
-        let mut node_map = Vec::new();
-        let mut parts = BTreeMap::new();
-        let mut n_global = 0;
-        let mut tag = 0_i32;
-        for (b, body) in joint.model().bodies().iter().enumerate() {
-            let n = body.mesh.n_nodes();
-            node_map.push((n_global..n_global + n).collect());
-            n_global += n;
-            for p in body.mesh.boundary_parts() {
-                parts.insert(tag, (BodyId(b), p.name().to_string()));
-                tag += 1;
-            }
-        }
+        let built = synovia_scenario::build::build::<D>(sc)
+            .map_err(|e| Fail::new(SynStatus::Scenario, e.to_string()))?;
+        let model = ArrayModel::from_joint(built.joint);
         // the solver parameters that the scenario gave the JointModel
         let mut params = Params::default();
         if let Some(s) = &sc.doc.solver {
@@ -345,42 +165,19 @@ impl<const D: usize> State<D> {
         if let Some(v) = &a.initial_friction {
             q.initial_friction = *v.get_ref();
         }
-        Ok(Self {
-            joint,
-            node_map,
-            n_global,
-            parts,
-            conditions: HashMap::new(),
-            params,
-            solver: None,
-            last: None,
-        })
+        Ok(Self::new(model, params))
     }
 
     pub fn n_nodes(&self) -> usize {
-        self.n_global
+        self.model.n_nodes()
     }
     pub fn n_pairs(&self) -> usize {
-        self.joint.pairs().len()
+        self.model.joint().pairs().len()
     }
 
     /// The tag of `part` of body `body`.
     pub fn part_tag(&self, body: &str, part: &str) -> Result<i32, Fail> {
-        let id = self
-            .joint
-            .model()
-            .body_id(body)
-            .map_err(|e| Fail::new(SynStatus::InvalidArgument, e.to_string()))?;
-        self.parts.iter().find(|(_, (b, p))| *b == id && p == part).map(|(t, _)| *t).ok_or_else(|| {
-            Fail::new(SynStatus::InvalidArgument, format!("body `{body}` has no part `{part}`"))
-        })
-    }
-
-    fn part(&self, tag: i32) -> Result<(BodyId, String), Fail> {
-        self.parts
-            .get(&tag)
-            .cloned()
-            .ok_or_else(|| Fail::new(SynStatus::InvalidArgument, format!("no part has tag {tag}")))
+        Ok(self.model.part_tag(body, part)?)
     }
 
     /// Forgets the factorisation and the last solution (the model's structure changed).
@@ -389,92 +186,12 @@ impl<const D: usize> State<D> {
         self.last = None;
     }
 
-    /// A new condition on a part that has none yet (`TractionFree`).
-    fn fresh_part(&self, tag: i32) -> Result<(BodyId, String), Fail> {
-        let (body, part) = self.part(tag)?;
-        let kind = self
-            .joint
-            .model()
-            .body(body)
-            .and_then(|b| {
-                b.mesh
-                    .boundary_part(&part)
-                    .map(|p| p.kind())
-                    .map_err(|source| synovia::fem::FemError::Mesh { body: b.name.clone(), source })
-            })
-            .map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?;
-        if kind != BoundaryKind::TractionFree {
-            return Err(Fail::new(
-                SynStatus::ModelRejected,
-                format!("part tag {tag} (`{part}`) is already of kind {kind:?}"),
-            ));
-        }
-        Ok((body, part))
-    }
-
     /// Sets (first call: creates) a condition with values `v` on part `tag`.
-    pub fn set_condition(&mut self, tag: i32, kind: CondKind, v: &[Real]) -> Result<(), Fail> {
-        finite(v, "value")?;
-        let expected = match kind {
-            CondKind::Clamped => 0,
-            CondKind::Pressure => 1,
-            CondKind::Displacement | CondKind::Traction => D,
-        };
-        check_len(v.len(), expected, "value")?;
-        if let Some((k, values)) = self.conditions.get(&tag) {
-            if *k != kind {
-                return Err(Fail::new(
-                    SynStatus::ModelRejected,
-                    format!("part tag {tag} already has a {k:?} condition, not {kind:?}"),
-                ));
-            }
-            values.set(v);
-            return Ok(());
+    pub fn set_condition(&mut self, tag: i32, kind: ConditionKind, v: &[Real]) -> Result<(), Fail> {
+        if self.model.set_condition(tag, kind, v)? == ConditionChange::Created {
+            self.invalidate();
         }
-        let (body, part) = self.fresh_part(tag)?;
-        let values = Arc::new(Values::default());
-        values.set(v);
-        let val = values.clone();
-        let r = match kind {
-            CondKind::Clamped => self.joint.clamp(body, &part).map(|_| ()),
-            CondKind::Displacement => self
-                .joint
-                .prescribe_field(body, &part, ComponentMask::ALL, move |_x, _t| val.vector::<D>())
-                .map(|_| ()),
-            CondKind::Traction => {
-                self.joint.traction_field(body, &part, move |_x, _n, _t| val.vector::<D>()).map(|_| ())
-            }
-            CondKind::Pressure => {
-                self.joint.traction_field(body, &part, move |_x, n, _t| n * -val.get(0)).map(|_| ())
-            }
-        };
-        r.map_err(model_err)?;
-        self.conditions.insert(tag, (kind, values));
-        self.invalidate();
         Ok(())
-    }
-
-    fn push_pair(&mut self, pair: ContactPair<D>, friction: Real) -> Result<usize, Fail> {
-        if !(friction.is_finite() && friction >= 0.0) {
-            return Err(Fail::new(
-                SynStatus::InvalidArgument,
-                format!("friction coefficient {friction} must be finite and >= 0"),
-            ));
-        }
-        self.joint.add_contact(pair.with_friction(friction)).map_err(model_err)?;
-        self.invalidate();
-        Ok(self.joint.pairs().len() - 1)
-    }
-
-    fn pair_name(&self) -> String {
-        let mut i = self.joint.pairs().len();
-        loop {
-            let name = format!("pair_{i}");
-            if !self.joint.pairs().iter().any(|p| p.name == name) {
-                return name;
-            }
-            i += 1;
-        }
     }
 
     /// A body–body pair (`segment`: node-to-segment, else node-to-node); returns its index.
@@ -485,18 +202,9 @@ impl<const D: usize> State<D> {
         segment: bool,
         friction: Real,
     ) -> Result<usize, Fail> {
-        let (k, pk) = self.fresh_part(slave)?;
-        let (l, pl) = self.fresh_part(master)?;
-        if k == l {
-            return Err(Fail::new(SynStatus::InvalidArgument, "a body cannot be in contact with itself"));
-        }
-        let name = self.pair_name();
-        let pair = if segment {
-            ContactPair::node_to_segment(&name, k, &pk, l, &pl)
-        } else {
-            ContactPair::node_to_node(&name, k, &pk, l, &pl)
-        };
-        self.push_pair(pair, friction)
+        let i = self.model.add_contact(slave, master, segment, friction)?;
+        self.invalidate();
+        Ok(i)
     }
 
     /// A pair against the rigid plane through `point` with normal `normal`.
@@ -507,36 +215,28 @@ impl<const D: usize> State<D> {
         normal: &[Real],
         friction: Real,
     ) -> Result<usize, Fail> {
-        check_len(point.len(), D, "point")?;
-        check_len(normal.len(), D, "normal")?;
-        finite(point, "point")?;
-        finite(normal, "normal")?;
-        let (body, part) = self.fresh_part(tag)?;
-        let plane =
-            PlaneObstacle::new(Point::<D>::from_fn(|i, _| point[i]), Vector::<D>::from_fn(|i, _| normal[i]))
-                .map_err(|e| Fail::new(SynStatus::InvalidArgument, e.to_string()))?;
-        let name = self.pair_name();
-        self.push_pair(ContactPair::rigid(&name, body, &part, Arc::new(plane)), friction)
+        let i = self.model.add_contact_plane(tag, point, normal, friction)?;
+        self.invalidate();
+        Ok(i)
     }
 
     pub fn set_solver(&mut self, name: &str) -> Result<(), Fail> {
-        self.joint.solver(name).map_err(|e| Fail::new(SynStatus::InvalidArgument, e.to_string()))?;
-        Ok(())
+        Ok(self.model.set_solver(name)?)
     }
 
     fn build(&mut self) -> Result<(), Fail> {
         if self.solver.is_some() {
             return Ok(());
         }
-        let model = self.joint.model();
+        let model = self.model.joint().model();
         model.validate().map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?;
-        let solver = if self.joint.pairs().is_empty() {
+        let solver = if self.model.joint().pairs().is_empty() {
             Solver::Elastic(Box::new(
                 ElasticSolver::new(model, self.params.elastic)
                     .map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?,
             ))
         } else {
-            let mut c = StaticContact::new(model, self.joint.pairs(), self.params.elastic)
+            let mut c = StaticContact::new(model, self.model.joint().pairs(), self.params.elastic)
                 .map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?;
             c.set_nested_iteration(self.params.nested);
             let stepper = QuasiStaticStepper::from_contact(model, c, self.params.quasistatic)
@@ -548,7 +248,7 @@ impl<const D: usize> State<D> {
     }
 
     fn contact_solver(&self) -> Result<Box<dyn ContactSolver>, Fail> {
-        self.joint.build_solver().map_err(|e| Fail::new(SynStatus::InvalidArgument, e.to_string()))
+        self.model.joint().build_solver().map_err(|e| Fail::new(SynStatus::InvalidArgument, e.to_string()))
     }
 
     /// The static problem at `t` (step 0 of the quasi-static scheme); starts a new sequence.
@@ -556,7 +256,7 @@ impl<const D: usize> State<D> {
         finite(&[t], "time")?;
         self.build()?;
         let cs = self.contact_solver()?;
-        let model = self.joint.model();
+        let model = self.model.joint().model();
         let solved = match &mut self.solver {
             Some(Solver::Elastic(e)) => {
                 let sol = e.solve(model, t).map_err(|e| Fail::new(SynStatus::SolveFailed, e.to_string()))?;
@@ -608,7 +308,7 @@ impl<const D: usize> State<D> {
     fn step_from(&mut self, prev: &Solved<D>, t: Real) -> Result<Solved<D>, Fail> {
         self.build()?;
         let cs = self.contact_solver()?;
-        let model = self.joint.model();
+        let model = self.model.joint().model();
         match &mut self.solver {
             Some(Solver::Elastic(e)) => {
                 let sol = e.solve(model, t).map_err(|e| Fail::new(SynStatus::SolveFailed, e.to_string()))?;
@@ -643,17 +343,9 @@ impl<const D: usize> State<D> {
 
     /// Nodal displacements in global numbering (`n_nodes × D`; nodes in no element: 0).
     pub fn displacements(&self, out: &mut [Real]) -> Result<(), Fail> {
-        check_len(out.len(), self.n_global * D, "displacement buffer (n_nodes * dimension)")?;
+        check_len(out.len(), self.n_nodes() * D, "displacement buffer (n_nodes * dimension)")?;
         let s = self.solved()?;
-        out.fill(0.0);
-        for (map, u) in self.node_map.iter().zip(&s.displacement) {
-            for (&g, ui) in map.iter().zip(u) {
-                for k in 0..D {
-                    out[g * D + k] = ui[k];
-                }
-            }
-        }
-        Ok(())
+        Ok(self.model.scatter_displacements(&s.displacement, out)?)
     }
 
     fn contact(&self) -> Option<&StaticContact<D>> {
@@ -687,7 +379,7 @@ impl<const D: usize> State<D> {
                 p[r] = i32::try_from(cn.pair).unwrap_or(-1);
             }
             if let Some(p) = node.as_deref_mut() {
-                let g = self.node_map.get(cn.node.0 .0).and_then(|m| m.get(cn.node.1)).copied();
+                let g = self.model.global_node(cn.node.0, cn.node.1);
                 p[r] = g.and_then(|g| i32::try_from(g).ok()).unwrap_or(-1);
             }
             if let Some(p) = coords.as_deref_mut() {
@@ -705,7 +397,7 @@ impl<const D: usize> State<D> {
     /// Normal force and resultant (3 components) of pair `i`.
     pub fn pair_force(&self, i: usize) -> Result<(Real, [Real; 3]), Fail> {
         let n = self.n_pairs();
-        let name = self.joint.pairs().get(i).map(|p| p.name.clone()).ok_or_else(|| {
+        let name = self.model.joint().pairs().get(i).map(|p| p.name.clone()).ok_or_else(|| {
             Fail::new(SynStatus::IndexOutOfRange, format!("pair {i} is out of range 0..{n}"))
         })?;
         let s = self.solved()?;
@@ -733,10 +425,6 @@ impl<const D: usize> State<D> {
             contact_nodes: self.contact().map_or(0, |c| c.geometry().len()),
         })
     }
-}
-
-fn part_name(tag: i32) -> String {
-    format!("tag_{tag}")
 }
 
 /// A solve failure of the quasi-static stepper.

@@ -361,8 +361,8 @@ fn elastic_model_without_contact_and_a_pressure_load() {
 #[test]
 fn scenario_model_matches_the_cli_build() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/hertz2d.toml");
-    let sc = synovia_cli::Scenario::from_file(&path).unwrap();
-    let built = synovia_cli::build::build::<2>(&sc).unwrap();
+    let sc = synovia_scenario::Scenario::from_file(&path).unwrap();
+    let built = synovia_scenario::build::build::<2>(&sc).unwrap();
     let rust = built.joint.run_static(0.0).unwrap();
     let expected = rust.records[0].pairs[0].normal_force;
     let c = CString::new(path.to_str().unwrap()).unwrap();

@@ -1,9 +1,10 @@
 //! # synovia-cli
 //!
-//! The library behind the `synovia` command: the TOML scenario format ([`scenario`]), its
-//! translation into a [`JointModel`](synovia::builder::JointModel) ([`build`]), and running it
-//! with ParaView, CSV and JSON output ([`run`]). The format is documented with a complete
-//! example in `docs/scenario.md`.
+//! The library behind the `synovia` command: running a scenario with ParaView, CSV and JSON
+//! output ([`run`]). The TOML scenario format ([`scenario`]) and its translation into a
+//! [`JointModel`](synovia::builder::JointModel) ([`build`]) live in the crate
+//! `synovia-scenario` (shared with the C API) and are re-exported here. The format is
+//! documented with a complete example in `docs/scenario.md`.
 //!
 //! ```no_run
 //! use synovia_cli::{run, scenario::Scenario};
@@ -23,8 +24,7 @@
 //! model (unknown body or part names, missing data, invalid materials or histories).
 #![warn(missing_docs)]
 
-pub mod build;
 pub mod run;
-pub mod scenario;
 
-pub use scenario::{Scenario, ScenarioError, Source};
+pub use synovia_scenario::{build, scenario};
+pub use synovia_scenario::{Scenario, ScenarioError, Source};

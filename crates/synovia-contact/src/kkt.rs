@@ -13,7 +13,7 @@ pub struct KktReport {
     pub negative_pressure: f64,
     /// `max_r |Λ_n,r (B_hn U − d)_r|` relative to `max Λ_n ×` displacement scale.
     pub complementarity: f64,
-    /// `max_r (‖Λ_t,r‖ − 1)⁺`.
+    /// `max_r ‖Λ_t,r − π(Λ_t,r)‖ = max_r (‖Λ_t,r‖ − 1)⁺` (`π` = [`crate::project_on_disc`]).
     pub friction_bound: f64,
     /// Sticking cells (`‖Λ_t,r‖ < 1 − 1e-6`) must not slip: `max ‖(B_Ht U − s)_r‖`, relative.
     pub stick_slip: f64,
@@ -105,7 +105,11 @@ pub fn check_kkt(problem: &ContactProblem<'_>, u: &[f64], lambda_n: &[f64], lamb
             let y = &yt[cell * c..(cell + 1) * c];
             let ln = l.iter().map(|v| v * v).sum::<f64>().sqrt();
             let yn2 = y.iter().map(|v| v * v).sum::<f64>().sqrt();
-            rep.friction_bound = rep.friction_bound.max(ln - 1.0);
+            // distance to the unit disc, ‖Λ_t,r − π(Λ_t,r)‖ = (‖Λ_t,r‖ − 1)⁺
+            let mut p = l.to_vec();
+            crate::friction::project_on_disc(&mut p, 1.0);
+            let dist = l.iter().zip(&p).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+            rep.friction_bound = rep.friction_bound.max(dist);
             if ln < 1.0 - 1e-6 {
                 rep.stick_slip = rep.stick_slip.max(yn2 / tscale);
             } else {

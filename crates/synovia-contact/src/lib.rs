@@ -13,7 +13,8 @@
 //!
 //! Contact pairs are node-to-node (matching meshes), node-to-segment / node-to-facet or dual
 //! mortar (non-matching meshes, with the R*-tree contact search of [`search`]; [`mortar`]) or
-//! body-to-obstacle;
+//! body-to-obstacle, each a [`ContactDiscretisation`] (one open trait, one file per kind in
+//! [`discretisation`]; new kinds can be added from outside the crate);
 //! the geometry can be rebuilt at every pose ([`operators::ContactGeometry::new_deformed`],
 //! [`StaticContact::update_geometry`]).
 //!
@@ -24,12 +25,14 @@
 #![warn(missing_docs)]
 
 pub mod context;
+pub mod discretisation;
 pub mod error;
 pub mod floating;
 pub mod friction;
 pub mod kkt;
 pub mod mortar;
 pub mod nested;
+pub mod obstacle;
 pub mod operators;
 pub mod problem;
 pub mod search;
@@ -38,8 +41,11 @@ pub mod static_contact;
 pub mod testing;
 
 pub use context::SolveContext;
+pub use discretisation::{ContactDiscretisation, ContactRow, PairContext};
 pub use error::{ContactError, IterationResidual};
-pub use friction::{ConstantFriction, ExponentialFriction, FrictionLaw};
+pub use friction::{
+    project_on_disc, slip_speeds, ConstantFriction, ExponentialFriction, FrictionLaw, PairFrictionLaws,
+};
 pub use kkt::{check_kkt, KktReport};
 pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};

@@ -1,24 +1,23 @@
 //! Contact pairs and the discrete contact operators of docs/model.md §5.
 //!
-//! A [`ContactPair`] joins the contact part of a body `k` either to the contact part of another
-//! body `l` with nodes at matching positions (node-to-node, the conforming case of the report),
-//! to the contact part of another body `l` with an arbitrary (non-matching) mesh
-//! (node-to-segment in 2D, node-to-facet in 3D: [`Partner::Segment`]; dual mortar:
-//! [`Partner::Mortar`]), or to a rigid obstacle
-//! described by a signed-distance function (the foundation case). For every contact node `s_r`
-//! of body `k` [`ContactGeometry`] stores
+//! A [`ContactPair`] joins the contact part of a body `k` to the other side through a contact
+//! discretisation ([`ContactDiscretisation`], one open trait, one file per kind in
+//! [`crate::discretisation`]): node-to-node on matching meshes, node-to-segment (2D) /
+//! node-to-facet (3D) or dual mortar on non-matching meshes, a rigid obstacle described by a
+//! signed distance, or any type implementing the trait ([`ContactPair::custom`]).
+//! [`ContactGeometry`] computes what every discretisation shares — the outward nodal normals
+//! `n^k` (docs/model.md §1), the lumped weights `κ_i = ∫_{Γ_c} φ_i ds` (row sums of the boundary
+//! mass of part `k`) and the shortest edge of part `k` in the configuration it is built on —
+//! asks the pair's discretisation for its rows, and stores for every contact node `s_r`
 //!
-//! * the normal `n_r` (the outward nodal normal `n^k` of body `k`, docs/model.md §1, or a fixed
-//!   direction; for node-to-segment the master facet's outward normal negated), and an
-//!   orthonormal tangent basis,
-//! * the lumped weight `κ_r = ∫_{Γ_c} φ_r ds` (row sums of the boundary mass of part `k`),
-//! * the initial gap `d_r = (x_l − x_k) · n_r` (node-to-node), `d_r = (Σ_j w_j x_{l,j} − x_k) · n_r`
-//!   (node-to-segment, `w_j` the weights of the projection of `x_k` on its master facet) or
-//!   `d_r = φ(x_k)` (obstacle).
+//! * the normal `n_r` and an orthonormal tangent basis,
+//! * the weight `κ_r`,
+//! * the gap `d_r`, e.g. `d_r = (x_l − x_k) · n_r` (node-to-node),
+//!   `d_r = (Σ_j w_j x_{l,j} − x_k) · n_r` (node-to-segment, mortar) or `d_r = φ(x_k)` (obstacle).
 //!
 //! From these, [`ContactGeometry::normal_constraints`] builds `B_hn` in the reduced unknowns of a
 //! [`DofMap`] (`(B_hn U)_r = [U_n](s_r) = n_r · (u^k(s_r) − u^l(s_r))`, with
-//! `u^l(s_r) = Σ_j w_j u^l_j` for node-to-segment), and
+//! `u^l(s_r) = Σ_j w_j u^l_j` for the weighted partners), and
 //! [`ContactGeometry::friction_constraints`] builds `B_Ht` on the dual cells of the contact nodes:
 //! `(B_Ht U)_r = g_{c,r} κ_r T_rᵀ [U_t](s_r)`, the cell integral `∫_{cell r} g_c [U_t] ds` with the
 //! nodal (lumped) rule, `T_r` the tangent basis (one vector in 2D, two in 3D), for the cells with
@@ -30,38 +29,9 @@
 //! uses the dual (median) cells of the contact nodes as the triangulation `Δ_H` in 2D and 3D,
 //! which keeps `B_Ht` of full rank and the semismooth Newton systems well posed.
 //!
-//! # Non-matching meshes: node-to-segment / node-to-facet
-//!
-//! For a [`Partner::Segment`] pair, part `k` is the *slave* side and part `l` the *master*
-//! side. Every slave node `x_s` is projected onto the master facets with the R*-tree search of
-//! [`crate::search`] (closest facet containing the orthogonal projection; see there for the
-//! rule at convex master edges and at the rim of the master part). The pair uses
-//!
-//! * the normal `n = −n_l`, the master facet's outward unit normal negated (it points from `k`
-//!   into `l`, like `n^k` of a conforming pair). The master normal, not the slave nodal normal,
-//!   is used because then `d` is the exact distance of `x_s` to the master facet plane and a
-//!   flat master surface gives the exact normal whatever the slave mesh;
-//! * the master point `x_m = Σ_j w_j x_{l,j}` (barycentric weights on the facet's nodes,
-//!   [`ContactNode::master`]), `[u_n] = (u_k − Σ_j w_j u_{l,j}) · n`,
-//!   `d = (x_m − x_s) · n` (the signed distance, negative if `x_s` is inside body `l`);
-//! * the tangent basis of `n` and the weight `κ_s` from the slave facets (the multipliers live
-//!   on the slave side, docs/model.md §5).
-//!
-//! Slave nodes without a master facet — farther than the pair's search distance, facing no
-//! master facet, or beyond the rim of the master part — are left out of the pair; they can
-//! enter it when the geometry is rebuilt at a later pose. The operator is not exact for a
-//! uniform pressure on non-matching meshes (the slave nodal forces are passed to the master
-//! nodes by point interpolation, not by the mortar integral); see `docs/contact.md` for the
-//! measured error.
-//!
-//! # Non-matching meshes: dual mortar
-//!
-//! A [`Partner::Mortar`] pair ([`ContactPair::mortar`]) couples slave part `k` and master part
-//! `l` with Wohlmuth's dual (biorthogonal) multipliers ([`crate::mortar`]): `D` is diagonal, so
-//! each slave node `j` keeps one row of the same form, `n_j · (u_j − Σ_k w_jk u_k) ≤ d_j` with
-//! `w_jk = M_jk / D_jj` ([`ContactNode::master`]), `κ_j = D_jj` and `d_j = g̃_j / D_jj` (the
-//! weighted gap), `n_j` the slave nodal normal. Friction rows use the slave tangent basis as
-//! above. The solvers run unchanged; a uniform pressure is transmitted exactly.
+//! The node-to-segment operator is not exact for a uniform pressure on non-matching meshes
+//! (the slave nodal forces are passed to the master nodes by point interpolation, not by the
+//! mortar integral; see `docs/contact.md` for the measured error); dual mortar is.
 //!
 //! # Rebuilding the geometry at a pose
 //!
@@ -71,367 +41,96 @@
 //! displacement `U` from the reference configuration, so the gap is returned in total form:
 //! the linearised condition `([U] − [u⁰]) · n ≤ d(x + u⁰)` is `[U] · n ≤ d(x + u⁰) + [u⁰] · n`,
 //! which for node-to-segment is `(Σ_j w_j X_{l,j} − X_s) · n` with the reference positions `X`
-//! and the weights and normal of the pose. Node-to-node pairs keep the pairing of the
-//! reference configuration (normals from the pose).
+//! and the weights and normal of the pose. The discretisations measure `d(x + u⁰)`; the geometry
+//! adds `[u⁰] · n`. Node-to-node pairs keep the pairing of the reference configuration (normals
+//! from the pose).
 
-use std::fmt;
 use std::sync::Arc;
 
 use synovia_fem::{BodyId, DofMap, Model};
-use synovia_mesh::matching::match_nodes;
 use synovia_mesh::math::{Point, Real, Tensor, Vector};
 
+use crate::discretisation::{ContactRow, PairContext};
 use crate::error::ContactError;
 use crate::problem::{FrictionConstraints, NormalConstraints};
-use crate::search::{area_normal, FacetSearch};
+use crate::search::area_normal;
 use synovia_linalg::SparseRows;
 use synovia_mesh::mesh::nodal_normals_at;
 
-/// A rigid obstacle given by a signed distance `φ` (positive in the free space outside the
-/// obstacle, negative inside) and its gradient.
-pub trait SignedDistance<const D: usize>: Send + Sync + fmt::Debug {
-    /// `φ(x)`.
-    fn distance(&self, x: &Point<D>) -> Real;
-    /// `∇φ(x)`: the unit normal of the obstacle surface pointing into the free space.
-    fn gradient(&self, x: &Point<D>) -> Vector<D>;
-    /// Checks the obstacle's parameters (finite, positive radius, unit directions); the
-    /// error names the offending parameter. [`ContactGeometry::new`] calls it for every rigid
-    /// pair and reports a failure as [`ContactError::InvalidPair`]. Default: no check.
-    fn validate(&self) -> Result<(), String> {
-        Ok(())
-    }
-}
+pub use crate::discretisation::{
+    ContactDiscretisation, DualMortar, NodeToNode, NodeToSegment, NormalChoice, RigidObstacle,
+};
+pub use crate::obstacle::{
+    CylinderObstacle, DistanceFn, FnObstacle, PlaneObstacle, SignedDistance, SphereObstacle,
+};
 
-/// `Err` naming `what` unless every entry of `v` is finite.
-fn check_finite(what: &str, v: &[Real]) -> Result<(), String> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(format!("{what} {v:?} is not finite"))
-    }
-}
-
-/// `Err` unless `v` is a finite unit vector (within 1e-9).
-fn check_unit(what: &str, v: &[Real]) -> Result<(), String> {
-    check_finite(what, v)?;
-    let n = v.iter().map(|x| x * x).sum::<Real>().sqrt();
-    if (n - 1.0).abs() > 1e-9 {
-        return Err(format!("{what} {v:?} must be a unit vector (length {n:e})"));
-    }
-    Ok(())
-}
-
-/// `Err` unless `r` is finite and positive.
-fn check_radius(r: Real) -> Result<(), String> {
-    if r.is_finite() && r > 0.0 {
-        Ok(())
-    } else {
-        Err(format!("radius {r} must be finite and > 0"))
-    }
-}
-
-/// The half-space `{(x − p) · n < 0}` is the obstacle; `n` points into the free space.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PlaneObstacle<const D: usize> {
-    /// A point of the plane.
-    pub point: Point<D>,
-    /// Unit normal pointing out of the obstacle.
-    pub normal: Vector<D>,
-}
-
-impl<const D: usize> PlaneObstacle<D> {
-    /// A plane through `point` with normal `normal` (normalised; error if zero).
-    pub fn new(point: Point<D>, normal: Vector<D>) -> Result<Self, ContactError> {
-        let len = normal.norm();
-        if !(len.is_finite() && len > 0.0) || point.iter().any(|x| !x.is_finite()) {
-            return Err(ContactError::InvalidParameter(
-                "plane obstacle needs a finite point and a non-zero normal".into(),
-            ));
-        }
-        Ok(Self { point, normal: normal / len })
-    }
-}
-
-impl<const D: usize> SignedDistance<D> for PlaneObstacle<D> {
-    fn distance(&self, x: &Point<D>) -> Real {
-        (x - self.point).dot(&self.normal)
-    }
-    fn gradient(&self, _x: &Point<D>) -> Vector<D> {
-        self.normal
-    }
-    fn validate(&self) -> Result<(), String> {
-        check_finite("plane point", self.point.as_slice())?;
-        check_unit("plane normal", self.normal.as_slice())
-    }
-}
-
-/// A rigid ball (circle in 2D) `|x − c| ≤ R`, or with `cavity = true` the outside of it (a
-/// spherical socket whose inside is free).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SphereObstacle<const D: usize> {
-    /// Centre.
-    pub center: Point<D>,
-    /// Radius `R > 0`.
-    pub radius: Real,
-    /// `true`: the body moves inside the sphere (socket); `false`: outside (ball).
-    pub cavity: bool,
-}
-
-impl<const D: usize> SphereObstacle<D> {
-    /// A ball (`cavity = false`) or spherical socket (`cavity = true`); error if the centre
-    /// is not finite or the radius not finite and positive.
-    pub fn new(center: Point<D>, radius: Real, cavity: bool) -> Result<Self, ContactError> {
-        let s = Self { center, radius, cavity };
-        s.validate().map_err(|m| ContactError::InvalidParameter(format!("sphere obstacle: {m}")))?;
-        Ok(s)
-    }
-}
-
-impl<const D: usize> SignedDistance<D> for SphereObstacle<D> {
-    fn validate(&self) -> Result<(), String> {
-        check_finite("sphere centre", self.center.as_slice())?;
-        check_radius(self.radius)
-    }
-    fn distance(&self, x: &Point<D>) -> Real {
-        let r = (x - self.center).norm();
-        if self.cavity {
-            self.radius - r
-        } else {
-            r - self.radius
-        }
-    }
-    fn gradient(&self, x: &Point<D>) -> Vector<D> {
-        let v = x - self.center;
-        let r = v.norm();
-        let g = if r > 0.0 { v / r } else { Vector::<D>::zeros() };
-        if self.cavity {
-            -g
-        } else {
-            g
-        }
-    }
-}
-
-/// A rigid infinite cylinder in 3D `dist(x, axis) ≤ R` (or its outside with `cavity`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CylinderObstacle {
-    /// A point of the axis.
-    pub point: Point<3>,
-    /// Unit axis direction.
-    pub axis: Vector<3>,
-    /// Radius.
-    pub radius: Real,
-    /// `true`: the free space is inside the cylinder.
-    pub cavity: bool,
-}
-
-impl CylinderObstacle {
-    /// A cylinder about the axis through `point` along `axis` (normalised); error if the point
-    /// or axis is not finite, the axis is zero, or the radius not finite and positive.
-    pub fn new(point: Point<3>, axis: Vector<3>, radius: Real, cavity: bool) -> Result<Self, ContactError> {
-        let bad = |m: String| ContactError::InvalidParameter(format!("cylinder obstacle: {m}"));
-        check_finite("cylinder axis", axis.as_slice()).map_err(bad)?;
-        let len = axis.norm();
-        if len <= 0.0 {
-            return Err(bad("axis is zero".into()));
-        }
-        let s = Self { point, axis: axis / len, radius, cavity };
-        s.validate().map_err(bad)?;
-        Ok(s)
-    }
-}
-
-impl SignedDistance<3> for CylinderObstacle {
-    fn validate(&self) -> Result<(), String> {
-        check_finite("cylinder point", self.point.as_slice())?;
-        check_unit("cylinder axis", self.axis.as_slice())?;
-        check_radius(self.radius)
-    }
-    fn distance(&self, x: &Point<3>) -> Real {
-        let v = x - self.point;
-        let r = (v - self.axis * v.dot(&self.axis)).norm();
-        if self.cavity {
-            self.radius - r
-        } else {
-            r - self.radius
-        }
-    }
-    fn gradient(&self, x: &Point<3>) -> Vector<3> {
-        let v = x - self.point;
-        let radial = v - self.axis * v.dot(&self.axis);
-        let r = radial.norm();
-        let g = if r > 0.0 { radial / r } else { Vector::<3>::zeros() };
-        if self.cavity {
-            -g
-        } else {
-            g
-        }
-    }
-}
-
-/// A user-defined obstacle from a closure returning `(φ(x), ∇φ(x))`.
-pub struct FnObstacle<const D: usize> {
-    f: DistanceFn<D>,
-}
-
-/// A closure `x ↦ (φ(x), ∇φ(x))`.
-pub type DistanceFn<const D: usize> = Arc<dyn Fn(&Point<D>) -> (Real, Vector<D>) + Send + Sync>;
-
-impl<const D: usize> FnObstacle<D> {
-    /// Wraps `f(x) = (φ(x), ∇φ(x))`.
-    pub fn new(f: impl Fn(&Point<D>) -> (Real, Vector<D>) + Send + Sync + 'static) -> Self {
-        Self { f: Arc::new(f) }
-    }
-}
-
-impl<const D: usize> fmt::Debug for FnObstacle<D> {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("FnObstacle")
-    }
-}
-
-impl<const D: usize> SignedDistance<D> for FnObstacle<D> {
-    fn distance(&self, x: &Point<D>) -> Real {
-        (self.f)(x).0
-    }
-    fn gradient(&self, x: &Point<D>) -> Vector<D> {
-        (self.f)(x).1
-    }
-}
-
-/// Which normal a node-to-node pair uses.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum NormalChoice<const D: usize> {
-    /// The outward nodal normal `n^k` of body `k` (docs/model.md §1; default).
-    BodyK,
-    /// A fixed unit direction from body `k` toward body `l` for every node.
-    Fixed(Vector<D>),
-}
-
-/// What the contact part of body `k` touches.
-#[derive(Debug, Clone)]
-pub enum Partner<const D: usize> {
-    /// The contact part `part` of body `body`, with nodes at matching positions.
-    Body {
-        /// The other body `l`.
-        body: BodyId,
-        /// Its contact part.
-        part: String,
-        /// Pairing direction: nodes are paired when their positions agree after projecting out
-        /// this direction (default: the mean outward normal of part `k`).
-        direction: Option<Vector<D>>,
-        /// Pairing tolerance (absolute; default `1e-6 ×` the shortest facet edge of part `k`).
-        tolerance: Option<Real>,
-        /// Normal used for the pairs.
-        normal: NormalChoice<D>,
-    },
-    /// A rigid obstacle.
-    Rigid(Arc<dyn SignedDistance<D>>),
-    /// The contact part `part` of body `body` with any mesh: node-to-segment (2D) /
-    /// node-to-facet (3D). Body `k` is the slave side, body `l` the master side (see the
-    /// [module docs](self)).
-    Segment {
-        /// The other (master) body `l`.
-        body: BodyId,
-        /// Its contact part.
-        part: String,
-        /// Largest distance from a slave node to its master point; slave nodes farther away are
-        /// left out of the pair (`None`: every slave node is paired with its closest master
-        /// facet).
-        search_distance: Option<Real>,
-    },
-    /// The contact part `part` of body `body` with any mesh, coupled by dual mortar
-    /// (Wohlmuth's biorthogonal multipliers; exact segment integration in 2D, polygon clipping
-    /// in 3D): body `k` is the slave side (it carries the multipliers), body `l` the master
-    /// side. One condensed row per slave node; see [`crate::mortar`].
-    Mortar {
-        /// The other (master) body `l`.
-        body: BodyId,
-        /// Its contact part.
-        part: String,
-        /// Largest gap (along the slave facet normal) of an integration cell; farther master
-        /// facets are not coupled (`None`: every master facet facing and overlapping a slave
-        /// facet near its closest master facet).
-        search_distance: Option<Real>,
-    },
-}
-
-/// A contact pair `Γ_c^{kl}` (docs/model.md §1, §3).
+/// A contact pair `Γ_c^{kl}` (docs/model.md §1, §3): the contact part of body `k` and the
+/// discretisation that couples it to the other side.
 #[derive(Debug, Clone)]
 pub struct ContactPair<const D: usize> {
     /// Name for reports and errors.
     pub name: String,
-    /// Body `k` (whose outward normal is `n`).
+    /// Body `k` (whose outward normal is `n`; the slave side).
     pub body: BodyId,
     /// Its contact part.
     pub part: String,
-    /// The partner.
-    pub partner: Partner<D>,
+    /// The discretisation producing the pair's rows, gaps and weights.
+    pub discretisation: Arc<dyn ContactDiscretisation<D>>,
     /// Coulomb coefficient `F_c ≥ 0` (0: frictionless).
     pub friction: Real,
 }
 
 impl<const D: usize> ContactPair<D> {
-    /// Body–body node-to-node pair with default pairing direction, tolerance and normal.
+    /// A pair of part `part` of body `body` with any discretisation (e.g. one defined outside
+    /// this crate), frictionless.
+    pub fn custom(
+        name: &str,
+        body: BodyId,
+        part: &str,
+        discretisation: Arc<dyn ContactDiscretisation<D>>,
+    ) -> Self {
+        Self { name: name.to_string(), body, part: part.to_string(), discretisation, friction: 0.0 }
+    }
+    /// Body–body node-to-node pair ([`NodeToNode`]) with default pairing direction, tolerance
+    /// and normal.
     pub fn node_to_node(name: &str, body_k: BodyId, part_k: &str, body_l: BodyId, part_l: &str) -> Self {
-        Self {
-            name: name.to_string(),
-            body: body_k,
-            part: part_k.to_string(),
-            partner: Partner::Body {
-                body: body_l,
-                part: part_l.to_string(),
-                direction: None,
-                tolerance: None,
-                normal: NormalChoice::BodyK,
-            },
-            friction: 0.0,
-        }
+        Self::custom(name, body_k, part_k, Arc::new(NodeToNode::<D>::new(body_l, part_l)))
     }
-    /// Body–body pair on non-matching meshes: node-to-segment (2D) / node-to-facet (3D), with
-    /// the nodes of `part_k` of body `k` as slave nodes projected onto the facets of `part_l`
-    /// of body `l` (no search-distance limit; see [`ContactPair::with_search_distance`]).
+    /// Body–body pair on non-matching meshes: node-to-segment (2D) / node-to-facet (3D)
+    /// ([`NodeToSegment`]), with the nodes of `part_k` of body `k` as slave nodes projected
+    /// onto the facets of `part_l` of body `l` (no search-distance limit; see
+    /// [`ContactPair::with_search_distance`]).
     pub fn node_to_segment(name: &str, body_k: BodyId, part_k: &str, body_l: BodyId, part_l: &str) -> Self {
-        Self {
-            name: name.to_string(),
-            body: body_k,
-            part: part_k.to_string(),
-            partner: Partner::Segment { body: body_l, part: part_l.to_string(), search_distance: None },
-            friction: 0.0,
-        }
+        Self::custom(name, body_k, part_k, Arc::new(NodeToSegment::new(body_l, part_l)))
     }
-    /// Body–body pair on non-matching meshes coupled by **dual mortar** (2D and 3D; docs/model.md §5,
-    /// [`crate::mortar`]): `part_k` of body `k` is the slave side, `part_l` of body `l` the
-    /// master side; no search-distance limit (see [`ContactPair::with_search_distance`]).
-    /// Passes the contact patch test exactly on non-matching meshes.
+    /// Body–body pair on non-matching meshes coupled by **dual mortar** ([`DualMortar`], 2D and
+    /// 3D; docs/model.md §5, [`crate::mortar`]): `part_k` of body `k` is the slave side,
+    /// `part_l` of body `l` the master side; no search-distance limit (see
+    /// [`ContactPair::with_search_distance`]). Passes the contact patch test exactly on
+    /// non-matching meshes.
     pub fn mortar(name: &str, body_k: BodyId, part_k: &str, body_l: BodyId, part_l: &str) -> Self {
-        Self {
-            name: name.to_string(),
-            body: body_k,
-            part: part_k.to_string(),
-            partner: Partner::Mortar { body: body_l, part: part_l.to_string(), search_distance: None },
-            friction: 0.0,
-        }
+        Self::custom(name, body_k, part_k, Arc::new(DualMortar::new(body_l, part_l)))
+    }
+    /// Body–rigid-obstacle pair ([`RigidObstacle`]).
+    pub fn rigid(name: &str, body: BodyId, part: &str, obstacle: Arc<dyn SignedDistance<D>>) -> Self {
+        Self::custom(name, body, part, Arc::new(RigidObstacle::new(obstacle)))
+    }
+    /// The built-in discretisation of this pair as a `T`, if it is one.
+    fn built_in<T: Clone + 'static>(&self) -> Option<T> {
+        let any: &dyn std::any::Any = &*self.discretisation;
+        any.downcast_ref::<T>().cloned()
     }
     /// Sets the search distance of a node-to-segment or mortar pair (no effect on other pairs).
     #[must_use]
     pub fn with_search_distance(mut self, distance: Real) -> Self {
-        if let Partner::Segment { search_distance, .. } | Partner::Mortar { search_distance, .. } =
-            &mut self.partner
-        {
-            *search_distance = Some(distance);
+        if let Some(mut d) = self.built_in::<NodeToSegment>() {
+            d.search_distance = Some(distance);
+            self.discretisation = Arc::new(d);
+        } else if let Some(mut d) = self.built_in::<DualMortar>() {
+            d.search_distance = Some(distance);
+            self.discretisation = Arc::new(d);
         }
         self
-    }
-    /// Body–rigid-obstacle pair.
-    pub fn rigid(name: &str, body: BodyId, part: &str, obstacle: Arc<dyn SignedDistance<D>>) -> Self {
-        Self {
-            name: name.to_string(),
-            body,
-            part: part.to_string(),
-            partner: Partner::Rigid(obstacle),
-            friction: 0.0,
-        }
     }
     /// Sets the Coulomb coefficient.
     #[must_use]
@@ -439,25 +138,31 @@ impl<const D: usize> ContactPair<D> {
         self.friction = coefficient;
         self
     }
-    /// Uses a fixed normal (and pairing direction) for a node-to-node pair.
+    /// Uses a fixed normal (and pairing direction) for a node-to-node pair (no effect on other
+    /// pairs).
     #[must_use]
     pub fn with_fixed_normal(mut self, direction: Vector<D>) -> Self {
-        if let Partner::Body { normal, direction: dir, .. } = &mut self.partner {
-            *normal = NormalChoice::Fixed(direction);
-            *dir = Some(direction);
+        if let Some(d) = self.built_in::<NodeToNode<D>>() {
+            self.discretisation = Arc::new(d.with_fixed_normal(direction));
         }
         self
     }
-}
-
-/// The master side of a node-to-segment or mortar pair: another body, a valid search distance.
-fn check_master(slave: BodyId, master: BodyId, search_distance: Option<Real>) -> Result<(), String> {
-    if master == slave {
-        return Err("self-contact (master body = slave body) is not supported".into());
+    /// Sets the absolute pairing tolerance of a node-to-node pair (no effect on other pairs).
+    #[must_use]
+    pub fn with_pairing_tolerance(mut self, tolerance: Real) -> Self {
+        if let Some(d) = self.built_in::<NodeToNode<D>>() {
+            self.discretisation = Arc::new(d.with_tolerance(tolerance));
+        }
+        self
     }
-    match search_distance {
-        Some(s) if !(s.is_finite() && s >= 0.0) => Err(format!("search distance {s} must be finite and ≥ 0")),
-        _ => Ok(()),
+    /// The kind of the pair's discretisation ([`ContactDiscretisation::kind`]).
+    pub fn kind(&self) -> &str {
+        self.discretisation.kind()
+    }
+    /// The other side's body and part ([`ContactDiscretisation::partner_part`]; `None` for a
+    /// rigid obstacle).
+    pub fn partner_part(&self) -> Option<(BodyId, &str)> {
+        self.discretisation.partner_part()
     }
 }
 
@@ -658,7 +363,7 @@ impl<const D: usize> ContactNode<D> {
 impl<const D: usize> ContactGeometry<D> {
     /// Builds the contact nodes of every pair in the reference configuration.
     pub fn new(model: &Model<D>, pairs: &[ContactPair<D>]) -> Result<Self, ContactError> {
-        Self::build(model, pairs, None)
+        Self::build(model, pairs, None, true, None)
     }
 
     /// Builds the contact nodes of every pair in the configuration `x + u⁰`, `u⁰ =
@@ -672,18 +377,24 @@ impl<const D: usize> ContactGeometry<D> {
         pairs: &[ContactPair<D>],
         displacement: &[Vec<Vector<D>>],
     ) -> Result<Self, ContactError> {
-        let bodies = model.bodies();
-        let fits = displacement.len() == bodies.len()
-            && bodies.iter().zip(displacement).all(|(b, u)| {
-                u.len() == b.mesh.n_nodes() && u.iter().all(|v| v.iter().all(|c| c.is_finite()))
-            });
-        if !fits {
-            return Err(ContactError::InvalidParameter(
-                "the displacement of the pose does not fit the model (one finite vector per node of every body)"
-                    .into(),
-            ));
-        }
-        Self::build(model, pairs, Some(displacement))
+        check_pose(model, displacement)?;
+        Self::build(model, pairs, Some(displacement), true, None)
+    }
+
+    /// [`ContactGeometry::new_deformed`] through the discretisations' re-pairing hook
+    /// ([`ContactDiscretisation::update`]): each pair of `pairs` gets the contact nodes it has in
+    /// `self` (same pair name); a pair without any is built from scratch.
+    ///
+    /// # Errors
+    /// As [`ContactGeometry::new_deformed`].
+    pub fn updated(
+        &self,
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        displacement: &[Vec<Vector<D>>],
+    ) -> Result<Self, ContactError> {
+        check_pose(model, displacement)?;
+        Self::build(model, pairs, Some(displacement), true, Some(self))
     }
 
     /// Builds the contact nodes of every pair with body `b` placed at `placements[b]`
@@ -722,7 +433,7 @@ impl<const D: usize> ContactGeometry<D> {
             }
         }
         if placements.iter().all(BodyPlacement::is_identity) {
-            return Self::build(model, pairs, None);
+            return Self::build(model, pairs, None, true, None);
         }
         // the placed configuration as a displacement u⁰ = R x + t − x of the reference mesh
         let offsets: Vec<Vec<Vector<D>>> = bodies
@@ -730,13 +441,9 @@ impl<const D: usize> ContactGeometry<D> {
             .zip(placements)
             .map(|(b, p)| b.mesh.nodes().iter().map(|x| p.position(x) - x).collect())
             .collect();
-        let mut geometry = Self::build(model, pairs, Some(&offsets))?;
-        // build gives gaps in total form, d = d_placed + [u⁰]·n; the rows act on the
-        // displacement from the placed configuration, so remove the placement's share
-        for node in &mut geometry.nodes {
-            let shift = node.jump(&offsets).map_or(0.0, |j| j.dot(&node.normal));
-            node.gap -= shift;
-        }
+        // the rows act on the displacement from the placed configuration: gaps of the placed
+        // bodies, not in total form
+        let mut geometry = Self::build(model, pairs, Some(&offsets), false, None)?;
         geometry.placements = placements.to_vec();
         Ok(geometry)
     }
@@ -761,6 +468,8 @@ impl<const D: usize> ContactGeometry<D> {
         model: &Model<D>,
         pairs: &[ContactPair<D>],
         displacement: Option<&[Vec<Vector<D>>]>,
+        total_form: bool,
+        previous: Option<&ContactGeometry<D>>,
     ) -> Result<Self, ContactError> {
         // positions of the configuration the geometry is built on
         let posed: Vec<Vec<Point<D>>> = model
@@ -817,200 +526,45 @@ impl<const D: usize> ContactGeometry<D> {
                     }
                 }
             }
-            match &pair.partner {
-                Partner::Rigid(obstacle) => {
-                    obstacle.validate().map_err(|m| invalid(format!("obstacle: {m}")))?;
-                    for (i, nk) in normals {
-                        let x = pos_k[i];
-                        let phi = obstacle.distance(&x);
-                        let grad = obstacle.gradient(&x);
-                        let gl = grad.norm();
-                        if !(phi.is_finite() && gl.is_finite() && gl > 0.0) {
-                            return Err(invalid(format!(
-                                "obstacle distance or gradient not finite/zero at node {i}"
-                            )));
-                        }
-                        let n = -grad / gl;
-                        if n.dot(&nk) <= 0.0 {
-                            return Err(invalid(format!(
-                                "at node {i} the obstacle faces away from the body (outward normal · obstacle normal = {:.3} ≤ 0)",
-                                n.dot(&nk)
-                            )));
-                        }
-                        // total form: φ(x + u⁰) + u⁰ · n
-                        let gap = match displacement {
-                            Some(_) => phi + (x - reference(i)).dot(&n),
-                            None => phi,
-                        };
-                        nodes.push(ContactNode {
-                            pair: pi,
-                            node: (pair.body, i),
-                            partner: None,
-                            master: Vec::new(),
-                            position: x,
-                            normal: n,
-                            tangents: tangent_basis(&n),
-                            weight: weight.get(&i).copied().unwrap_or(0.0),
-                            gap,
-                            friction: pair.friction,
-                        });
-                    }
+            let context = PairContext {
+                model,
+                name: &pair.name,
+                body: pair.body,
+                part: &pair.part,
+                positions: &posed,
+                posed: displacement.is_some(),
+                normals: &normals,
+                weights: &weight,
+                min_edge,
+            };
+            let rows = match previous.and_then(|g| g.pair_nodes(&pair.name)) {
+                Some(old) => pair.discretisation.update(&context, old)?,
+                None => pair.discretisation.rows(&context)?,
+            };
+            let on_part: std::collections::HashSet<usize> = normals.iter().map(|(i, _)| *i).collect();
+            let mut seen = std::collections::HashSet::new();
+            for row in rows {
+                check_row(model, &on_part, &row).map_err(&invalid)?;
+                if !seen.insert(row.node) {
+                    return Err(invalid(format!("two rows for node {} of part `{}`", row.node, pair.part)));
                 }
-                Partner::Body { body: bl, part: pl, direction, tolerance, normal } => {
-                    let other = model.body(*bl)?;
-                    let lpart = other.mesh.boundary_part(pl)?;
-                    let lnodes = lpart.nodes();
-                    // the pairing is made in the reference configuration
-                    let ref_normals = match displacement {
-                        Some(_) => body.mesh.nodal_normals(&pair.part)?,
-                        None => normals.clone(),
-                    };
-                    let mean_n: Vector<D> = ref_normals.iter().fold(Vector::<D>::zeros(), |a, (_, n)| a + n);
-                    let e = direction.unwrap_or(mean_n);
-                    let el = e.norm();
-                    if !(el.is_finite() && el > 0.0) {
-                        return Err(invalid("pairing direction is zero".into()));
-                    }
-                    let e = e / el;
-                    let proj = |x: &Point<D>| x - e * x.dot(&e);
-                    let knodes: Vec<usize> = normals.iter().map(|(i, _)| *i).collect();
-                    let xk: Vec<Point<D>> = knodes.iter().map(|&i| proj(body.mesh.node(i))).collect();
-                    let xl: Vec<Point<D>> = lnodes.iter().map(|&i| proj(other.mesh.node(i))).collect();
-                    let tol = tolerance.unwrap_or(1e-6 * min_edge);
-                    let pairs_found = match match_nodes(&xk, &xl, tol) {
-                        Ok(p) => p,
-                        Err(u) => {
-                            if !u.first.is_empty() {
-                                return Err(ContactError::UnmatchedNodes {
-                                    pair: pair.name.clone(),
-                                    body: body.name.clone(),
-                                    count: u.first.len(),
-                                    nodes: u.first.iter().take(10).map(|&i| knodes[i]).collect(),
-                                });
-                            }
-                            // extra nodes on body l are allowed: redo the matching on the matched subset
-                            let used: std::collections::HashSet<usize> = u.second.iter().copied().collect();
-                            let keep: Vec<usize> = (0..lnodes.len()).filter(|j| !used.contains(j)).collect();
-                            let xl2: Vec<Point<D>> = keep.iter().map(|&j| xl[j]).collect();
-                            match_nodes(&xk, &xl2, tol)
-                                .map_err(|_| invalid("node pairing is ambiguous".into()))?
-                                .into_iter()
-                                .map(|(a, b)| (a, keep[b]))
-                                .collect()
-                        }
-                    };
-                    for (a, b) in pairs_found {
-                        let (i, j) = (knodes[a], lnodes[b]);
-                        let n = match normal {
-                            NormalChoice::BodyK => normals[a].1,
-                            NormalChoice::Fixed(v) => {
-                                let l = v.norm();
-                                if !(l.is_finite() && l > 0.0) {
-                                    return Err(invalid("fixed normal is zero".into()));
-                                }
-                                v / l
-                            }
-                        };
-                        // total form: reference positions
-                        let xk = *body.mesh.node(i);
-                        let xlj = *other.mesh.node(j);
-                        nodes.push(ContactNode {
-                            pair: pi,
-                            node: (pair.body, i),
-                            partner: Some((*bl, j)),
-                            master: Vec::new(),
-                            position: pos_k[i],
-                            normal: n,
-                            tangents: tangent_basis(&n),
-                            weight: weight.get(&i).copied().unwrap_or(0.0),
-                            gap: (xlj - xk).dot(&n),
-                            friction: pair.friction,
-                        });
-                    }
-                    // every node penetrating its partner by more than an element edge: the
-                    // normals of part k point away from part l (or the parts are swapped)
-                    let largest_gap =
-                        nodes[start..].iter().map(|c| c.gap).fold(Real::NEG_INFINITY, Real::max);
-                    if nodes.len() > start && largest_gap < -min_edge {
-                        return Err(invalid(format!(
-                            "every node of part `{}` lies more than one element edge ({min_edge:.3e}) behind                              its partner on part `{pl}` (largest gap {largest_gap:.3e}): do the normals of                              `{}` point away from `{pl}`?",
-                            pair.part, pair.part
-                        )));
-                    }
+                let mut node = ContactNode {
+                    pair: pi,
+                    node: (pair.body, row.node),
+                    partner: row.partner,
+                    master: row.master,
+                    position: pos_k[row.node],
+                    normal: row.normal,
+                    tangents: tangent_basis(&row.normal),
+                    weight: row.weight,
+                    gap: row.gap,
+                    friction: pair.friction,
+                };
+                // total form: d(x + u⁰) + [u⁰] · n
+                if let (true, Some(u)) = (total_form, displacement) {
+                    node.gap += node.jump(u).map_or(0.0, |j| j.dot(&node.normal));
                 }
-                Partner::Segment { body: bl, part: pl, search_distance } => {
-                    check_master(pair.body, *bl, *search_distance).map_err(invalid)?;
-                    let other = model.body(*bl)?;
-                    let lpart = other.mesh.boundary_part(pl)?;
-                    let lfacets: Vec<Vec<usize>> = lpart.facets().map(<[usize]>::to_vec).collect();
-                    let search = FacetSearch::new(&posed[bl.0], &lfacets);
-                    for (i, nk) in normals {
-                        let Some(p) = search.project(&pos_k[i], Some(&nk), *search_distance) else {
-                            continue;
-                        };
-                        let n = -p.normal;
-                        // total form: reference positions with the weights of the pose
-                        let xm = p
-                            .weights
-                            .iter()
-                            .fold(Point::<D>::zeros(), |acc, &(j, w)| acc + other.mesh.node(j) * w);
-                        nodes.push(ContactNode {
-                            pair: pi,
-                            node: (pair.body, i),
-                            partner: None,
-                            master: p.weights.iter().map(|&(j, w)| (*bl, j, w)).collect(),
-                            position: pos_k[i],
-                            normal: n,
-                            tangents: tangent_basis(&n),
-                            weight: weight.get(&i).copied().unwrap_or(0.0),
-                            gap: (xm - reference(i)).dot(&n),
-                            friction: pair.friction,
-                        });
-                    }
-                    if nodes.len() == start {
-                        return Err(invalid(format!(
-                            "no node of part `{}` has a master facet of part `{pl}` (search distance {search_distance:?})",
-                            pair.part
-                        )));
-                    }
-                }
-                Partner::Mortar { body: bl, part: pl, search_distance } => {
-                    check_master(pair.body, *bl, *search_distance).map_err(invalid)?;
-                    let other = model.body(*bl)?;
-                    let lfacets: Vec<Vec<usize>> =
-                        other.mesh.boundary_part(pl)?.facets().map(<[usize]>::to_vec).collect();
-                    let sfacets: Vec<Vec<usize>> = part.facets().map(<[usize]>::to_vec).collect();
-                    let rows =
-                        crate::mortar::mortar_rows(pos_k, &sfacets, &posed[bl.0], &lfacets, *search_distance);
-                    let normal_of: std::collections::HashMap<usize, Vector<D>> =
-                        normals.into_iter().collect();
-                    for row in rows {
-                        let Some(&n) = normal_of.get(&row.slave) else { continue };
-                        // total form: reference positions with the weights of the pose
-                        let xm = row
-                            .master
-                            .iter()
-                            .fold(Point::<D>::zeros(), |acc, &(j, w)| acc + other.mesh.node(j) * w);
-                        nodes.push(ContactNode {
-                            pair: pi,
-                            node: (pair.body, row.slave),
-                            partner: None,
-                            master: row.master.iter().map(|&(j, w)| (*bl, j, w)).collect(),
-                            position: pos_k[row.slave],
-                            normal: n,
-                            tangents: tangent_basis(&n),
-                            weight: row.d,
-                            gap: (xm - reference(row.slave)).dot(&n),
-                            friction: pair.friction,
-                        });
-                    }
-                    if nodes.len() == start {
-                        return Err(invalid(format!(
-                            "no node of part `{}` has enough mortar overlap with part `{pl}` (search distance {search_distance:?})",
-                            pair.part
-                        )));
-                    }
-                }
+                nodes.push(node);
             }
             if nodes.len() == start {
                 return Err(invalid("the contact part has no nodes".into()));
@@ -1037,6 +591,11 @@ impl<const D: usize> ContactGeometry<D> {
             a.dedup();
         }
         Ok(Self { pairs: ranges, nodes, adjacency, placements: Vec::new() })
+    }
+
+    /// The contact nodes of the pair called `name`, if any.
+    pub fn pair_nodes(&self, name: &str) -> Option<&[ContactNode<D>]> {
+        self.pairs.iter().find(|(n, _)| n == name).and_then(|(_, r)| self.nodes.get(r.clone()))
     }
 
     /// Number of contact nodes.
@@ -1193,5 +752,58 @@ impl<const D: usize> ContactGeometry<D> {
             cell_node,
             slip_bound: bounds,
         })
+    }
+}
+
+/// `Err` unless `row` is a valid contact row: its node on the slave part, the other side's
+/// nodes in the model, a finite unit normal, finite weights and gap.
+fn check_row<const D: usize>(
+    model: &Model<D>,
+    on_part: &std::collections::HashSet<usize>,
+    row: &ContactRow<D>,
+) -> Result<(), String> {
+    if !on_part.contains(&row.node) {
+        return Err(format!("row for node {}, which is not on the contact part", row.node));
+    }
+    let exists = |b: BodyId, j: usize| model.bodies().get(b.0).is_some_and(|body| j < body.mesh.n_nodes());
+    for (b, j) in row.partner.iter().copied().chain(row.master.iter().map(|&(b, j, _)| (b, j))) {
+        if !exists(b, j) {
+            return Err(format!(
+                "row of node {} refers to node {j} of body {}, which does not exist",
+                row.node, b.0
+            ));
+        }
+    }
+    let n = row.normal.norm();
+    if !(n.is_finite() && (n - 1.0).abs() <= 1e-8) {
+        return Err(format!(
+            "row of node {}: the normal must be a finite unit vector (length {n:e})",
+            row.node
+        ));
+    }
+    if !(row.weight.is_finite() && row.gap.is_finite() && row.master.iter().all(|m| m.2.is_finite())) {
+        return Err(format!(
+            "row of node {}: weight {} and gap {} (and the partner weights) must be finite",
+            row.node, row.weight, row.gap
+        ));
+    }
+    Ok(())
+}
+
+/// `Err` unless `displacement` has one finite vector per node of every body of `model`.
+fn check_pose<const D: usize>(model: &Model<D>, displacement: &[Vec<Vector<D>>]) -> Result<(), ContactError> {
+    let bodies = model.bodies();
+    let fits = displacement.len() == bodies.len()
+        && bodies
+            .iter()
+            .zip(displacement)
+            .all(|(b, u)| u.len() == b.mesh.n_nodes() && u.iter().all(|v| v.iter().all(|c| c.is_finite())));
+    if fits {
+        Ok(())
+    } else {
+        Err(ContactError::InvalidParameter(
+            "the displacement of the pose does not fit the model (one finite vector per node of every body)"
+                .into(),
+        ))
     }
 }

@@ -6,8 +6,8 @@
 //! given slip bounds `g_c`), runs the solver, and maps the result back to nodal displacements
 //! per body and pressures per contact node.
 
-use synovia_fem::{ElasticParams, ElasticSolver, Model};
-use synovia_linalg::{CholeskyOperator, InterfaceBlockParams};
+use synovia_fem::{DofMap, ElasticParams, ElasticSolver, FemError, Model};
+use synovia_linalg::{CholeskyOperator, InterfaceBlockParams, SymmetricMatrix};
 use synovia_mesh::math::{Real, Vector};
 
 use crate::context::SolveContext;
@@ -36,6 +36,9 @@ pub struct StaticContact<const D: usize> {
     /// What the solves reuse: columns of `S` kept between solves on the same geometry, the
     /// recycled load solves `A⁻¹ F` ([`SolveContext`], with its memory budget).
     context: SolveContext,
+    /// Built on a caller's matrix ([`StaticContact::with_system_matrix`]): the loads come from
+    /// the caller ([`StaticContact::solve_load`]), not from the model.
+    caller_matrix: bool,
 }
 
 /// The result of one static contact solve.
@@ -86,17 +89,8 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<Self, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
         let interface = interface_nodes(model, pairs, &geometry)?;
-        let elastic = ElasticSolver::new_with_ordering(model, params, true, &|dofs, base| {
-            let groups: Vec<std::ops::Range<usize>> = interface
-                .iter()
-                .map(|&(b, i)| {
-                    let g = &dofs.groups()[dofs.group_of(b, i)];
-                    g.first_dof..g.first_dof + g.n_dofs
-                })
-                .collect();
-            Ok(block.ordering(base, &groups, dofs.n_dofs()))
-        })?;
-        Ok(Self { elastic, geometry, nested_min_rows: Some(32), context: SolveContext::new() })
+        let elastic = ElasticSolver::new_with_ordering(model, params, true, &interface_ordering(&interface, block))?;
+        Ok(Self { elastic, geometry, nested_min_rows: Some(32), context: SolveContext::new(), caller_matrix: false })
     }
 
     /// The context of the solves (kept columns, recycled load solves, memory budget).
@@ -110,9 +104,78 @@ impl<const D: usize> StaticContact<D> {
         self.context = context;
     }
 
+    /// The contact machinery on a caller-assembled symmetric positive definite matrix `A` of the
+    /// model's reduced dofs ([`ElasticSolver::with_system_matrix`], interface dofs ordered
+    /// last): e.g. the time-step matrix `A = M_ρ + Δt M_α + Δt² A⁽⁰⁾ + Δt A⁽¹⁾` of the dynamic
+    /// scheme (docs/model.md §7), whose every step is the contact problem of docs/model.md §5
+    /// `A U + B_hnᵀ κ Λ_n + B_Htᵀ Λ_t = F̄` with the caller's right-hand side `F̄`, solved by
+    /// [`StaticContact::solve_load`]. `assemble` fills the zero matrix on the model's pattern.
+    /// Solves of the model's own load case ([`StaticContact::solve`] and its relatives) are
+    /// refused, and loads are not recycled (each right-hand side is new).
+    ///
+    /// # Errors
+    /// Invalid pairs, the errors of `assemble` and of the factorisation.
+    pub fn with_system_matrix(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        params: ElasticParams,
+        assemble: impl FnOnce(&DofMap<D>, &mut SymmetricMatrix) -> Result<(), FemError>,
+    ) -> Result<Self, ContactError> {
+        let geometry = ContactGeometry::new(model, pairs)?;
+        let interface = interface_nodes(model, pairs, &geometry)?;
+        let ordering = interface_ordering(&interface, InterfaceBlockParams::default());
+        let elastic = ElasticSolver::with_system_matrix(model, params, &ordering, assemble)?;
+        Ok(Self { elastic, geometry, nested_min_rows: Some(32), context: SolveContext::new(), caller_matrix: true })
+    }
+
+    /// Solves the contact problem of docs/model.md §5 with the caller's reduced right-hand side
+    /// `load` (`F̄`, one entry per reduced dof) and lifts of prescribed displacements `lifts`
+    /// (one per dof group, [`DofMap::lifts`]; they enter the gaps and the slip shifts) on the
+    /// factorised matrix: `A U + B_hnᵀ κ Λ_n + B_Htᵀ Λ_t = F̄`, `Λ_n ≥ 0 ⟂ B_hn U ≤ d`, and
+    /// Tresca friction with the slip bounds `slip_bound` (one per contact node; `None` =
+    /// frictionless) and slip measured from `previous` nodal displacements (if given). The
+    /// same solve as [`StaticContact::solve`] (row screening, Schur-column cache, KKT check,
+    /// nested iteration for cold starts) with the load given instead of assembled.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] for a `load` or `lifts` of the wrong length or a
+    /// non-finite `load`; the errors of the solve.
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_load(
+        &self,
+        load: &[f64],
+        lifts: &[Vector<D>],
+        solver: &dyn ContactSolver,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        warm_start: Option<&ContactSolution>,
+    ) -> Result<StaticContactResult<D>, ContactError> {
+        let dofs = self.elastic.dofs();
+        if load.len() != dofs.n_dofs() || lifts.len() != dofs.groups().len() {
+            return Err(ContactError::InvalidParameter(format!(
+                "a load of {} entries and {} lifts for {} reduced dofs and {} dof groups",
+                load.len(),
+                lifts.len(),
+                dofs.n_dofs(),
+                dofs.groups().len()
+            )));
+        }
+        if load.iter().any(|v| !v.is_finite()) {
+            return Err(ContactError::InvalidParameter("the load is not finite".into()));
+        }
+        let source = Source::Given(load, lifts);
+        match self.solve_with(source, solver, slip_bound, previous, warm_start, false)? {
+            Solved::Full(result) => Ok(*result),
+            Solved::Multipliers(..) => {
+                Err(ContactError::InvalidParameter("internal: multipliers without displacement".into()))
+            }
+        }
+    }
+
     /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
-    /// ([`ContactGeometry::new_deformed`]: re-pairing of node-to-segment pairs, normals and
-    /// weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
+    /// ([`ContactGeometry::updated`]: each discretisation's re-pairing hook, as
+    /// [`ContactGeometry::new_deformed`] by default: re-pairing of node-to-segment pairs, normals
+    /// and weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
     /// previous geometry, e.g. to carry contact data over with [`ContactGeometry::transfer`].
     pub fn update_geometry(
         &mut self,
@@ -120,7 +183,7 @@ impl<const D: usize> StaticContact<D> {
         pairs: &[ContactPair<D>],
         displacement: &[Vec<Vector<D>>],
     ) -> Result<ContactGeometry<D>, ContactError> {
-        let geometry = ContactGeometry::new_deformed(model, pairs, displacement)?;
+        let geometry = self.geometry.updated(model, pairs, displacement)?;
         self.context.clear_rows();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
@@ -183,7 +246,7 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         warm_start: Option<&ContactSolution>,
     ) -> Result<StaticContactResult<D>, ContactError> {
-        match self.solve_with(model, t, solver, slip_bound, previous, warm_start, false)? {
+        match self.solve_with(Source::Model(model, t), solver, slip_bound, previous, warm_start, false)? {
             Solved::Full(result) => Ok(*result),
             Solved::Multipliers(..) => {
                 Err(ContactError::InvalidParameter("internal: multipliers without displacement".into()))
@@ -210,10 +273,12 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         warm_start: Option<&ContactSolution>,
     ) -> Result<(ContactSolution, usize), ContactError> {
-        Ok(match self.solve_with(model, t, solver, slip_bound, previous, warm_start, true)? {
-            Solved::Full(result) => (result.solution, result.coarse_iterations),
-            Solved::Multipliers(solution, coarse) => (*solution, coarse),
-        })
+        Ok(
+            match self.solve_with(Source::Model(model, t), solver, slip_bound, previous, warm_start, true)? {
+                Solved::Full(result) => (result.solution, result.coarse_iterations),
+                Solved::Multipliers(solution, coarse) => (*solution, coarse),
+            },
+        )
     }
 
     /// Completes a solution of [`StaticContact::solve_multipliers`] (same `t`, `slip_bound`,
@@ -233,7 +298,8 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         solution: ContactSolution,
     ) -> Result<StaticContactResult<D>, ContactError> {
-        let Assembled { load, lifts, normal, friction_op } = self.assemble(model, t, slip_bound, previous)?;
+        let Assembled { load, lifts, normal, friction_op } =
+            self.assemble(Source::Model(model, t), slip_bound, previous)?;
         let friction = active_friction(friction_op.as_ref());
         let n_tangential = friction.map_or(0, |f| f.rows.nrows());
         if solution.lambda_n.len() != normal.rows.nrows() || solution.lambda_t.len() != n_tangential {
@@ -263,15 +329,14 @@ impl<const D: usize> StaticContact<D> {
     #[allow(clippy::too_many_arguments)]
     fn solve_with(
         &self,
-        model: &Model<D>,
-        t: Real,
+        source: Source<'_, D>,
         solver: &dyn ContactSolver,
         slip_bound: Option<&[Real]>,
         previous: Option<&[Vec<Vector<D>>]>,
         warm_start: Option<&ContactSolution>,
         multipliers_only: bool,
     ) -> Result<Solved<D>, ContactError> {
-        let Assembled { load, lifts, normal, friction_op } = self.assemble(model, t, slip_bound, previous)?;
+        let Assembled { load, lifts, normal, friction_op } = self.assemble(source, slip_bound, previous)?;
         let friction = active_friction(friction_op.as_ref());
         let stabilisation = self.elastic.stabilisation();
         if let Some(st) = stabilisation {
@@ -354,12 +419,19 @@ impl<const D: usize> StaticContact<D> {
     /// The load, the lifts of prescribed displacements and the constraints at `t`.
     fn assemble(
         &self,
-        model: &Model<D>,
-        t: Real,
+        source: Source<'_, D>,
         slip_bound: Option<&[Real]>,
         previous: Option<&[Vec<Vector<D>>]>,
     ) -> Result<Assembled<D>, ContactError> {
-        let (load, lifts) = self.elastic.rhs(model, t)?;
+        let (load, lifts) = match source {
+            Source::Model(..) if self.caller_matrix => {
+                return Err(ContactError::InvalidParameter(
+                    "this contact problem is built on a caller's matrix: solve it with solve_load".into(),
+                ))
+            }
+            Source::Model(model, t) => self.elastic.rhs(model, t)?,
+            Source::Given(load, lifts) => (load.to_vec(), lifts.to_vec()),
+        };
         let dofs = self.elastic.dofs();
         let normal = self.geometry.normal_constraints(dofs, &lifts);
         let friction_op = match slip_bound {
@@ -382,7 +454,8 @@ impl<const D: usize> StaticContact<D> {
         operator: &CholeskyOperator<'_>,
         load: &[f64],
     ) -> Result<Option<Vec<f64>>, ContactError> {
-        if self.elastic.stabilisation().is_some() {
+        // a caller's matrix (dynamic steps): every right-hand side is new, nothing to recycle
+        if self.elastic.stabilisation().is_some() || self.caller_matrix {
             return Ok(None);
         }
         Ok(Some(self.context.recycled_load_solve(operator, load)?))
@@ -523,6 +596,14 @@ impl<const D: usize> StaticContact<D> {
     }
 }
 
+/// Where the right-hand side of a solve comes from: the model's load case at `t`, or the
+/// caller ([`StaticContact::solve_load`]: reduced load and lifts).
+#[derive(Clone, Copy)]
+enum Source<'a, const D: usize> {
+    Model(&'a Model<D>, Real),
+    Given(&'a [f64], &'a [Vector<D>]),
+}
+
 /// The right-hand side and constraints of one contact problem ([`StaticContact::assemble`]).
 struct Assembled<const D: usize> {
     load: Vec<f64>,
@@ -558,7 +639,6 @@ fn interface_nodes<const D: usize>(
     pairs: &[ContactPair<D>],
     geometry: &ContactGeometry<D>,
 ) -> Result<Vec<(synovia_fem::BodyId, usize)>, ContactError> {
-    use crate::operators::Partner;
     let mut out = Vec::new();
     let mut seen = std::collections::HashSet::new();
     let mut by_gap: Vec<usize> = (0..geometry.len()).collect();
@@ -585,14 +665,29 @@ fn interface_nodes<const D: usize>(
     };
     for pair in pairs {
         add(pair.body, &pair.part)?;
-        match &pair.partner {
-            Partner::Body { body, part, .. }
-            | Partner::Segment { body, part, .. }
-            | Partner::Mortar { body, part, .. } => add(*body, part)?,
-            Partner::Rigid(_) => {}
+        if let Some((body, part)) = pair.partner_part() {
+            add(body, part)?;
         }
     }
     Ok(out)
+}
+
+/// The ordering of the contact set-up: the dofs of the `interface` nodes (in priority order)
+/// last, as [`InterfaceBlockParams`] selects them.
+fn interface_ordering<const D: usize>(
+    interface: &[(synovia_fem::BodyId, usize)],
+    block: InterfaceBlockParams,
+) -> impl Fn(&DofMap<D>, synovia_linalg::Ordering) -> Result<synovia_linalg::Ordering, FemError> + '_ {
+    move |dofs, base| {
+        let groups: Vec<std::ops::Range<usize>> = interface
+            .iter()
+            .map(|&(b, i)| {
+                let g = &dofs.groups()[dofs.group_of(b, i)];
+                g.first_dof..g.first_dof + g.n_dofs
+            })
+            .collect();
+        Ok(block.ordering(base, &groups, dofs.n_dofs()))
+    }
 }
 
 /// The rows `rows` of `normal` (with their weights and gaps).

@@ -138,7 +138,7 @@ impl<const D: usize> ElasticSolver<D> {
     /// Validates the model, builds the dofs, checks coercivity (docs/model.md §4), assembles `K̃`, and
     /// factorises it.
     pub fn new(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
-        Self::build(model, params, false, None)
+        Self::build(model, params, false, None, None)
     }
 
     /// Like [`ElasticSolver::new_semi_coercive`] (or [`ElasticSolver::new`] when
@@ -154,7 +154,7 @@ impl<const D: usize> ElasticSolver<D> {
         semi_coercive: bool,
         reorder: &Reorder<'_, D>,
     ) -> Result<Self, FemError> {
-        Self::build(model, params, semi_coercive, Some(reorder))
+        Self::build(model, params, semi_coercive, Some(reorder), None)
     }
 
     /// Like [`ElasticSolver::new`], but a semi-coercive model (bodies whose rigid motions no
@@ -164,18 +164,49 @@ impl<const D: usize> ElasticSolver<D> {
     /// refuses such a model ([`FemError::SemiCoercive`]): without contact it has no unique
     /// solution.
     pub fn new_semi_coercive(model: &Model<D>, params: ElasticParams) -> Result<Self, FemError> {
-        Self::build(model, params, true, None)
+        Self::build(model, params, true, None, None)
     }
 
+    /// The factorisation of a caller-assembled symmetric positive definite matrix `A` on the
+    /// model's reduced dofs and sparsity pattern, e.g. the time-step matrix
+    /// `A = M_ρ + Δt M_α + Δt² A⁽⁰⁾ + Δt A⁽¹⁾` of the dynamic scheme (docs/model.md §7), with the
+    /// ordering chosen by `reorder` as in [`ElasticSolver::new_with_ordering`]. `assemble`
+    /// receives the dof map and the zero matrix on the pattern and fills it with `A`.
+    /// No coercivity check (the caller's `A` must be positive definite: the factorisation
+    /// fails otherwise) and no stabilisation; [`ElasticSolver::stiffness`] and
+    /// [`ElasticSolver::system_matrix`] return `A`, while [`ElasticSolver::rhs`] and
+    /// [`ElasticSolver::solve`] still evaluate the elastic load case `Pᵀ (F(t) − K u_p(t))`
+    /// (the caller builds its own right-hand side for `A`).
+    ///
+    /// # Errors
+    /// Model and dof errors, the errors of `assemble`, [`FemError`] of the factorisation.
+    pub fn with_system_matrix(
+        model: &Model<D>,
+        params: ElasticParams,
+        reorder: &Reorder<'_, D>,
+        assemble: impl FnOnce(&DofMap<D>, &mut SymmetricMatrix) -> Result<(), FemError>,
+    ) -> Result<Self, FemError> {
+        let mut assemble = Some(assemble);
+        let mut call = |dofs: &DofMap<D>, a: &mut SymmetricMatrix| match assemble.take() {
+            Some(f) => f(dofs, a),
+            None => Ok(()),
+        };
+        Self::build(model, params, true, Some(reorder), Some(&mut call))
+    }
+
+    /// `system`: a caller's assembly of the matrix instead of the stiffness (no floating
+    /// components are looked for).
+    #[allow(clippy::type_complexity)]
     fn build(
         model: &Model<D>,
         params: ElasticParams,
         allow_floating: bool,
         reorder: Option<&Reorder<'_, D>>,
+        system: Option<&mut dyn FnMut(&DofMap<D>, &mut SymmetricMatrix) -> Result<(), FemError>>,
     ) -> Result<Self, FemError> {
         let t0 = Instant::now();
         let dofs = DofMap::new(model)?;
-        let floating = dofs.floating_components(model);
+        let floating = if system.is_some() { Vec::new() } else { dofs.floating_components(model) };
         if let (false, Some(c)) = (allow_floating, floating.first()) {
             return Err(FemError::SemiCoercive { bodies: c.bodies.clone(), free_modes: c.modes.len() });
         }
@@ -183,7 +214,12 @@ impl<const D: usize> ElasticSolver<D> {
         let setup_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
         let body_c = body_stiffnesses(model)?;
-        assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| stiffness_into(geo, &body_c[b], out))?;
+        match system {
+            Some(assemble) => assemble(&dofs, &mut stiffness)?,
+            None => assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| {
+                stiffness_into(geo, &body_c[b], out)
+            })?,
+        }
         let assembly_s = t1.elapsed().as_secs_f64();
         let mut ordering = match (params.ordering, D) {
             (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => Ordering::Amd,

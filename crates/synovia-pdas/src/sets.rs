@@ -112,10 +112,12 @@ pub(crate) struct State<'p> {
 }
 
 /// `ζ / max(1, ‖ζ‖)`: the projection `π` onto `[−1, 1]` (2D) or the unit disc (3D).
+/// [`synovia_contact::project_on_disc`] with radius 1 (an unused second component is 0 and
+/// stays 0).
 pub(crate) fn project(z: [f64; 2]) -> [f64; 2] {
-    let n = (z[0] * z[0] + z[1] * z[1]).sqrt();
-    let f = 1.0 / n.max(1.0);
-    [z[0] * f, z[1] * f]
+    let mut p = z;
+    synovia_contact::project_on_disc(&mut p, 1.0);
+    p
 }
 
 fn norm2(z: [f64; 2]) -> f64 {

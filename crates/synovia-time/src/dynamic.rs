@@ -23,6 +23,12 @@
 //! term), so no coercivity check is needed; it is assembled on one sparsity pattern and
 //! factorised once (symbolic and numeric) for the whole run.
 //!
+//! **One pipeline**: the step problem is solved by the static contact machinery,
+//! [`StaticContact::with_system_matrix`] on `A` and [`StaticContact::solve_load`] with `F̄` per
+//! step (contact rows, row screening, Schur-column cache, KKT check), the same code as a static
+//! or quasi-static solve; this module only adds what is dynamic (mass and damping, `F̄`, the
+//! levels, slip speeds, the `Δt²` scaling, energies).
+//!
 //! **Contact in displacements**: `[U^{i+1}_n] ≤ d` with the initial gap `d` (minus the normal
 //! part of the lift at `t_{i+1}`). Because the equation was multiplied by `Δt²`, the contact
 //! multipliers of the step problem are `Λ̄_n = Δt² λ_n`: the physical contact pressure is
@@ -36,9 +42,9 @@
 //! area (check the units: every term of the step problem is `kg·m²`); synovia uses the slip
 //! bound `ḡ_c = Δt² g_c = F_c(|[u'_t]|^i) |Λ̄_n^i|` in the step problem, i.e. the Coulomb law with the scaled pressure of level `i`. The deceleration of a
 //! sliding block (`μ g`, see the tests) confirms the scaling. The slip speed `|[u'_t]|^i` is
-//! `|[U^i_t] − [U^{i−1}_t]| / Δt` at each contact node and the law `F_c` is any
-//! [`FrictionLaw`] per pair ([`DynamicStepper::set_friction_law`]; default
-//! `ConstantFriction(pair.friction)`). Optionally a Coulomb fixed point per step recomputes
+//! `|[U^i_t] − [U^{i−1}_t]| / Δt` at each contact node ([`slip_speeds`]) and the law `F_c` is any
+//! [`FrictionLaw`] per pair ([`DynamicStepper::set_friction_law`], [`PairFrictionLaws`], shared
+//! with the quasi-static stepper; default: the pair's constant coefficient). Optionally a Coulomb fixed point per step recomputes
 //! `ḡ_c` from the new level until it stops changing ([`DynamicParams::coulomb_iterations`]).
 //!
 //! ## Reduced unknowns and moving lifts
@@ -80,16 +86,17 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 use synovia_contact::operators::{ContactGeometry, ContactPair};
 use synovia_contact::{
-    check_kkt, ConstantFriction, ContactProblem, ContactSolution, ContactSolver, FrictionLaw, KktReport,
-    NormalConstraints, StaticContactResult,
+    slip_speeds, ContactSolution, ContactSolver, FrictionLaw, PairFrictionLaws, StaticContact,
+    StaticContactResult,
 };
-use synovia_fem::assembly::{add_loads, assemble_matrix, body_stiffnesses, pattern, subtract_lift};
+use synovia_fem::assembly::{add_loads, assemble_matrix, body_stiffnesses, subtract_lift};
 use synovia_fem::element::{mass_into, stiffness_into, SimplexGeometry};
-use synovia_fem::{CholeskySolver, DofMap, FemError, Model, OrderingChoice, SymmetricMatrix};
+use synovia_fem::{CholeskySolver, DofMap, ElasticParams, FemError, Model, OrderingChoice, SymmetricMatrix};
 use synovia_material::{voigt_len, KelvinVoigt, VoigtMatrix};
 use synovia_mesh::math::{Point, Real, Vector};
 
 use crate::error::TimeError;
+use crate::quasistatic::{friction_dissipation, warm_start};
 use crate::results::{pair_records, PairRecord, StepRecord};
 
 /// Largest element matrix size `(D(D+1))²` for `D ≤ 3`.
@@ -288,28 +295,30 @@ pub struct DynamicInfo {
     pub numeric_s: f64,
 }
 
-/// The dynamic semi-implicit stepper of docs/model.md §7 (see the module docs): factorises
-/// `A = M_ρ + Δt M_α + Δt² A⁽⁰⁾ + Δt A⁽¹⁾` once and solves one contact problem of docs/model.md §5 per
-/// step with any [`ContactSolver`].
+/// The dynamic semi-implicit stepper of docs/model.md §7 (see the module docs): assembles
+/// `A = M_ρ + Δt M_α + Δt² A⁽⁰⁾ + Δt A⁽¹⁾` and hands it to the static contact machinery
+/// ([`StaticContact::with_system_matrix`]: one factorisation, contact rows, Schur-column cache,
+/// KKT check), which solves one contact problem of docs/model.md §5 per step with any
+/// [`ContactSolver`] for the right-hand side `F̄` of the step ([`StaticContact::solve_load`]).
+/// The stepper keeps only what is dynamic: the mass, damping and viscosity matrices, `F̄`, the
+/// levels `U^i`, `U^{i−1}`, the slip speeds and the energies.
 ///
 /// The [`Model`] passed to [`DynamicStepper::step`] must be the one given to
 /// [`DynamicStepper::new`] (its loads and prescribed displacements are evaluated at every step).
 #[derive(Debug)]
 pub struct DynamicStepper<const D: usize> {
-    dofs: DofMap<D>,
-    geometry: ContactGeometry<D>,
+    /// The contact machinery on `Ã` (dofs, geometry, factorisation).
+    contact: StaticContact<D>,
     params: DynamicParams,
     bodies: Vec<DynamicBody>,
     c0: Vec<DMatrix<Real>>,
-    laws: Vec<Option<Arc<dyn FrictionLaw>>>,
+    laws: PairFrictionLaws,
     mass: SymmetricMatrix,
     mass_alpha: SymmetricMatrix,
     stiffness: SymmetricMatrix,
     viscous: SymmetricMatrix,
     /// `Δt (M̃_α + Ã⁽¹⁾)`.
     damping_dt: SymmetricMatrix,
-    matrix: SymmetricMatrix,
-    factor: CholeskySolver,
     has_damping: bool,
     nodal_mass: Vec<Vec<Real>>,
     info: DynamicInfo,
@@ -325,7 +334,8 @@ pub struct DynamicStepper<const D: usize> {
     pressure: Vec<Real>,
     /// Slip speed `|[u'_t]|` per contact node at level i.
     slip_speed: Vec<Real>,
-    warm: Option<(ContactSolution, Vec<usize>)>,
+    /// The step problem's solution of level i (scaled multipliers), for the warm start.
+    warm: Option<StaticContactResult<D>>,
     last: Option<StaticContactResult<D>>,
     balance: EnergyBalance,
     cumulative_friction: Real,
@@ -348,7 +358,6 @@ impl<const D: usize> DynamicStepper<D> {
         pairs: &[ContactPair<D>],
         params: DynamicParams,
     ) -> Result<Self, TimeError> {
-        let t_start = Instant::now();
         params.check()?;
         model.validate()?;
         if bodies.len() != model.bodies().len() {
@@ -362,8 +371,6 @@ impl<const D: usize> DynamicStepper<D> {
         for (b, data) in model.bodies().iter().zip(bodies) {
             data.check(&b.name, nv)?;
         }
-        let dofs = DofMap::new(model)?;
-        let geometry = ContactGeometry::new(model, pairs)?;
         let c0 = body_stiffnesses(model)?;
         let zero_c = DMatrix::<Real>::zeros(nv, nv);
         let c1: Vec<DMatrix<Real>> =
@@ -372,47 +379,53 @@ impl<const D: usize> DynamicStepper<D> {
         let alpha: Vec<Real> = bodies.iter().map(|b| b.damping).collect();
         let lumped = params.mass == MassKind::Lumped;
         let dt = params.dt;
-
-        let (mut mass, metis) = pattern(model, &dofs)?;
-        let mut mass_alpha = mass.clone();
-        let mut stiffness = mass.clone();
-        let mut viscous = mass.clone();
-        assemble_matrix(model, &dofs, &mut mass, |b, _, geo, out| mass_into(geo, rho[b], lumped, out))?;
         let has_alpha = alpha.iter().any(|&a| a > 0.0);
         let has_c1 = bodies.iter().any(|b| b.viscous.as_ref().is_some_and(|c| c.iter().any(|v| *v != 0.0)));
-        if has_alpha {
-            assemble_matrix(model, &dofs, &mut mass_alpha, |b, _, geo, out| {
-                mass_into(geo, alpha[b], lumped, out)
-            })?;
-        }
-        assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| stiffness_into(geo, &c0[b], out))?;
-        if has_c1 {
-            assemble_matrix(model, &dofs, &mut viscous, |b, _, geo, out| stiffness_into(geo, &c1[b], out))?;
-        }
-        let mut damping_dt = mass_alpha.clone();
-        damping_dt.values_mut().iter_mut().for_each(|v| *v *= dt);
-        damping_dt.add_scaled(dt, &viscous)?;
-        let mut matrix = mass.clone();
-        matrix.add_scaled(1.0, &damping_dt)?;
-        matrix.add_scaled(dt * dt, &stiffness)?;
-        let assembly_s = t_start.elapsed().as_secs_f64();
 
-        let ordering = match (params.ordering, D) {
-            (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => synovia_fem::Ordering::Amd,
-            _ => metis,
+        // M̃_ρ, M̃_α, Ã⁽⁰⁾, Ã⁽¹⁾ on the model's pattern; Ã is handed to the contact machinery
+        let mut parts = None;
+        let assemble = |dofs: &DofMap<D>, matrix: &mut SymmetricMatrix| -> Result<(), FemError> {
+            let mut mass = matrix.clone();
+            let mut mass_alpha = matrix.clone();
+            let mut stiffness = matrix.clone();
+            let mut viscous = matrix.clone();
+            assemble_matrix(model, dofs, &mut mass, |b, _, geo, out| mass_into(geo, rho[b], lumped, out))?;
+            if has_alpha {
+                assemble_matrix(model, dofs, &mut mass_alpha, |b, _, geo, out| {
+                    mass_into(geo, alpha[b], lumped, out)
+                })?;
+            }
+            assemble_matrix(model, dofs, &mut stiffness, |b, _, geo, out| stiffness_into(geo, &c0[b], out))?;
+            if has_c1 {
+                assemble_matrix(model, dofs, &mut viscous, |b, _, geo, out| {
+                    stiffness_into(geo, &c1[b], out)
+                })?;
+            }
+            let mut damping_dt = mass_alpha.clone();
+            damping_dt.values_mut().iter_mut().for_each(|v| *v *= dt);
+            damping_dt.add_scaled(dt, &viscous)?;
+            *matrix = mass.clone();
+            matrix.add_scaled(1.0, &damping_dt)?;
+            matrix.add_scaled(dt * dt, &stiffness)?;
+            parts = Some((mass, mass_alpha, stiffness, viscous, damping_dt));
+            Ok(())
         };
-        let mut factor = CholeskySolver::analyse(&matrix, &ordering)?;
-        factor.factorize(&matrix)?;
-        let ci = factor.info();
+        let elastic = ElasticParams { ordering: params.ordering, ..ElasticParams::default() };
+        let mut contact = StaticContact::with_system_matrix(model, pairs, elastic, assemble)?;
+        // every step is warm-started from the previous one (or cold, as chosen): no nested iteration
+        contact.set_nested_iteration(None);
+        let (mass, mass_alpha, stiffness, viscous, damping_dt) = parts.ok_or_else(|| {
+            TimeError::InvalidParameter("internal: the time-step matrix was not assembled".into())
+        })?;
+        let ei = contact.elastic().info();
         let info = DynamicInfo {
-            n_dofs: dofs.n_dofs(),
-            matrix_nnz: matrix.nnz(),
-            factor_nnz: ci.factor_nnz,
-            assembly_s,
-            symbolic_s: ci.symbolic_s,
-            numeric_s: ci.numeric_s,
+            n_dofs: ei.n_dofs,
+            matrix_nnz: ei.matrix_nnz,
+            factor_nnz: ei.factor_nnz,
+            assembly_s: ei.setup_s + ei.assembly_s,
+            symbolic_s: ei.symbolic_s,
+            numeric_s: ei.numeric_s,
         };
-
         // lumped nodal masses (eᵀ M_ρ for a translation e, the same for consistent mass)
         let mut nodal_mass = Vec::with_capacity(model.bodies().len());
         for (bi, body) in model.bodies().iter().enumerate() {
@@ -426,24 +439,14 @@ impl<const D: usize> DynamicStepper<D> {
             nodal_mass.push(m);
         }
 
-        let laws = pairs
-            .iter()
-            .map(|p| {
-                if p.friction > 0.0 {
-                    Some(Arc::new(ConstantFriction(p.friction)) as Arc<dyn FrictionLaw>)
-                } else {
-                    None
-                }
-            })
-            .collect();
-        let n = dofs.n_dofs();
-        let nc = geometry.len();
-        let lifts = dofs.lifts(model, params.t0)?;
+        let laws = PairFrictionLaws::new(contact.geometry());
+        let n = contact.elastic().dofs().n_dofs();
+        let nc = contact.geometry().len();
+        let lifts = contact.elastic().dofs().lifts(model, params.t0)?;
         let zero_nodal: Vec<Vec<Vector<D>>> =
             model.bodies().iter().map(|b| vec![Vector::<D>::zeros(); b.mesh.n_nodes()]).collect();
         let mut s = Self {
-            dofs,
-            geometry,
+            contact,
             params,
             bodies: bodies.to_vec(),
             c0,
@@ -453,8 +456,6 @@ impl<const D: usize> DynamicStepper<D> {
             stiffness,
             viscous,
             damping_dt,
-            matrix,
-            factor,
             has_damping: has_alpha || has_c1,
             nodal_mass,
             info,
@@ -500,12 +501,12 @@ impl<const D: usize> DynamicStepper<D> {
             }
         }
         let dt = self.params.dt;
-        let lifts0 = self.dofs.lifts(model, self.params.t0)?;
-        let n = self.dofs.n_dofs();
+        let lifts0 = self.dofs().lifts(model, self.params.t0)?;
+        let n = self.dofs().n_dofs();
         let mut u0 = vec![0.0; n];
         let mut um1 = vec![0.0; n];
-        let mut lifts_m1 = vec![Vector::<D>::zeros(); self.dofs.groups().len()];
-        for (gi, grp) in self.dofs.groups().iter().enumerate() {
+        let mut lifts_m1 = vec![Vector::<D>::zeros(); self.dofs().groups().len()];
+        for (gi, grp) in self.dofs().groups().iter().enumerate() {
             let (body, node) = grp.origin;
             let x0 = displacement.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
             let v0 = velocity.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
@@ -526,8 +527,8 @@ impl<const D: usize> DynamicStepper<D> {
             }
             lifts_m1[gi] = wm1 - free;
         }
-        self.disp = self.dofs.expand(&u0, &lifts0)?;
-        self.disp_prev = self.dofs.expand(&um1, &lifts_m1)?;
+        self.disp = self.dofs().expand(&u0, &lifts0)?;
+        self.disp_prev = self.dofs().expand(&um1, &lifts_m1)?;
         self.u = u0;
         self.u_prev = um1;
         self.lifts = lifts0;
@@ -561,10 +562,10 @@ impl<const D: usize> DynamicStepper<D> {
     /// # Errors
     /// [`TimeError::InvalidParameter`] for a wrong length or non-finite values.
     pub fn set_initial_pressure(&mut self, pressure: &[Real]) -> Result<(), TimeError> {
-        if pressure.len() != self.geometry.len() || pressure.iter().any(|p| !p.is_finite()) {
+        if pressure.len() != self.geometry().len() || pressure.iter().any(|p| !p.is_finite()) {
             return Err(TimeError::InvalidParameter(format!(
                 "initial pressure: {} finite values needed (one per contact node), got {}",
-                self.geometry.len(),
+                self.geometry().len(),
                 pressure.len()
             )));
         }
@@ -579,50 +580,24 @@ impl<const D: usize> DynamicStepper<D> {
     /// # Errors
     /// [`TimeError::InvalidParameter`] for an unknown pair name.
     pub fn set_friction_law(&mut self, pair: &str, law: Arc<dyn FrictionLaw>) -> Result<(), TimeError> {
-        let i = self
-            .geometry
-            .pairs
-            .iter()
-            .position(|(name, _)| name == pair)
-            .ok_or_else(|| TimeError::InvalidParameter(format!("unknown contact pair `{pair}`")))?;
-        self.laws[i] = Some(law);
-        Ok(())
+        self.laws.set(pair, law).map_err(|e| TimeError::InvalidParameter(e.to_string()))
+    }
+
+    /// The friction laws of the pairs.
+    pub fn friction_laws(&self) -> &PairFrictionLaws {
+        &self.laws
     }
 
     /// The physical slip bounds `g_c = F_c(|[u'_t]|) |λ_n|` per contact node scaled by `Δt²`
-    /// (`ḡ_c = F_c |Λ̄_n|`), from the given scaled pressures and slip speeds.
+    /// (`ḡ_c = F_c |Λ̄_n|`), from the given scaled pressures and slip speeds
+    /// ([`PairFrictionLaws::slip_bounds`]).
     fn slip_bounds(&self, pressure: &[Real], speed: &[Real]) -> Vec<Real> {
-        self.geometry
-            .nodes
-            .iter()
-            .enumerate()
-            .map(|(r, node)| match &self.laws[node.pair] {
-                Some(law) => {
-                    let f = law.coefficient(speed[r]);
-                    if f.is_finite() && f > 0.0 {
-                        f * pressure[r].abs()
-                    } else {
-                        0.0
-                    }
-                }
-                None => 0.0,
-            })
-            .collect()
+        self.laws.slip_bounds(self.geometry(), pressure, speed)
     }
 
-    /// `|[u'_t]|` per contact node from two nodal displacement levels.
+    /// `|[u'_t]|` per contact node from two nodal displacement levels ([`slip_speeds`]).
     fn nodal_slip_speeds(&self, new: &[Vec<Vector<D>>], old: &[Vec<Vector<D>>]) -> Vec<Real> {
-        let dt = self.params.dt;
-        let geometry = &self.geometry;
-        (0..geometry.len())
-            .map(|r| {
-                let node = &geometry.nodes[r];
-                let v = geometry.jump(r, new).unwrap_or_else(Vector::<D>::zeros)
-                    - geometry.jump(r, old).unwrap_or_else(Vector::<D>::zeros);
-                let vt = v - node.normal * node.normal.dot(&v);
-                vt.norm() / dt
-            })
-            .collect()
+        slip_speeds(self.geometry(), new, old, self.params.dt)
     }
 
     /// Advances one step `t_i → t_{i+1}`: assembles `F̃` (see the module docs), builds the
@@ -645,12 +620,12 @@ impl<const D: usize> DynamicStepper<D> {
                 "the model passed to step() is not the one the stepper was built for".into(),
             ));
         }
-        let n = self.dofs.n_dofs();
-        let lifts_new = self.dofs.lifts(model, time)?;
+        let n = self.dofs().n_dofs();
+        let lifts_new = self.dofs().lifts(model, time)?;
 
         // loads: F̃_load = Pᵀ F(t_{i+1})
         let mut load = vec![0.0; n];
-        add_loads(model, &self.dofs, time, self.params.load_degree, &mut load)?;
+        add_loads(model, self.dofs(), time, self.params.load_degree, &mut load)?;
         // F̄ = Δt² F̃_load + M̃ (2ũ^i − ũ^{i−1}) + Δt (M̃_α + Ã⁽¹⁾) ũ^i − lift terms
         let mut rhs: Vec<Real> = load.iter().map(|f| dt2 * f).collect();
         let two_u: Vec<Real> = self.u.iter().zip(&self.u_prev).map(|(a, b)| 2.0 * a - b).collect();
@@ -664,20 +639,20 @@ impl<const D: usize> DynamicStepper<D> {
         self.subtract_lift_terms(model, &lifts_new, &mut rhs)?;
 
         // contact
-        let nc = self.geometry.len();
+        let nc = self.geometry().len();
         let (u_new, result, iterations) = if nc == 0 {
             let mut x = rhs.clone();
-            self.factor.solve_in_place(&mut x)?;
+            self.cholesky().solve_in_place(&mut x)?;
             (x, None, 0)
         } else {
             let cs = self.solve_contact(step, time, &lifts_new, &rhs, solver)?;
             let iterations = cs.iterations;
-            (cs.solution.u.clone(), Some(cs), iterations)
+            (cs.result.solution.u.clone(), Some(cs), iterations)
         };
 
         // energies (before shifting the levels)
         let lifts_zero = all_zero(&lifts_new) && all_zero(&self.lifts) && all_zero(&self.lifts_prev);
-        let disp_new = self.dofs.expand(&u_new, &lifts_new)?;
+        let disp_new = self.dofs().expand(&u_new, &lifts_new)?;
         let delta: Vec<Real> = u_new.iter().zip(&self.u).map(|(a, b)| a - b).collect();
         let (kinetic, strain, numerical, viscous) = if lifts_zero {
             let d2: Vec<Real> =
@@ -706,38 +681,37 @@ impl<const D: usize> DynamicStepper<D> {
         let (mut contact_work, mut friction_work) = (0.0, 0.0);
         let mut warm = None;
         let mut new_pressure = vec![0.0; nc];
-        if let Some(ContactStep {
-            solution, kkt, cell_node, slip_bound, friction_work: fwork, normal, ..
-        }) = result
-        {
+        if let Some(ContactStep { result: scaled, friction_work: fwork, .. }) = result {
+            // W_c = δᵀ B_hnᵀ κ Λ̄_n / Δt² with the normal rows of the step
+            let normal = self.geometry().normal_constraints(self.dofs(), &lifts_new);
             let bn_delta = normal.rows.mul(&delta);
             contact_work = bn_delta
                 .iter()
                 .zip(&normal.weights)
-                .zip(&solution.lambda_n)
+                .zip(&scaled.solution.lambda_n)
                 .map(|((y, k), l)| y * k * l)
                 .sum::<Real>()
                 / dt2;
             friction_work = fwork / dt2;
-            new_pressure.clone_from(&solution.lambda_n);
+            new_pressure.clone_from(&scaled.solution.lambda_n);
             let physical = ContactSolution {
-                u: solution.u.clone(),
-                lambda_n: solution.lambda_n.iter().map(|l| l / dt2).collect(),
-                lambda_t: solution.lambda_t.clone(),
-                report: solution.report.clone(),
+                u: scaled.solution.u.clone(),
+                lambda_n: scaled.solution.lambda_n.iter().map(|l| l / dt2).collect(),
+                lambda_t: scaled.solution.lambda_t.clone(),
+                report: scaled.solution.report.clone(),
             };
             let res = StaticContactResult {
                 displacement: disp_new.clone(),
                 solution: physical,
-                cell_node: cell_node.clone(),
-                slip_bound: slip_bound.iter().map(|g| g / dt2).collect(),
-                kkt,
-                coarse_iterations: 0,
-                proximal_iterations: 0,
+                cell_node: scaled.cell_node.clone(),
+                slip_bound: scaled.slip_bound.iter().map(|g| g / dt2).collect(),
+                kkt: scaled.kkt,
+                coarse_iterations: scaled.coarse_iterations,
+                proximal_iterations: scaled.proximal_iterations,
             };
-            record.pairs = pair_records(&self.geometry, &res);
+            record.pairs = pair_records(self.geometry(), &res);
             self.last = Some(res);
-            warm = Some((solution, cell_node));
+            warm = Some(scaled);
         }
         self.cumulative_friction += friction_work;
         record.friction_dissipation = friction_work;
@@ -768,7 +742,9 @@ impl<const D: usize> DynamicStepper<D> {
         Ok(record)
     }
 
-    /// Solves the contact problem of one step (with the optional Coulomb fixed point).
+    /// Solves the contact problem of one step (with the optional Coulomb fixed point) on the
+    /// static contact machinery ([`StaticContact::solve_load`] with `F̄`, the lifts of
+    /// `t_{i+1}`, `ḡ_c` and slip measured from `U^i`).
     fn solve_contact(
         &self,
         step: usize,
@@ -776,51 +752,28 @@ impl<const D: usize> DynamicStepper<D> {
         lifts_new: &[Vector<D>],
         rhs: &[Real],
         solver: &dyn ContactSolver,
-    ) -> Result<ContactStep, TimeError> {
+    ) -> Result<ContactStep<D>, TimeError> {
         let contact_err = |source| TimeError::Contact { step, time, source };
-        let normal = self.geometry.normal_constraints(&self.dofs, lifts_new);
+        let geometry = self.geometry();
         let mut bounds = self.slip_bounds(&self.pressure, &self.slip_speed);
         let mut iterations = 0;
         let mut fp_iter = 0;
         loop {
-            let friction_op = if bounds.iter().any(|g| *g > 0.0) {
-                Some(
-                    self.geometry
-                        .friction_constraints(&self.dofs, lifts_new, &bounds, Some(&self.disp))
-                        .map_err(contact_err)?,
-                )
-            } else {
-                None
+            let slip_bound = bounds.iter().any(|g| *g > 0.0).then_some(&bounds[..]);
+            let warm = match (&self.warm, self.params.warm_start) {
+                (Some(prev), true) => Some(warm_start(geometry, prev, &bounds)),
+                _ => None,
             };
-            let friction = friction_op.as_ref().map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0);
-            let operator = synovia_linalg::CholeskyOperator::new(&self.matrix, &self.factor)?;
-            let problem = ContactProblem { operator: &operator, load: rhs, normal: &normal, friction };
-            let (cell_node, slip_bound) = match (&friction_op, friction.is_some()) {
-                (Some(op), true) => (op.cell_node.clone(), op.slip_bound.clone()),
-                _ => (Vec::new(), Vec::new()),
-            };
-            let warm = if self.params.warm_start { self.warm_start(&cell_node) } else { None };
-            let context = match warm {
-                Some(w) => synovia_contact::SolveContext::warm(w),
-                None => synovia_contact::SolveContext::new(),
-            };
-            let solution = solver.solve(&problem, &context).map_err(contact_err)?;
-            iterations += solution.report.iterations;
-            let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
-            // Σ_c ‖B_Ht U − s‖_c (scaled friction work)
-            let mut friction_work = 0.0;
-            if let Some(fr) = friction {
-                let y = fr.rows.mul(&solution.u);
-                let c = fr.components;
-                for cell in 0..fr.n_cells() {
-                    let s2: Real = (0..c).map(|k| (y[cell * c + k] - fr.shift[cell * c + k]).powi(2)).sum();
-                    friction_work += s2.sqrt();
-                }
-            }
+            let result = self
+                .contact
+                .solve_load(rhs, lifts_new, solver, slip_bound, Some(&self.disp), warm.as_ref())
+                .map_err(contact_err)?;
+            iterations += result.solution.report.iterations + result.coarse_iterations;
+            // Σ_c ‖B_Ht U − s‖_c = Σ_c ḡ_c κ_c ‖T_cᵀ([U^{i+1}] − [U^i])‖ (scaled friction work)
+            let friction_work = friction_dissipation(geometry, &result, Some(&self.disp))?;
             if self.params.coulomb_iterations > 0 {
-                let new_disp = self.dofs.expand(&solution.u, lifts_new)?;
-                let speed = self.nodal_slip_speeds(&new_disp, &self.disp);
-                let new_bounds = self.slip_bounds(&solution.lambda_n, &speed);
+                let speed = self.nodal_slip_speeds(&result.displacement, &self.disp);
+                let new_bounds = self.slip_bounds(&result.solution.lambda_n, &speed);
                 let scale = new_bounds.iter().chain(&bounds).fold(0.0_f64, |a, &b| a.max(b));
                 let change = if scale > 0.0 {
                     new_bounds.iter().zip(&bounds).fold(0.0_f64, |a, (x, y)| a.max((x - y).abs())) / scale
@@ -836,15 +789,7 @@ impl<const D: usize> DynamicStepper<D> {
                     continue;
                 }
             }
-            return Ok(ContactStep {
-                solution,
-                kkt,
-                cell_node,
-                slip_bound,
-                friction_work,
-                normal,
-                iterations,
-            });
+            return Ok(ContactStep { result, friction_work, iterations });
         }
     }
 
@@ -871,7 +816,7 @@ impl<const D: usize> DynamicStepper<D> {
     /// [`PairRecord`] per pair, so CSV columns line up): the row of step 0 of a results table.
     pub fn initial_record(&self) -> StepRecord {
         let pairs = self
-            .geometry
+            .geometry()
             .pairs
             .iter()
             .map(|(name, _)| PairRecord {
@@ -896,32 +841,6 @@ impl<const D: usize> DynamicStepper<D> {
         }
     }
 
-    /// Warm start for the given friction cells: the previous multipliers, cells matched by
-    /// contact node (new cells start at 0).
-    fn warm_start(&self, cells: &[usize]) -> Option<ContactSolution> {
-        let (prev, prev_cells) = self.warm.as_ref()?;
-        let comps = D - 1;
-        let mut by_node = vec![None; self.geometry.len()];
-        for (c, &r) in prev_cells.iter().enumerate() {
-            if (c + 1) * comps <= prev.lambda_t.len() {
-                by_node[r] = Some(c);
-            }
-        }
-        let mut lambda_t = vec![0.0; cells.len() * comps];
-        for (c, &r) in cells.iter().enumerate() {
-            if let Some(pc) = by_node[r] {
-                lambda_t[c * comps..(c + 1) * comps]
-                    .copy_from_slice(&prev.lambda_t[pc * comps..(pc + 1) * comps]);
-            }
-        }
-        Some(ContactSolution {
-            u: Vec::new(),
-            lambda_n: prev.lambda_n.clone(),
-            lambda_t,
-            report: Default::default(),
-        })
-    }
-
     /// `rhs −= Pᵀ [M_ρ (u_p^{i+1} − 2u_p^i + u_p^{i−1}) + Δt (M_α + A⁽¹⁾)(u_p^{i+1} − u_p^i)
     /// + Δt² A⁽⁰⁾ u_p^{i+1}]`, element by element.
     fn subtract_lift_terms(
@@ -939,21 +858,21 @@ impl<const D: usize> DynamicStepper<D> {
             .map(|(a, (b, c))| a - b * 2.0 + c)
             .collect();
         if !all_zero(&second) {
-            subtract_lift(model, &self.dofs, &second, rhs, |b, _, geo, out| {
+            subtract_lift(model, self.dofs(), &second, rhs, |b, _, geo, out| {
                 mass_into(geo, rho[b], lumped, out)
             })?;
         }
         if self.has_damping {
             let first: Vec<Vector<D>> = lifts_new.iter().zip(&self.lifts).map(|(a, b)| a - b).collect();
             if !all_zero(&first) {
-                subtract_lift(model, &self.dofs, &first, rhs, |b, _, geo, out| {
+                subtract_lift(model, self.dofs(), &first, rhs, |b, _, geo, out| {
                     self.element_kernel(Kernel::DampingDt, b, geo, out)
                 })?;
             }
         }
         if !all_zero(lifts_new) {
             let c0 = &self.c0;
-            subtract_lift(model, &self.dofs, lifts_new, rhs, |b, _, geo, out| {
+            subtract_lift(model, self.dofs(), lifts_new, rhs, |b, _, geo, out| {
                 stiffness_into(geo, &c0[b], out);
                 out.iter_mut().for_each(|v| *v *= dt * dt);
             })?;
@@ -1109,7 +1028,7 @@ impl<const D: usize> DynamicStepper<D> {
     pub fn contact_force(&self) -> Vector<D> {
         let mut f = Vector::<D>::zeros();
         if let Some(res) = &self.last {
-            for rec in pair_records(&self.geometry, res) {
+            for rec in pair_records(self.geometry(), res) {
                 for k in 0..D {
                     f[k] += rec.force[k];
                 }
@@ -1128,11 +1047,11 @@ impl<const D: usize> DynamicStepper<D> {
     }
     /// The dof map.
     pub fn dofs(&self) -> &DofMap<D> {
-        &self.dofs
+        self.contact.elastic().dofs()
     }
     /// The contact nodes.
     pub fn geometry(&self) -> &ContactGeometry<D> {
-        &self.geometry
+        self.contact.geometry()
     }
     /// `M̃_ρ = Pᵀ M_ρ P`.
     pub fn mass_matrix(&self) -> &SymmetricMatrix {
@@ -1152,11 +1071,11 @@ impl<const D: usize> DynamicStepper<D> {
     }
     /// `Ã = M̃_ρ + Δt M̃_α + Δt² Ã⁽⁰⁾ + Δt Ã⁽¹⁾`.
     pub fn system_matrix(&self) -> &SymmetricMatrix {
-        &self.matrix
+        self.contact.elastic().system_matrix()
     }
     /// The factorisation of `Ã` (computed once in [`DynamicStepper::new`]).
     pub fn cholesky(&self) -> &CholeskySolver {
-        &self.factor
+        self.contact.elastic().cholesky()
     }
     /// Sizes and set-up timings.
     pub fn info(&self) -> DynamicInfo {
@@ -1172,14 +1091,12 @@ enum Kernel {
     DampingDt,
 }
 
-/// The solution of one step's contact problem with what the record needs.
-struct ContactStep {
-    solution: ContactSolution,
-    kkt: KktReport,
-    cell_node: Vec<usize>,
-    slip_bound: Vec<Real>,
+/// The solution of one step's contact problem (scaled multipliers `Λ̄_n`, `ḡ_c`) with what
+/// the record needs.
+struct ContactStep<const D: usize> {
+    result: StaticContactResult<D>,
+    /// `Σ_c ‖B_Ht U − s‖_c` (scaled by `Δt²`).
     friction_work: Real,
-    normal: NormalConstraints,
     iterations: usize,
 }
 

@@ -19,8 +19,11 @@
 //!   Λ_t − π(Λ_t + ρ B_Ht (U − U(t_{i−1})))     = 0
 //!   ```
 //!
-//!   with `B_Ht` built on the cells of `supp g_c`, `g_c,r = F_c |Λ_n,r(t_{i−1})|`
-//!   ([`ContactGeometry::slip_bounds_from_pressure`] of the previous level, docs/model.md §3, `r = 1`),
+//!   with `B_Ht` built on the cells of `supp g_c`, `g_c,r = F_c(v_r) |Λ_n,r(t_{i−1})|`
+//!   (docs/model.md §3, `r = 1`) with the friction law `F_c` of the pair
+//!   ([`QuasiStaticStepper::set_friction_law`], default its constant coefficient, then exactly
+//!   [`ContactGeometry::slip_bounds_from_pressure`] of the previous level) and the slip rate
+//!   `v_r = ‖Δ[u_t]_r‖ / Δt` of the previous level ([`QuasiStaticStepper::slip_rate`]),
 //!   and slip measured from the previous level `U(t_{i−1})` (incremental slip, docs/model.md §3; with
 //!   [`QuasiStaticParams::incremental_slip`] `= false` the report's total-displacement form
 //!   `Λ_t − π(Λ_t + ρ B_Ht U)` is used instead, slip measured from the reference state).
@@ -29,7 +32,7 @@
 //!   node of each cell ([`StaticContactResult::cell_node`]), since the friction cells
 //!   `supp g_c` change from level to level; new cells start from `Λ_t = 0`.
 //! * **Coulomb fixed point** ([`QuasiStaticParams::coulomb_fixed_point`], docs/model.md §3): the level
-//!   is re-solved with `g_c^{k+1} = F_c |Λ_n^k|` from the current iterate until
+//!   is re-solved with `g_c^{k+1} = F_c(v^k) |Λ_n^k|` (pressure and slip rate of the current iterate) until
 //!   `max_r |g^{k+1}_r − g^k_r| / max_r |g^{k+1}_r| ≤ fixed_point_tolerance`; the accepted
 //!   solution is the last one (computed with `g^k`). After `max_fixed_point` solves without
 //!   convergence the run stops with [`TimeError::FixedPoint`].
@@ -81,10 +84,14 @@
 //! and von Mises stress) and the records as CSV ([`crate::results::write_csv`]).
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 use synovia_contact::operators::{ContactGeometry, ContactPair};
-use synovia_contact::{ContactSolution, ContactSolver, SolverReport, StaticContact, StaticContactResult};
+use synovia_contact::{
+    slip_speeds, ContactSolution, ContactSolver, FrictionLaw, PairFrictionLaws, SolverReport, StaticContact,
+    StaticContactResult,
+};
 use synovia_fem::post::body_fields;
 use synovia_fem::{ElasticParams, Model};
 use synovia_io::{Encoding, Field, TimeSeriesWriter, VtuWriter};
@@ -162,6 +169,10 @@ pub struct QuasiStaticStepper<const D: usize> {
     last_time: Option<Real>,
     /// Friction dissipation summed over the current sequence.
     cumulative: Real,
+    /// The friction law `F_c` of every pair (default: its constant coefficient).
+    laws: PairFrictionLaws,
+    /// Slip rate `|[u'_t]|` per contact node of the last level (0 at step 0).
+    slip_rate: Vec<Real>,
 }
 
 impl<const D: usize> QuasiStaticStepper<D> {
@@ -193,6 +204,31 @@ impl<const D: usize> QuasiStaticStepper<D> {
     ) -> Result<Self, TimeError> {
         params.validate()?;
         Ok(Self::assemble(contact, params, body_nodes(model)))
+    }
+
+    /// Replaces the friction law `F_c(|[u'_t]|)` of the contact pair `pair` (docs/model.md §3;
+    /// default: the pair's constant coefficient [`ContactPair::friction`]); the same as
+    /// [`crate::dynamic::DynamicStepper::set_friction_law`]. The slip bounds of level `i` are
+    /// `g_c,r = F_c(v_r) |Λ_n,r|` with the pressure and the slip rate
+    /// `v_r = ‖[u_t](s_r, t_{i−1}) − [u_t](s_r, t_{i−2})‖ / (t_{i−1} − t_{i−2})` of level `i − 1`
+    /// (0 for level 0); with the Coulomb fixed point, both from the current iterate of level `i`
+    /// (slip rate over `[t_{i−1}, t_i]`). A law set on a pair built frictionless gives it friction.
+    ///
+    /// # Errors
+    /// [`TimeError::InvalidParameter`] for an unknown pair name.
+    pub fn set_friction_law(&mut self, pair: &str, law: Arc<dyn FrictionLaw>) -> Result<(), TimeError> {
+        self.laws.set(pair, law).map_err(|e| TimeError::InvalidParameter(e.to_string()))
+    }
+
+    /// The friction laws of the pairs.
+    pub fn friction_laws(&self) -> &PairFrictionLaws {
+        &self.laws
+    }
+
+    /// Slip rate `|[u'_t]|` per contact node of the last level solved (see
+    /// [`QuasiStaticStepper::set_friction_law`]; 0 at step 0).
+    pub fn slip_rate(&self) -> &[Real] {
+        &self.slip_rate
     }
 
     /// Re-pair every level `i ≥ 1` from the configuration of level `i − 1` with the contact
@@ -370,7 +406,11 @@ impl<const D: usize> QuasiStaticStepper<D> {
     }
 
     fn assemble(contact: StaticContact<D>, params: QuasiStaticParams, body_nodes: Vec<usize>) -> Self {
+        let laws = PairFrictionLaws::new(contact.geometry());
+        let slip_rate = vec![0.0; contact.geometry().len()];
         Self {
+            laws,
+            slip_rate,
             contact,
             params,
             body_nodes,
@@ -404,18 +444,26 @@ impl<const D: usize> QuasiStaticStepper<D> {
                     .update_geometry(model, pairs, &prev.displacement)
                     .map_err(|source| TimeError::Contact { step, time: t, source })?;
                 *prev = transfer_result(&old, self.contact.geometry(), prev);
+                self.slip_rate = self.contact.geometry().transfer(&old, &self.slip_rate);
             }
         }
         let previous = if step > 0 { self.last.as_ref() } else { None };
+        let dt = self.last_time.map_or(0.0, |l| t - l);
         let (result, iterations) = match previous {
             None => self.initial(model, t, solver, initial_warm.as_ref())?,
             Some(prev) => {
-                let g = self.contact.geometry().slip_bounds_from_pressure(&prev.solution.lambda_n);
+                let g =
+                    self.laws.slip_bounds(self.contact.geometry(), &prev.solution.lambda_n, &self.slip_rate);
                 let origin = self.params.incremental_slip.then_some(prev.displacement.as_slice());
-                self.tresca_level(model, step, t, solver, g, origin, Some(prev))?
+                let rate_from = Some((prev.displacement.as_slice(), dt));
+                self.tresca_level(model, step, t, solver, g, origin, rate_from, Some(prev))?
             }
         };
         let geometry = self.contact.geometry();
+        let slip_rate = match previous {
+            Some(prev) => slip_speeds(geometry, &result.displacement, &prev.displacement, dt),
+            None => vec![0.0; geometry.len()],
+        };
         let dissipation =
             friction_dissipation(geometry, &result, previous.map(|p| p.displacement.as_slice()))?;
         let cumulative = base + dissipation;
@@ -433,6 +481,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
             step_s: start.elapsed().as_secs_f64(),
         };
         self.cumulative = cumulative;
+        self.slip_rate = slip_rate;
         self.next_step = step + 1;
         self.last_time = Some(t);
         let result = &*self.last.insert(result);
@@ -464,16 +513,19 @@ impl<const D: usize> QuasiStaticStepper<D> {
             .solve(model, t, solver, None, None, warm)
             .map_err(|source| TimeError::Contact { step: 0, time: t, source })?;
         let its = pre.solution.report.iterations + pre.coarse_iterations;
-        let has_friction = self.contact.geometry().nodes.iter().any(|n| n.friction > 0.0);
-        if !(self.params.initial_friction && has_friction) {
+        let geometry = self.contact.geometry();
+        if !(self.params.initial_friction && self.laws.any_friction(geometry)) {
             return Ok((pre, its));
         }
-        let g = self.contact.geometry().slip_bounds_from_pressure(&pre.solution.lambda_n);
-        let (res, more) = self.tresca_level(model, 0, t, solver, g, None, Some(&pre))?;
+        // no previous level: the slip rate of step 0 is 0 (F_c at rest)
+        let rest = vec![0.0; geometry.len()];
+        let g = self.laws.slip_bounds(geometry, &pre.solution.lambda_n, &rest);
+        let (res, more) = self.tresca_level(model, 0, t, solver, g, None, None, Some(&pre))?;
         Ok((res, its + more))
     }
 
-    /// One Tresca level (with the optional Coulomb fixed point).
+    /// One Tresca level (with the optional Coulomb fixed point, whose slip rates are measured
+    /// from `rate_from = (U(t_{i−1}), t_i − t_{i−1})`, 0 without it).
     #[allow(clippy::too_many_arguments)]
     fn tresca_level(
         &self,
@@ -483,6 +535,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
         solver: &dyn ContactSolver,
         slip_bound: Vec<Real>,
         origin: Option<&[Vec<Vector<D>>]>,
+        rate_from: Option<(&[Vec<Vector<D>>], Real)>,
         warm_from: Option<&StaticContactResult<D>>,
     ) -> Result<(StaticContactResult<D>, usize), TimeError> {
         let geometry = self.contact.geometry();
@@ -501,7 +554,11 @@ impl<const D: usize> QuasiStaticStepper<D> {
             if !coulomb {
                 return Ok((res, iterations));
             }
-            let g_new = geometry.slip_bounds_from_pressure(&res.solution.lambda_n);
+            let rate = match rate_from {
+                Some((prev, dt)) => slip_speeds(geometry, &res.displacement, prev, dt),
+                None => vec![0.0; geometry.len()],
+            };
+            let g_new = self.laws.slip_bounds(geometry, &res.solution.lambda_n, &rate);
             change = relative_change(&g, &g_new);
             if change <= self.params.fixed_point_tolerance {
                 return Ok((res, iterations));

@@ -26,7 +26,7 @@ fn pdas() -> Pdas {
     Pdas::new(ContactParams { tolerance: 1e-12, max_iterations: 200, ..Default::default() })
 }
 
-/// The 2D Hertz set-up of `synovia::hertz::hertz2d_model`: the upper half-disc `"indenter"`
+/// The 2D Hertz set-up of `synovia_models::hertz::hertz2d_model`: the upper half-disc `"indenter"`
 /// (centre `(0, R)`, flat top prescribed to `(shift(t), −push(t))`, contact part its arc below
 /// `y < 0.3 R`) on either a rigid flat `y = 0` or the mirrored half-disc `"base"` (clamped at
 /// its flat side), refined `levels` times toward the contact point.

@@ -48,12 +48,10 @@ pub(crate) fn initial_multipliers(
     Ok(nu)
 }
 
-/// Projection `π` onto `[−1, 1]` (one component) or the unit disc (two).
+/// Projection `π` onto `[−1, 1]` (one component) or the unit disc (two):
+/// [`synovia_contact::project_on_disc`] with radius 1 (docs/model.md §3).
 pub(crate) fn project_unit(v: &mut [f64]) {
-    let n = norm(v);
-    if n > 1.0 {
-        v.iter_mut().for_each(|a| *a /= n);
-    }
+    synovia_contact::project_on_disc(v, 1.0);
 }
 
 /// Jacobi scales `D` of the interface rows: `S_rr` for the normal rows, the mean of `S_rr` over

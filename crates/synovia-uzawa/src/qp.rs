@@ -154,13 +154,7 @@ impl ConvexBlock {
                     *v = v.max(lower).min(upper);
                 }
             }
-            ConvexBlock::Ball { radius, .. } => {
-                let n = norm(x);
-                if n > radius {
-                    let s = if n > 0.0 { radius / n } else { 0.0 };
-                    x.iter_mut().for_each(|v| *v *= s);
-                }
-            }
+            ConvexBlock::Ball { radius, .. } => synovia_contact::project_on_disc(x, radius),
         }
     }
 }

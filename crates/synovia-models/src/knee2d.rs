@@ -33,7 +33,7 @@
 //! flexion the contact moves over the femoral cartilage (toward the posterior condyle), i.e.
 //! over different elements of the femur mesh. Femoral displacements of a [`KneePose`] are in
 //! the femur frame ([`BodyPlacement::to_global`] turns them into space);
-//! [`crate::output::contact_vtu`] writes the posed configuration.
+//! [`synovia::output::contact_vtu`] writes the posed configuration.
 //!
 //! # Load control
 //!

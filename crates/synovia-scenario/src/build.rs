@@ -9,9 +9,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use synovia::builder::{Analysis, BodyMaterial, JointModel};
-use synovia::contact_ops::operators::{
-    ContactPair, CylinderObstacle, Partner, PlaneObstacle, SphereObstacle,
-};
+use synovia::contact_ops::operators::{ContactPair, CylinderObstacle, PlaneObstacle, SphereObstacle};
 use synovia::contact_ops::{ContactParams, ExponentialFriction};
 use synovia::fem::{ComponentMask, ElasticParams, FemError, OrderingChoice};
 use synovia::io::gmsh::GmshMesh;
@@ -1243,10 +1241,7 @@ fn contact<const D: usize>(
                 pair = pair.with_fixed_normal(cx.nonzero::<D>(n, &key(k, "normal"))?);
             }
             if let Some(t) = &s.tolerance {
-                let tol = cx.positive(t, &key(k, "tolerance"))?;
-                if let Partner::Body { tolerance, .. } = &mut pair.partner {
-                    *tolerance = Some(tol);
-                }
+                pair = pair.with_pairing_tolerance(cx.positive(t, &key(k, "tolerance"))?);
             }
             pair
         }

@@ -30,7 +30,7 @@ use synovia_mesh::math::{Point, Real, Vector};
 use synovia_mesh::refine::StraightMidpoint;
 use synovia_mesh::{BoundaryKind, Mesh};
 
-use crate::contact::{StaticContact, StaticContactResult};
+use synovia::contact::{StaticContact, StaticContactResult};
 
 /// Figures of one Hertz or Cattaneo–Mindlin run.
 #[derive(Debug, Clone, PartialEq)]
@@ -330,7 +330,7 @@ pub fn hertz2d_write(
     let solve_s = t0.elapsed().as_secs_f64();
     let geo = sc.geometry();
     if let Some(path) = vtu {
-        crate::output::contact_vtu(&model, geo, &res, synovia_io::Encoding::Base64)
+        synovia::output::contact_vtu(&model, geo, &res, synovia_io::Encoding::Base64)
             .and_then(|w| w.write(path))
             .map_err(|e| ContactError::InvalidParameter(format!("writing {}: {e}", path.display())))?;
     }

@@ -1,0 +1,69 @@
+//! Contact with a rigid obstacle given by a signed distance `φ` (docs/model.md §5, the
+//! foundation case).
+//!
+//! Every node `i` of the slave part gives the row `(B_hn U)_r = n_r · u^k_i ≤ d_r = φ(x_i)` with
+//! `n_r = −∇φ(x_i) / |∇φ(x_i)|` (pointing from the body into the obstacle) and the lumped weight
+//! `κ_r = ∫_{Γ_c} φ_i ds`; there is no other side.
+
+use std::sync::Arc;
+
+use synovia_fem::BodyId;
+
+use super::{ContactDiscretisation, ContactRow, PairContext};
+use crate::error::ContactError;
+use crate::operators::SignedDistance;
+
+/// The slave part against a rigid obstacle (see the [module docs](self)).
+#[derive(Debug, Clone)]
+pub struct RigidObstacle<const D: usize> {
+    /// The obstacle's signed distance (positive in the free space).
+    pub obstacle: Arc<dyn SignedDistance<D>>,
+}
+
+impl<const D: usize> RigidObstacle<D> {
+    /// Against `obstacle`.
+    pub fn new(obstacle: Arc<dyn SignedDistance<D>>) -> Self {
+        Self { obstacle }
+    }
+}
+
+impl<const D: usize> ContactDiscretisation<D> for RigidObstacle<D> {
+    fn kind(&self) -> &str {
+        "rigid"
+    }
+
+    fn partner_part(&self) -> Option<(BodyId, &str)> {
+        None
+    }
+
+    fn rows(&self, cx: &PairContext<'_, D>) -> Result<Vec<ContactRow<D>>, ContactError> {
+        self.obstacle.validate().map_err(|m| cx.invalid(format!("obstacle: {m}")))?;
+        let pos_k = cx.positions(cx.body()).ok_or_else(|| cx.invalid("unknown body"))?;
+        let mut rows = Vec::with_capacity(cx.normals().len());
+        for &(i, nk) in cx.normals() {
+            let x = pos_k[i];
+            let phi = self.obstacle.distance(&x);
+            let grad = self.obstacle.gradient(&x);
+            let gl = grad.norm();
+            if !(phi.is_finite() && gl.is_finite() && gl > 0.0) {
+                return Err(cx.invalid(format!("obstacle distance or gradient not finite/zero at node {i}")));
+            }
+            let n = -grad / gl;
+            if n.dot(&nk) <= 0.0 {
+                return Err(cx.invalid(format!(
+                    "at node {i} the obstacle faces away from the body (outward normal · obstacle normal = {:.3} ≤ 0)",
+                    n.dot(&nk)
+                )));
+            }
+            rows.push(ContactRow {
+                node: i,
+                partner: None,
+                master: Vec::new(),
+                normal: n,
+                weight: cx.weight(i),
+                gap: phi,
+            });
+        }
+        Ok(rows)
+    }
+}
