@@ -89,8 +89,15 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<Self, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
         let interface = interface_nodes(model, pairs, &geometry)?;
-        let elastic = ElasticSolver::new_with_ordering(model, params, true, &interface_ordering(&interface, block))?;
-        Ok(Self { elastic, geometry, nested_min_rows: Some(32), context: SolveContext::new(), caller_matrix: false })
+        let elastic =
+            ElasticSolver::new_with_ordering(model, params, true, &interface_ordering(&interface, block))?;
+        Ok(Self {
+            elastic,
+            geometry,
+            nested_min_rows: Some(32),
+            context: SolveContext::new(),
+            caller_matrix: false,
+        })
     }
 
     /// The context of the solves (kept columns, recycled load solves, memory budget).
@@ -125,7 +132,13 @@ impl<const D: usize> StaticContact<D> {
         let interface = interface_nodes(model, pairs, &geometry)?;
         let ordering = interface_ordering(&interface, InterfaceBlockParams::default());
         let elastic = ElasticSolver::with_system_matrix(model, params, &ordering, assemble)?;
-        Ok(Self { elastic, geometry, nested_min_rows: Some(32), context: SolveContext::new(), caller_matrix: true })
+        Ok(Self {
+            elastic,
+            geometry,
+            nested_min_rows: Some(32),
+            context: SolveContext::new(),
+            caller_matrix: true,
+        })
     }
 
     /// Solves the contact problem of docs/model.md §5 with the caller's reduced right-hand side

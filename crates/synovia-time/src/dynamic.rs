@@ -410,7 +410,7 @@ impl<const D: usize> DynamicStepper<D> {
             parts = Some((mass, mass_alpha, stiffness, viscous, damping_dt));
             Ok(())
         };
-        let elastic = ElasticParams { ordering: params.ordering, ..ElasticParams::default() };
+        let elastic = ElasticParams::default().with_ordering(params.ordering);
         let mut contact = StaticContact::with_system_matrix(model, pairs, elastic, assemble)?;
         // every step is warm-started from the previous one (or cold, as chosen): no nested iteration
         contact.set_nested_iteration(None);
