@@ -1,6 +1,6 @@
-//! The Rust side of a C handle: a [`JointModel`] with a global node numbering, integer part
-//! tags, live condition values, and the solver state that carries a quasi-static sequence from
-//! one call to the next.
+//! The Rust side of a C handle: an [`ArrayModel`] (from `synovia-scenario`: a `JointModel`
+//! with a global node numbering, integer part tags and live condition values), and the solver
+//! state that carries a quasi-static sequence from one call to the next.
 //!
 //! Nothing here touches raw pointers; `lib.rs` turns C arguments into slices and strings first.
 
