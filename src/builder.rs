@@ -1030,7 +1030,7 @@ impl<const D: usize> JointModel<D> {
                 }
             }
         }
-        let params = DynamicParams { dt, ..self.dynamic_params.clone() };
+        let params = self.dynamic_params.clone().with_dt(dt);
         let mut stepper = DynamicStepper::new(&self.model, &bodies, &self.pairs, params)?;
         for (pair, law) in &self.friction_laws {
             stepper.set_friction_law(pair, law.clone())?;

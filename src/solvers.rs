@@ -65,7 +65,7 @@ pub struct PdasFallback {
 impl PdasFallback {
     /// PDAS with `params`, the fallback with `params` and at least 10 000 QP iterations.
     pub fn new(params: ContactParams) -> Self {
-        let fb = ContactParams { max_iterations: params.max_iterations.max(10_000), ..params };
+        let fb = params.with_max_iterations(params.max_iterations.max(10_000));
         Self { pdas: Pdas::new(params), fallback: DualMprgp::new(fb) }
     }
 }

@@ -79,7 +79,7 @@ fn the_solvers_agree_on_frictionless_and_tresca_problems() {
     let (model, mut pairs) = hertz2d_model(&p).expect("model");
     pairs[0].friction = 0.3;
     let sc = StaticContact::new(&model, &pairs, Default::default()).expect("factorise");
-    let tight = ContactParams { tolerance: 1e-10, max_iterations: 5000, ..Default::default() };
+    let tight = ContactParams::default().with_tolerance(1e-10).with_max_iterations(5000);
     // normal state and slip bounds from PDAS
     let pdas = by_name("pdas").expect("pdas");
     let normal = sc.solve(&model, 0.0, pdas.as_ref(), None, None, None).expect("normal");
@@ -89,7 +89,7 @@ fn the_solvers_agree_on_frictionless_and_tresca_problems() {
         let mut sols = Vec::new();
         for name in SOLVER_NAMES {
             let s = match *name {
-                "au-pdas" => by_name_with(name, ContactParams { rho_scale: 0.2, ..tight }),
+                "au-pdas" => by_name_with(name, tight.with_rho_scale(0.2)),
                 _ => by_name_with(name, tight),
             }
             .expect("solver");
@@ -137,7 +137,7 @@ fn non_convergence_returns_the_residual_history() {
     let (model, pairs) = hertz2d_model(&p).expect("model");
     let mut sc = StaticContact::new(&model, &pairs, Default::default()).expect("factorise");
     sc.set_nested_iteration(None);
-    let s = by_name_with("pdas", ContactParams { max_iterations: 2, ..Default::default() }).expect("solver");
+    let s = by_name_with("pdas", ContactParams::default().with_max_iterations(2)).expect("solver");
     match sc.solve(&model, 0.0, s.as_ref(), None, None, None) {
         Err(ContactError::NoConvergence { iterations, history, .. }) => {
             assert_eq!(iterations, 2);
@@ -277,10 +277,10 @@ fn the_solvers_agree_in_3d_with_friction() {
     .build::<3>()
     .expect("problem");
     let problem = owned.problem();
-    let tight = ContactParams { tolerance: 1e-10, max_iterations: 5000, ..Default::default() };
+    let tight = ContactParams::default().with_tolerance(1e-10).with_max_iterations(5000);
     let mut sols = Vec::new();
     for name in SOLVER_NAMES {
-        let params = if *name == "au-pdas" { ContactParams { rho_scale: 0.2, ..tight } } else { tight };
+        let params = if *name == "au-pdas" { tight.with_rho_scale(0.2) } else { tight };
         let s = by_name_with(name, params).expect("solver");
         let sol = s
             .solve(&problem, &synovia::contact_ops::SolveContext::new())

@@ -276,7 +276,7 @@ fn all_solvers_agree<const D: usize>(model: &Model<D>, sc: &StaticContact<D>, sh
     use synovia::contact_ops::ContactParams;
     use synovia::solvers::{by_name_with, SOLVER_NAMES};
     let geo = sc.geometry();
-    let tight = ContactParams { tolerance: 1e-11, max_iterations: 5000, ..Default::default() };
+    let tight = ContactParams::default().with_tolerance(1e-11).with_max_iterations(5000);
     let pdas = by_name_with("pdas", tight).expect("solver");
     let normal = sc.solve(model, 0.0, pdas.as_ref(), None, None, None).expect("normal");
     let g = geo.slip_bounds_from_pressure(&normal.solution.lambda_n);
@@ -285,7 +285,7 @@ fn all_solvers_agree<const D: usize>(model: &Model<D>, sc: &StaticContact<D>, sh
         // AU-PDAS is ρ-sensitive (its docs): with the default ρ it cycles on the 2D mortar
         // Tresca problem (tangential residual ≈ 5 after 5000 iterations); ρ/10 converges in
         // 6 (2D) and 28 (3D) iterations. The other solvers run with the defaults.
-        let params = if *name == "au-pdas" { ContactParams { rho_scale: 0.1, ..tight } } else { tight };
+        let params = if *name == "au-pdas" { tight.with_rho_scale(0.1) } else { tight };
         let s = by_name_with(name, params).expect("solver");
         let frictionless =
             sc.solve(model, 0.0, s.as_ref(), None, None, None).unwrap_or_else(|e| panic!("{name}: {e}"));

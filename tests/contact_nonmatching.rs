@@ -354,7 +354,7 @@ fn all_solvers_run_on_node_to_segment_operators() {
     let pdas = by_name("pdas").expect("solver");
     let normal = sc.solve(&model, 0.0, pdas.as_ref(), None, None, None).expect("normal");
     let g = geo.slip_bounds_from_pressure(&normal.solution.lambda_n);
-    let tight = ContactParams { tolerance: 1e-11, max_iterations: 5000, ..Default::default() };
+    let tight = ContactParams::default().with_tolerance(1e-11).with_max_iterations(5000);
     let mut reference: Option<(Vec<f64>, Vec<f64>)> = None;
     for name in SOLVER_NAMES {
         let s = by_name_with(name, tight).expect("solver");

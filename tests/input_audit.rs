@@ -319,7 +319,7 @@ fn public_constructors_reject_bad_input_with_named_errors() {
                 let floor = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0))
                     .map_err(|e| e.to_string())?;
                 j.contact_rigid("floor", b, "bottom", floor, 0.0).map_err(|e| e.to_string())?;
-                j.contact_params(ContactParams { tolerance: 0.0, ..ContactParams::default() });
+                j.contact_params(ContactParams::default().with_tolerance(0.0));
                 j.run_static(0.0).map(|_| ()).map_err(|e| e.to_string())
             }),
             "tolerance",

@@ -96,7 +96,7 @@ fn pdas_fallback_hands_a_cycling_problem_to_dual_mprgp_and_reports_it() {
     let why = sol.report.fallback.as_deref().expect("fallback recorded");
     assert!(why.contains("cycle of period 3") && why.contains("dual-mprgp"), "{why}");
     // the same solution as dual-mprgp from a cold start
-    let cold = DualMprgp::new(ContactParams { max_iterations: 10_000, ..Default::default() })
+    let cold = DualMprgp::new(ContactParams::default().with_max_iterations(10_000))
         .solve(&p, &synovia::contact_ops::SolveContext::new())
         .expect("dual-mprgp");
     for (a, b) in sol.u.iter().zip(&cold.u).chain(sol.lambda_n.iter().zip(&cold.lambda_n)) {

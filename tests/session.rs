@@ -81,7 +81,7 @@ fn rel_diff(a: &[Real], b: &[Real]) -> Real {
 fn resolve_with_new_loads_equals_a_fresh_run_static() {
     let frames = [(0.01, 0.0, 0.0), (0.02, 0.001, 0.5), (0.015, -0.002, 2.0), (0.03, 0.0, 0.0)];
     for (mu, initial_friction) in [(0.0, false), (0.3, true)] {
-        let params = QuasiStaticParams { initial_friction, ..Default::default() };
+        let params = QuasiStaticParams::default().with_initial_friction(initial_friction);
         let inputs = Inputs::new(frames[0].0, frames[0].1, frames[0].2);
         let joint = block_on_disc(
             inputs.depth.clone(),

@@ -6,6 +6,7 @@ use crate::problem::ContactProblem;
 
 /// Parameters shared by the contact solvers.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct ContactParams {
     /// Stopping tolerance on the relative complementarity residuals (default `1e-10`).
     pub tolerance: f64,
@@ -19,6 +20,24 @@ pub struct ContactParams {
 impl Default for ContactParams {
     fn default() -> Self {
         Self { tolerance: 1e-10, max_iterations: 200, rho_scale: 1.0 }
+    }
+}
+
+impl ContactParams {
+    /// Sets [`Self::tolerance`].
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+    /// Sets [`Self::max_iterations`].
+    pub fn with_max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
+    }
+    /// Sets [`Self::rho_scale`].
+    pub fn with_rho_scale(mut self, rho_scale: f64) -> Self {
+        self.rho_scale = rho_scale;
+        self
     }
 }
 

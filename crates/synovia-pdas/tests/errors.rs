@@ -17,7 +17,7 @@ fn max_iterations_gives_no_convergence_with_history() {
     let needed =
         Pdas::default().solve(&p, &synovia_contact::SolveContext::new()).expect("pdas").report.iterations;
     assert!(needed > 1);
-    for s in solvers(ContactParams { max_iterations: 1, ..Default::default() }) {
+    for s in solvers(ContactParams::default().with_max_iterations(1)) {
         match s.solve(&p, &synovia_contact::SolveContext::new()) {
             Err(ContactError::NoConvergence { solver, iterations, history }) => {
                 println!("{solver}: {iterations} iteration(s), history {history:?}");
@@ -89,10 +89,10 @@ fn invalid_parameters_are_rejected() {
     let owned = tresca_2d();
     let p = owned.problem();
     let bad = [
-        ContactParams { rho_scale: 0.0, ..Default::default() },
-        ContactParams { rho_scale: f64::NAN, ..Default::default() },
-        ContactParams { tolerance: -1.0, ..Default::default() },
-        ContactParams { max_iterations: 0, ..Default::default() },
+        ContactParams::default().with_rho_scale(0.0),
+        ContactParams::default().with_rho_scale(f64::NAN),
+        ContactParams::default().with_tolerance(-1.0),
+        ContactParams::default().with_max_iterations(0),
     ];
     for params in bad {
         for s in solvers(params) {

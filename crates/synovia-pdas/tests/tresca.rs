@@ -72,7 +72,7 @@ fn rho_independence(owned: &OwnedProblem, label: &str) {
     let sols: Vec<ContactSolution> = [1e-2, 1.0, 1e2]
         .iter()
         .map(|&rho_scale| {
-            let s = Pdas { params: ContactParams { rho_scale, ..Default::default() } };
+            let s = Pdas { params: ContactParams::default().with_rho_scale(rho_scale) };
             solve_checked(owned, &s, &format!("{label}, rho_scale {rho_scale}"))
         })
         .collect();
@@ -107,7 +107,7 @@ fn au_pdas_agrees_with_pdas_3d() {
     let pdas = solve_checked(&owned, &Pdas::default(), "pdas 3D Tresca");
     // the explicit slip-direction update of AU-PDAS is a projected-gradient (Uzawa) step:
     // it needs a smaller ρ than PDAS in 3D (it cycles at rho_scale ≥ 0.5 on this problem)
-    let params = ContactParams { rho_scale: 0.2, ..Default::default() };
+    let params = ContactParams::default().with_rho_scale(0.2);
     let au = solve_checked(&owned, &AuPdas { params }, "au-pdas 3D Tresca (rho_scale 0.2)");
     assert_eq!(au.report.stick, pdas.report.stick);
     assert_eq!(au.report.slip, pdas.report.slip);
@@ -129,7 +129,7 @@ fn warm_start(owned: &OwnedProblem, solver: &dyn ContactSolver, label: &str) {
 
 #[test]
 fn warm_start_converges_in_one_iteration() {
-    let params = ContactParams { rho_scale: 0.2, ..Default::default() };
+    let params = ContactParams::default().with_rho_scale(0.2);
     let (two, three) = (tresca_2d(), tresca_3d());
     warm_start(&two, &Pdas::default(), "pdas 2D");
     warm_start(&three, &Pdas::default(), "pdas 3D");

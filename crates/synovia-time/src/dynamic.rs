@@ -181,6 +181,7 @@ pub enum MassKind {
 
 /// Parameters of the dynamic stepper (docs/model.md §7).
 #[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
 pub struct DynamicParams {
     /// Time step `Δt > 0`.
     pub dt: Real,
@@ -203,7 +204,55 @@ pub struct DynamicParams {
     pub warm_start: bool,
 }
 
+impl Default for DynamicParams {
+    /// The defaults with `Δt = 10⁻³` (set the time step of the problem with
+    /// [`DynamicParams::with_dt`] or use [`DynamicParams::new`]).
+    fn default() -> Self {
+        Self::new(1e-3)
+    }
+}
+
 impl DynamicParams {
+    /// Sets [`Self::dt`].
+    pub fn with_dt(mut self, dt: Real) -> Self {
+        self.dt = dt;
+        self
+    }
+    /// Sets [`Self::t0`].
+    pub fn with_t0(mut self, t0: Real) -> Self {
+        self.t0 = t0;
+        self
+    }
+    /// Sets [`Self::mass`].
+    pub fn with_mass(mut self, mass: MassKind) -> Self {
+        self.mass = mass;
+        self
+    }
+    /// Sets [`Self::ordering`].
+    pub fn with_ordering(mut self, ordering: OrderingChoice) -> Self {
+        self.ordering = ordering;
+        self
+    }
+    /// Sets [`Self::load_degree`].
+    pub fn with_load_degree(mut self, load_degree: usize) -> Self {
+        self.load_degree = load_degree;
+        self
+    }
+    /// Sets [`Self::coulomb_iterations`].
+    pub fn with_coulomb_iterations(mut self, coulomb_iterations: usize) -> Self {
+        self.coulomb_iterations = coulomb_iterations;
+        self
+    }
+    /// Sets [`Self::coulomb_tolerance`].
+    pub fn with_coulomb_tolerance(mut self, coulomb_tolerance: Real) -> Self {
+        self.coulomb_tolerance = coulomb_tolerance;
+        self
+    }
+    /// Sets [`Self::warm_start`].
+    pub fn with_warm_start(mut self, warm_start: bool) -> Self {
+        self.warm_start = warm_start;
+        self
+    }
     /// Defaults with the time step `dt`.
     pub fn new(dt: Real) -> Self {
         Self {

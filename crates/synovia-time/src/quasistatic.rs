@@ -102,6 +102,7 @@ use crate::results::{pair_records, write_csv, StepRecord};
 
 /// Parameters of the quasi-static stepper.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct QuasiStaticParams {
     /// Re-solve each level with `g_c = F_c |Λ_n|` of the current iterate until `g_c` stops
     /// changing (true Coulomb friction, docs/model.md §3). Default `false` (Tresca with `g_c` frozen
@@ -134,6 +135,31 @@ impl Default for QuasiStaticParams {
 }
 
 impl QuasiStaticParams {
+    /// Sets [`Self::coulomb_fixed_point`].
+    pub fn with_coulomb_fixed_point(mut self, coulomb_fixed_point: bool) -> Self {
+        self.coulomb_fixed_point = coulomb_fixed_point;
+        self
+    }
+    /// Sets [`Self::max_fixed_point`].
+    pub fn with_max_fixed_point(mut self, max_fixed_point: usize) -> Self {
+        self.max_fixed_point = max_fixed_point;
+        self
+    }
+    /// Sets [`Self::fixed_point_tolerance`].
+    pub fn with_fixed_point_tolerance(mut self, fixed_point_tolerance: Real) -> Self {
+        self.fixed_point_tolerance = fixed_point_tolerance;
+        self
+    }
+    /// Sets [`Self::incremental_slip`].
+    pub fn with_incremental_slip(mut self, incremental_slip: bool) -> Self {
+        self.incremental_slip = incremental_slip;
+        self
+    }
+    /// Sets [`Self::initial_friction`].
+    pub fn with_initial_friction(mut self, initial_friction: bool) -> Self {
+        self.initial_friction = initial_friction;
+        self
+    }
     /// Checks the parameters.
     ///
     /// # Errors

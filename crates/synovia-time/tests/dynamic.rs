@@ -23,7 +23,7 @@ fn sub(a: &[Real], b: &[Real]) -> Vec<Real> {
 }
 
 fn pdas() -> Pdas {
-    Pdas::new(ContactParams { tolerance: 1e-12, ..Default::default() })
+    Pdas::new(ContactParams::default().with_tolerance(1e-12))
 }
 
 /// Cantilever `[0, 4] × [0, 1]`, clamped on the left, with an initial velocity

@@ -19,7 +19,7 @@ use synovia_time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
 use synovia_time::results::StepRecord;
 
 fn pdas() -> Pdas {
-    Pdas::new(ContactParams { tolerance: 1e-13, max_iterations: 200, ..Default::default() })
+    Pdas::new(ContactParams::default().with_tolerance(1e-13).with_max_iterations(200))
 }
 
 /// Block `[0, 1] × [0, 0.25]` on the rigid flat `y = 0` (pair `"floor"`, coefficient `mu`), its
@@ -66,11 +66,7 @@ fn slip_rate_dependent_law_gives_the_friction_force_of_the_sliding_speed() {
     assert!((expected - (0.2 + 0.3 * (-2.0_f64).exp())).abs() < 1e-15);
     let (model, pairs) = dragged_block(v, delta, 0.0);
     for coulomb in [true, false] {
-        let params = QuasiStaticParams {
-            coulomb_fixed_point: coulomb,
-            fixed_point_tolerance: 1e-13,
-            ..Default::default()
-        };
+        let params = QuasiStaticParams::default().with_coulomb_fixed_point(coulomb).with_fixed_point_tolerance(1e-13);
         let (records, st) = run(&model, &pairs, params, Some(Arc::new(law)), 16);
         let last = records.last().unwrap();
         let p = &last.pairs[0];
@@ -100,7 +96,7 @@ fn constant_law_reproduces_the_pair_coefficient_bit_for_bit() {
     let mu = 0.3;
     let (model, pairs) = dragged_block(0.002, 2e-3, mu);
     for coulomb in [false, true] {
-        let params = QuasiStaticParams { coulomb_fixed_point: coulomb, ..Default::default() };
+        let params = QuasiStaticParams::default().with_coulomb_fixed_point(coulomb);
         let (plain, a) = run(&model, &pairs, params, None, 6);
         let (with_law, b) = run(&model, &pairs, params, Some(Arc::new(ConstantFriction(mu))), 6);
         // partial slip then sliding: friction is active
@@ -122,7 +118,7 @@ fn a_law_on_a_frictionless_pair_gives_it_friction_and_unknown_pairs_are_errors()
     let (plain, _) = run(&model, &pairs, QuasiStaticParams::default(), None, 4);
     assert!(plain.iter().all(|r| r.pairs[0].tangential_force == 0.0));
     let params =
-        QuasiStaticParams { coulomb_fixed_point: true, fixed_point_tolerance: 1e-13, ..Default::default() };
+        QuasiStaticParams::default().with_coulomb_fixed_point(true).with_fixed_point_tolerance(1e-13);
     let (with_law, _) = run(&model, &pairs, params, Some(Arc::new(ConstantFriction(0.4))), 6);
     let last = &with_law.last().unwrap().pairs[0];
     // sliding with Coulomb friction of a constant law: T = 0.4 N

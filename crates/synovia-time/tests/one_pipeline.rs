@@ -38,7 +38,7 @@ fn pressed_block() -> (Model<2>, Vec<ContactPair<2>>) {
 #[test]
 fn caller_matrix_and_load_reproduce_the_static_solve() {
     let (model, pairs) = pressed_block();
-    let solver = Pdas::new(ContactParams { tolerance: 1e-13, ..Default::default() });
+    let solver = Pdas::new(ContactParams::default().with_tolerance(1e-13));
     let statics = StaticContact::new(&model, &pairs, ElasticParams::default()).unwrap();
     let c0 = body_stiffnesses(&model).unwrap();
     let caller = StaticContact::with_system_matrix(&model, &pairs, ElasticParams::default(), |dofs, a| {

@@ -23,7 +23,7 @@ const E: Real = 1.0;
 const NU: Real = 0.3;
 
 fn pdas() -> Pdas {
-    Pdas::new(ContactParams { tolerance: 1e-12, max_iterations: 200, ..Default::default() })
+    Pdas::new(ContactParams::default().with_tolerance(1e-12).with_max_iterations(200))
 }
 
 /// The 2D Hertz set-up of `synovia_models::hertz::hertz2d_model`: the upper half-disc `"indenter"`
@@ -430,7 +430,7 @@ fn coulomb_fixed_point_converges_and_differs_slightly_from_frozen_tresca() {
         Ok((records, last))
     };
     let (tresca, tresca_last) = run(QuasiStaticParams::default()).expect("frozen Tresca");
-    let coulomb_params = QuasiStaticParams { coulomb_fixed_point: true, ..Default::default() };
+    let coulomb_params = QuasiStaticParams::default().with_coulomb_fixed_point(true);
     let (coulomb, coulomb_last) = run(coulomb_params).expect("Coulomb fixed point");
     let dl = rel_diff(&tresca_last.solution.lambda_n, &coulomb_last.solution.lambda_n);
     let (qt, qc) = (tresca[4].pairs[0].tangential_force, coulomb[4].pairs[0].tangential_force);
@@ -439,12 +439,7 @@ fn coulomb_fixed_point_converges_and_differs_slightly_from_frozen_tresca() {
     assert!(dl > 1e-8 && dl < 0.05, "ΔΛ_n = {dl}");
     assert!(dq > 1e-6 && dq < 0.1, "ΔQ/Q = {dq}");
     // one solve per level is not enough for a tight tolerance
-    let strict = QuasiStaticParams {
-        coulomb_fixed_point: true,
-        max_fixed_point: 1,
-        fixed_point_tolerance: 1e-12,
-        ..Default::default()
-    };
+    let strict = QuasiStaticParams::default().with_coulomb_fixed_point(true).with_max_fixed_point(1).with_fixed_point_tolerance(1e-12);
     match run(strict) {
         Err(TimeError::FixedPoint { step, iterations, change }) => {
             println!("max_fixed_point = 1: FixedPoint at step {step}, change {change:.2e}");
@@ -531,12 +526,12 @@ fn csv_and_pvd_series_are_written_and_read_back() {
 #[test]
 fn invalid_inputs_are_reported() {
     let (model, pairs) = half_discs(4, Constant(0.01), Constant(0.0), false, 0.2);
-    let bad = QuasiStaticParams { max_fixed_point: 0, ..Default::default() };
+    let bad = QuasiStaticParams::default().with_max_fixed_point(0);
     assert!(matches!(
         QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), bad),
         Err(TimeError::InvalidParameter(_))
     ));
-    let bad = QuasiStaticParams { fixed_point_tolerance: f64::NAN, ..Default::default() };
+    let bad = QuasiStaticParams::default().with_fixed_point_tolerance(f64::NAN);
     assert!(matches!(
         QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), bad),
         Err(TimeError::InvalidParameter(_))
@@ -575,7 +570,7 @@ fn slip_origin_and_initial_friction_options() {
     let times = [0.0, 0.5, 1.0, 2.0, 3.0, 4.0];
     let solver = pdas();
     let run = |incremental_slip: bool| -> (Vec<StepRecord>, Vec<Vec<Real>>) {
-        let params = QuasiStaticParams { incremental_slip, ..Default::default() };
+        let params = QuasiStaticParams::default().with_incremental_slip(incremental_slip);
         let mut stepper =
             QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), params).expect("stepper");
         let mut us = Vec::new();
@@ -605,7 +600,7 @@ fn slip_origin_and_initial_friction_options() {
     // initial friction on a rigid flat: the Poisson expansion of the indenter slips at the edges
     let (model, pairs) = half_discs(7, Constant(0.01), Constant(0.0), false, mu);
     let params =
-        QuasiStaticParams { initial_friction: true, coulomb_fixed_point: true, ..Default::default() };
+        QuasiStaticParams::default().with_initial_friction(true).with_coulomb_fixed_point(true);
     let mut stepper =
         QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), params).expect("stepper");
     let mut cells = Vec::new();
@@ -676,8 +671,8 @@ fn stepping_one_level_at_a_time_is_bit_identical_to_run() {
     let times = [0.5, 1.0, 1.5, 2.0, 2.5, 3.0];
     for params in [
         QuasiStaticParams::default(),
-        QuasiStaticParams { coulomb_fixed_point: true, initial_friction: true, ..Default::default() },
-        QuasiStaticParams { incremental_slip: false, ..Default::default() },
+        QuasiStaticParams::default().with_coulomb_fixed_point(true).with_initial_friction(true),
+        QuasiStaticParams::default().with_incremental_slip(false),
     ] {
         let solver = pdas();
         let mut runner =

@@ -161,6 +161,7 @@ impl ConvexBlock {
 
 /// Options of [`mprgp`] and [`mpgp`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
 pub struct QpOptions {
     /// Relative tolerance `ε`: stop when `‖g^P‖ ≤ ε ‖b‖` (default `1e-10`).
     pub tolerance: f64,
@@ -193,6 +194,49 @@ impl Default for QpOptions {
             power_iterations: 20,
             precondition: true,
         }
+    }
+}
+
+impl QpOptions {
+    /// Sets [`Self::tolerance`].
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+    /// Sets [`Self::absolute_tolerance`].
+    pub fn with_absolute_tolerance(mut self, absolute_tolerance: f64) -> Self {
+        self.absolute_tolerance = absolute_tolerance;
+        self
+    }
+    /// Sets [`Self::max_iterations`].
+    pub fn with_max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
+    }
+    /// Sets [`Self::gamma`].
+    pub fn with_gamma(mut self, gamma: f64) -> Self {
+        self.gamma = gamma;
+        self
+    }
+    /// Sets [`Self::step_factor`].
+    pub fn with_step_factor(mut self, step_factor: f64) -> Self {
+        self.step_factor = step_factor;
+        self
+    }
+    /// Sets [`Self::hessian_norm`].
+    pub fn with_hessian_norm(mut self, hessian_norm: Option<f64>) -> Self {
+        self.hessian_norm = hessian_norm;
+        self
+    }
+    /// Sets [`Self::power_iterations`].
+    pub fn with_power_iterations(mut self, power_iterations: usize) -> Self {
+        self.power_iterations = power_iterations;
+        self
+    }
+    /// Sets [`Self::precondition`].
+    pub fn with_precondition(mut self, precondition: bool) -> Self {
+        self.precondition = precondition;
+        self
     }
 }
 

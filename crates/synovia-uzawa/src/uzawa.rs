@@ -83,7 +83,7 @@ pub struct UzawaMprgp {
 impl Default for UzawaMprgp {
     fn default() -> Self {
         Self {
-            params: ContactParams { max_iterations: 2000, ..ContactParams::default() },
+            params: ContactParams::default().with_max_iterations(2000),
             inner_tolerance: 1e-12,
             max_inner: 2000,
         }

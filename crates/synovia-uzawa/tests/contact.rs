@@ -26,7 +26,7 @@ fn problem(dim: usize, friction: bool) -> OwnedProblem {
 }
 
 fn params(tolerance: f64) -> ContactParams {
-    ContactParams { tolerance, max_iterations: 2000, rho_scale: 1.0 }
+    ContactParams::default().with_tolerance(tolerance).with_max_iterations(2000).with_rho_scale(1.0)
 }
 
 fn uzawa(tolerance: f64) -> UzawaMprgp {
@@ -158,7 +158,7 @@ fn too_few_iterations_is_no_convergence() {
     for dim in [2, 3] {
         let owned = problem(dim, true);
         let p = owned.problem();
-        let few = ContactParams { tolerance: 1e-12, max_iterations: 3, rho_scale: 1.0 };
+        let few = ContactParams::default().with_tolerance(1e-12).with_max_iterations(3).with_rho_scale(1.0);
         let solvers: [Box<dyn ContactSolver>; 2] = [
             Box::new(DualMprgp { params: few }),
             Box::new(UzawaMprgp { params: few, inner_tolerance: 1e-12, max_inner: 100 }),
@@ -183,7 +183,7 @@ fn too_few_iterations_is_no_convergence() {
 fn invalid_parameters_and_warm_starts() {
     let owned = problem(2, true);
     let p = owned.problem();
-    let bad = ContactParams { tolerance: 0.0, ..ContactParams::default() };
+    let bad = ContactParams::default().with_tolerance(0.0);
     assert!(matches!(
         DualMprgp { params: bad }.solve(&p, &synovia_contact::SolveContext::new()),
         Err(ContactError::InvalidParameter(_))

@@ -124,7 +124,7 @@ fn mprgp_random_spd_against_kkt() {
                 (0..n).map(|i| if i % 5 == 0 { -INF } else { -0.5 + 0.3 * rng.next() }).collect();
             let u: Vec<f64> = (0..n).map(|i| if i % 7 == 0 { INF } else { 0.5 + 0.3 * rng.next() }).collect();
             let mut x = vec![0.0; n];
-            let opts = QpOptions { tolerance: 1e-11, precondition, ..QpOptions::default() };
+            let opts = QpOptions::default().with_tolerance(1e-11).with_precondition(precondition);
             let rep = mprgp(&mut DenseHessian(h.clone()), &b, &l, &u, &mut x, &opts).expect("mprgp");
             let kkt = box_kkt(&h, &b, &l, &u, &x);
             println!(
@@ -165,7 +165,7 @@ fn mpgp_random_spd_with_discs_and_half_lines() {
         let mut blocks = vec![ConvexBlock::Interval { lower: 0.0, upper: INF }; nh];
         blocks.extend(std::iter::repeat_n(ConvexBlock::Ball { dim: 2, radius: 0.8 }, nd));
         let mut x = vec![0.0; n];
-        let opts = QpOptions { tolerance: 1e-11, ..QpOptions::default() };
+        let opts = QpOptions::default().with_tolerance(1e-11);
         let rep = mpgp(&mut DenseHessian(h.clone()), &b, &blocks, &mut x, &opts).expect("mpgp");
         let g = gradient(&h, &x, &b);
         let scale = b.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -214,7 +214,7 @@ fn mpgp_with_intervals_matches_mprgp() {
     let u = vec![0.2; n];
     let blocks: Vec<ConvexBlock> =
         l.iter().zip(&u).map(|(&lower, &upper)| ConvexBlock::Interval { lower, upper }).collect();
-    let opts = QpOptions { tolerance: 1e-12, ..QpOptions::default() };
+    let opts = QpOptions::default().with_tolerance(1e-12);
     let mut x1 = vec![0.0; n];
     let mut x2 = vec![0.0; n];
     mprgp(&mut DenseHessian(h.clone()), &b, &l, &u, &mut x1, &opts).expect("mprgp");
@@ -250,7 +250,7 @@ fn qp_errors() {
         mprgp(&mut DenseHessian(h.clone()), &[1.0, 1.0], &[0.0], &[1.0, 1.0], &mut x, &QpOptions::default());
     assert!(matches!(e, Err(ContactError::InvalidParameter(_))), "{e:?}");
     // step factor outside (0, 2]
-    let opts = QpOptions { step_factor: 2.5, ..QpOptions::default() };
+    let opts = QpOptions::default().with_step_factor(2.5);
     let e = mprgp(&mut DenseHessian(h.clone()), &[1.0, 1.0], &[0.0; 2], &[1.0; 2], &mut x, &opts);
     assert!(matches!(e, Err(ContactError::InvalidParameter(_))), "{e:?}");
     // unbounded below: a zero-curvature descent ray inside the feasible set
@@ -277,7 +277,7 @@ fn qp_errors() {
     let h = random_spd(20, &mut rng);
     let b: Vec<f64> = (0..20).map(|_| rng.next()).collect();
     let mut x = vec![0.0; 20];
-    let opts = QpOptions { max_iterations: 3, ..QpOptions::default() };
+    let opts = QpOptions::default().with_max_iterations(3);
     match mprgp(&mut DenseHessian(h), &b, &[-INF; 20], &[INF; 20], &mut x, &opts) {
         Err(ContactError::NoConvergence { solver, iterations, history }) => {
             assert_eq!(solver, "mprgp");
