@@ -68,7 +68,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let glass = PlaneObstacle::new(Point::<2>::zeros(), Vector::<2>::new(0.0, 1.0))?;
     joint.contact_rigid("glass", plug, "bottom", glass, 0.0)?;
     joint.friction_law("glass", Arc::new(law))?;
-    joint.quasistatic_params(QuasiStaticParams::default().with_coulomb_fixed_point(true).with_fixed_point_tolerance(1e-13));
+    joint.quasistatic_params(
+        QuasiStaticParams::default().with_coulomb_fixed_point(true).with_fixed_point_tolerance(1e-13),
+    );
     joint.contact_params(ContactParams::default().with_tolerance(1e-13).with_max_iterations(200));
 
     let times: Vec<Real> = (0..levels).map(|i| i as Real * dt).collect();

@@ -37,9 +37,10 @@
 //! **Friction on the slip rate** (docs/model.md §3): the rate form `j(w) = ∫ g_c |[w_t]| ds` in the
 //! velocity `w = (v − U^i)/Δt`, tested with `(v − U^{i+1})/Δt` and multiplied by `Δt²`
 //! (`j` is positively homogeneous), becomes `Δt² ∫ g_c |[v_t − U^i_t]| ds` in the step problem
-//! with the *physical* slip bound `g_c = F_c(|[u'_t]|) |λ_n|` (force per area). The spec's
-//! `j(v) = Δt ∫ g_c |[v_t − U^i_t]| ds` has one power of `Δt` too few for a `g_c` in force per
-//! area (check the units: every term of the step problem is `kg·m²`); synovia uses the slip
+//! with the *physical* slip bound `g_c = F_c(|[u'_t]|) |λ_n|` (force per area). The report's
+//! Part II (2.16), (2.19) carries the same `Δt²`; a single `Δt` would be one power too few for
+//! a `g_c` in force per area (check the units: every term of the step problem is `kg·m²`;
+//! docs/model.md (7.7)). synovia uses the slip
 //! bound `ḡ_c = Δt² g_c = F_c(|[u'_t]|^i) |Λ̄_n^i|` in the step problem, i.e. the Coulomb law with the scaled pressure of level `i`. The deceleration of a
 //! sliding block (`μ g`, see the tests) confirms the scaling. The slip speed `|[u'_t]|^i` is
 //! `|[U^i_t] − [U^{i−1}_t]| / Δt` at each contact node ([`slip_speeds`]) and the law `F_c` is any

@@ -66,7 +66,8 @@ fn slip_rate_dependent_law_gives_the_friction_force_of_the_sliding_speed() {
     assert!((expected - (0.2 + 0.3 * (-2.0_f64).exp())).abs() < 1e-15);
     let (model, pairs) = dragged_block(v, delta, 0.0);
     for coulomb in [true, false] {
-        let params = QuasiStaticParams::default().with_coulomb_fixed_point(coulomb).with_fixed_point_tolerance(1e-13);
+        let params =
+            QuasiStaticParams::default().with_coulomb_fixed_point(coulomb).with_fixed_point_tolerance(1e-13);
         let (records, st) = run(&model, &pairs, params, Some(Arc::new(law)), 16);
         let last = records.last().unwrap();
         let p = &last.pairs[0];

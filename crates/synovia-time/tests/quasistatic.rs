@@ -439,7 +439,10 @@ fn coulomb_fixed_point_converges_and_differs_slightly_from_frozen_tresca() {
     assert!(dl > 1e-8 && dl < 0.05, "ΔΛ_n = {dl}");
     assert!(dq > 1e-6 && dq < 0.1, "ΔQ/Q = {dq}");
     // one solve per level is not enough for a tight tolerance
-    let strict = QuasiStaticParams::default().with_coulomb_fixed_point(true).with_max_fixed_point(1).with_fixed_point_tolerance(1e-12);
+    let strict = QuasiStaticParams::default()
+        .with_coulomb_fixed_point(true)
+        .with_max_fixed_point(1)
+        .with_fixed_point_tolerance(1e-12);
     match run(strict) {
         Err(TimeError::FixedPoint { step, iterations, change }) => {
             println!("max_fixed_point = 1: FixedPoint at step {step}, change {change:.2e}");
@@ -599,8 +602,7 @@ fn slip_origin_and_initial_friction_options() {
 
     // initial friction on a rigid flat: the Poisson expansion of the indenter slips at the edges
     let (model, pairs) = half_discs(7, Constant(0.01), Constant(0.0), false, mu);
-    let params =
-        QuasiStaticParams::default().with_initial_friction(true).with_coulomb_fixed_point(true);
+    let params = QuasiStaticParams::default().with_initial_friction(true).with_coulomb_fixed_point(true);
     let mut stepper =
         QuasiStaticStepper::new(&model, &pairs, ElasticParams::default(), params).expect("stepper");
     let mut cells = Vec::new();
