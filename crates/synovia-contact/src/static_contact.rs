@@ -644,7 +644,7 @@ impl<const D: usize> Solved<D> {
 }
 
 /// Every node of the contact parts of `pairs` (both sides), each once: the dofs that
-/// [`ElasticSolver::new_for_contact`] orders last. Priority order (what a trailing block too
+/// [`StaticContact::with_interface_block`] orders last ([`InterfaceBlockParams`]). Priority order (what a trailing block too
 /// small for all of them keeps): the contact nodes of `geometry` by increasing initial gap,
 /// each with its partner and master nodes, then the remaining nodes of the parts.
 fn interface_nodes<const D: usize>(
