@@ -13,10 +13,10 @@
 //! - **row solves** of the dense interface block shared between interfaces with rows in
 //!   common ([`BlockSolveStore`]).
 //!
-//! Caches never grow without bound: the columns kept between solves and the row solves each
-//! hold at most half of the context's memory budget ([`SolveContext::with_memory_budget`],
-//! default [`SolveContext::DEFAULT_MEMORY_BUDGET`]); the load subspace keeps a fixed number of
-//! directions. A navigation loop may call a solve millions of times on one context.
+//! Caches never grow without bound: the columns kept between solves hold at most half of the
+//! context's memory budget and the row solves a quarter ([`SolveContext::with_memory_budget`],
+//! default [`SolveContext::DEFAULT_MEMORY_BUDGET`]: 1 GiB and 512 MiB); the load subspace
+//! keeps a fixed number of directions. A navigation loop may call a solve millions of times on one context.
 
 use std::sync::{Arc, Mutex};
 
@@ -65,7 +65,7 @@ impl SolveContext {
         Self::default()
     }
     /// An empty context whose caches hold at most `bytes` (half for the kept columns of `S`,
-    /// half for the row solves; the recycled load solves keep
+    /// a quarter for the row solves; the recycled load solves keep
     /// [`Self::RECYCLED_LOADS`] directions besides).
     pub fn with_memory_budget(bytes: usize) -> Self {
         Self {
@@ -74,7 +74,7 @@ impl SolveContext {
             load_solution: None,
             columns: Arc::default(),
             load: Arc::default(),
-            row_solves: Arc::new(BlockSolveStore::with_budget(bytes / 2)),
+            row_solves: Arc::new(BlockSolveStore::with_budget(bytes / 4)),
             recycled: Arc::new(Mutex::new(LoadSubspace::new(Self::RECYCLED_LOADS))),
             memory_budget: bytes,
         }
