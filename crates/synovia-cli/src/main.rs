@@ -1,7 +1,7 @@
 //! `synovia`: run joint-contact scenarios described in TOML files (`docs/scenario.md`).
 //!
 //! ```text
-//! synovia run SCENARIO.toml --out DIR    # solve; write DIR/NAME.pvd, NAME_*.vtu, NAME.csv, summary.json
+//! synovia run SCENARIO.toml --out DIR    # solve; write DIR/NAME.pvd, NAME_*.vtu, NAME.csv, summary.json, manifest.json
 //! synovia check SCENARIO.toml            # read and build the model without solving
 //! ```
 //!
