@@ -165,6 +165,7 @@ fn an_interrupted_run_leaves_a_consistent_folder() {
     assert_eq!(vtus, ["mix_0000.vtu", "mix_0001.vtu"]);
 }
 
+#[cfg(unix)]
 #[test]
 fn sigint_stops_after_the_current_step() {
     let dir = tmp("sigint");
