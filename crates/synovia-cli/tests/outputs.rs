@@ -238,3 +238,30 @@ fn foreign_files_refuse_the_run_unless_forced_and_are_kept() {
     assert_eq!(s["steps"].as_array().unwrap().len(), 3);
     assert_eq!(std::fs::read_to_string(out.join("notes.txt")).unwrap(), "mine");
 }
+
+#[test]
+fn library_interrupt_flag_and_refusal() {
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+    use synovia_cli::run::{run_with_options, RunError, RunOptions};
+    let dir = tmp("library");
+    let out = dir.join("out");
+    let sc = synovia_cli::Scenario::from_file(scenario(&dir, 3)).unwrap();
+    // a flag raised before the run stops it after its first step
+    let options = RunOptions { force: false, interrupt: Some(Arc::new(AtomicBool::new(true))) };
+    let mut seen = Vec::new();
+    let report = run_with_options(&sc, Some(&out), &options, &mut |p| seen.push(p)).unwrap();
+    assert!(report.summary.interrupted);
+    assert_eq!((report.summary.steps.len(), report.summary.steps_planned), (1, 4));
+    assert_eq!(seen.len(), 2, "{seen:?}");
+    let (m, _) = consistent(&out, &[]);
+    assert_eq!(m["status"], "interrupted");
+    // a foreign file: refused (not a solve failure), accepted with force
+    std::fs::write(out.join("report.pdf"), "x").unwrap();
+    let err = run_with_options(&sc, Some(&out), &RunOptions::default(), &mut |_| {}).unwrap_err();
+    assert!(matches!(&err, RunError::Refused(m) if m.contains("report.pdf")), "{err}");
+    let forced = RunOptions { force: true, interrupt: None };
+    let report = run_with_options(&sc, Some(&out), &forced, &mut |_| {}).unwrap();
+    assert!(!report.summary.interrupted && report.summary.steps.len() == 4);
+    consistent(&out, &["report.pdf"]);
+}
