@@ -1,20 +1,27 @@
 //! `synovia`: run joint-contact scenarios described in TOML files (`docs/scenario.md`).
 //!
 //! ```text
-//! synovia run SCENARIO.toml --out DIR    # solve; write DIR/NAME.pvd, NAME_*.vtu, NAME.csv, summary.json
+//! synovia run SCENARIO.toml --out DIR    # solve; write DIR/NAME.pvd, NAME_*.vtu, NAME.csv, summary.json, manifest.json
 //! synovia check SCENARIO.toml            # read and build the model without solving
 //! ```
 //!
 //! Exit codes: 0 success, 1 the solve or the output failed, 2 a broken scenario (the message on
-//! stderr names the key and the line:column) or bad command-line arguments.
+//! stderr names the key and the line:column), bad command-line arguments, or an output
+//! directory holding files no earlier run wrote (without `--force`), 130 interrupted (Ctrl-C,
+//! SIGTERM: the folder then holds the steps done, with `"interrupted": true` in summary.json).
+//!
+//! For tests, the environment variable `SYNOVIA_STOP_AFTER_STEPS=N` raises the interrupt flag
+//! once `N` steps are done, exactly as Ctrl-C would then.
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use synovia_cli::run::{self, Progress, RunError};
+use synovia_cli::run::{self, Progress, RunError, RunOptions};
 use synovia_cli::Scenario;
 
 #[derive(Parser)]
@@ -36,6 +43,10 @@ enum Command {
         /// No progress bar and no closing report.
         #[arg(long, short)]
         quiet: bool,
+        /// Write into an output directory that holds files no earlier run wrote (they are
+        /// kept; the outputs of earlier runs are always replaced).
+        #[arg(long)]
+        force: bool,
     },
     /// Read a scenario and build its model (meshes, materials, conditions) without solving.
     Check {
@@ -72,7 +83,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Run { scenario, out, quiet } => {
+        Command::Run { scenario, out, quiet, force } => {
             let sc = match Scenario::from_file(&scenario) {
                 Ok(sc) => sc,
                 Err(e) => {
@@ -91,15 +102,42 @@ fn main() -> ExitCode {
             ) {
                 bar.set_style(style);
             }
-            let result = run::run(&sc, out.as_deref(), &mut |p| match p {
+            // Ctrl-C / SIGTERM: stop after the current step with a consistent folder; a second
+            // signal exits at once
+            let interrupt = Arc::new(AtomicBool::new(false));
+            let flag = Arc::clone(&interrupt);
+            if let Err(e) = ctrlc::set_handler(move || {
+                if flag.swap(true, Ordering::SeqCst) {
+                    std::process::exit(130);
+                }
+            }) {
+                eprintln!("warning: cannot catch Ctrl-C ({e}); an interrupted run leaves partial results");
+            }
+            let stop_after =
+                std::env::var("SYNOVIA_STOP_AFTER_STEPS").ok().and_then(|v| v.parse::<usize>().ok());
+            let options = RunOptions { force, interrupt: Some(Arc::clone(&interrupt)) };
+            let result = run::run_with_options(&sc, out.as_deref(), &options, &mut |p| match p {
                 Progress::Start { steps } => bar.set_length(steps as u64),
                 Progress::Step { index, time } => {
                     bar.set_message(format!("t = {time:.4e}"));
                     bar.set_position(index as u64 + 1);
+                    if stop_after.is_some_and(|n| index + 1 >= n) {
+                        interrupt.store(true, Ordering::SeqCst);
+                    }
                 }
             });
             bar.finish_and_clear();
             match result {
+                Ok(report) if report.summary.interrupted => {
+                    let s = &report.summary;
+                    eprintln!(
+                        "interrupted after {} of {} steps; {} holds their results (summary.json has \"interrupted\": true)",
+                        s.steps.len(),
+                        s.steps_planned,
+                        report.out_dir.display()
+                    );
+                    ExitCode::from(130)
+                }
                 Ok(report) => {
                     if !quiet {
                         let s = &report.summary;
@@ -128,8 +166,13 @@ fn main() -> ExitCode {
                         }
                         println!("  {}  (one row per step)", s.files.csv);
                         println!("  summary.json");
+                        println!("  {}  (every file written, with its size)", s.files.manifest);
                     }
                     ExitCode::SUCCESS
+                }
+                Err(RunError::Refused(e)) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
                 }
                 Err(RunError::Scenario(e)) => {
                     eprintln!("error: {e}");

@@ -2,6 +2,9 @@
 //! the per-step CSV and `summary.json`.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
 
 use serde::Serialize;
 use synovia::builder::JointError;
@@ -9,6 +12,7 @@ use synovia::time::quasistatic::QuasiStaticOutput;
 use synovia::time::results::{write_csv, StepRecord};
 
 use crate::build::{build, Built};
+use crate::outdir::{OutDir, MANIFEST, SUMMARY};
 use crate::scenario::{Scenario, ScenarioError};
 
 /// Why a run failed.
@@ -17,6 +21,10 @@ pub enum RunError {
     /// The scenario is broken (with its key and position).
     #[error("{0}")]
     Scenario(#[from] ScenarioError),
+    /// The output directory holds files no earlier run wrote and `force` was not given
+    /// ([`crate::outdir`]).
+    #[error("{0}")]
+    Refused(String),
     /// The model is valid but solving or writing failed.
     #[error("{0}")]
     Failed(#[from] anyhow::Error),
@@ -106,6 +114,8 @@ pub struct FilesSummary {
     pub csv: String,
     /// Number of `.vtu` files.
     pub vtu: usize,
+    /// The manifest of every file written (`manifest.json`, written last).
+    pub manifest: String,
 }
 
 /// `summary.json`.
@@ -139,6 +149,22 @@ pub struct Summary {
     pub steps: Vec<StepSummary>,
     /// Files written.
     pub files: FilesSummary,
+    /// `true` when the run was interrupted (Ctrl-C, SIGTERM, [`RunOptions::interrupt`]):
+    /// `steps` holds the steps done, and the files are those of these steps.
+    pub interrupted: bool,
+    /// Steps the analysis would have produced (`steps.len()` unless interrupted).
+    pub steps_planned: usize,
+}
+
+/// Options of [`run_with_options`].
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Write into an output directory that holds files no earlier run wrote (they are kept);
+    /// without it the run is refused ([`RunError::Refused`]).
+    pub force: bool,
+    /// Checked after every step: once `true`, the run stops there and writes a consistent
+    /// folder (`summary.json` with `"interrupted": true`).
+    pub interrupt: Option<Arc<AtomicBool>>,
 }
 
 /// What a successful run wrote.
@@ -205,22 +231,41 @@ pub fn check(sc: &Scenario) -> Result<ModelInfo, ScenarioError> {
 }
 
 /// Runs a scenario and writes its results to `out` (default: `output.dir` of the scenario, or
-/// `out/NAME`), calling `progress` as it goes.
+/// `out/NAME`), calling `progress` as it goes; [`run_with_options`] with the default options
+/// (no `force`, no interrupt flag).
 ///
 /// # Errors
-/// [`RunError::Scenario`] for a broken scenario, [`RunError::Failed`] when solving or writing
-/// fails.
+/// As [`run_with_options`].
 pub fn run(
     sc: &Scenario,
     out: Option<&Path>,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunReport, RunError> {
-    match dimension(sc)? {
-        2 => run_dim::<2>(sc, out, progress),
-        _ => run_dim::<3>(sc, out, progress),
-    }
+    run_with_options(sc, out, &RunOptions::default(), progress)
 }
 
+/// Runs a scenario and writes its results to `out` (default: `output.dir` of the scenario, or
+/// `out/NAME`), calling `progress` as it goes.
+///
+/// The folder is first cleared of what an earlier run wrote ([`crate::outdir`]); every file
+/// is written under a temporary name and renamed into place; `manifest.json`, written last,
+/// lists every file with its size. When `options.interrupt` becomes `true` the run stops after
+/// the current step and returns `Ok` with [`Summary::interrupted`] set.
+///
+/// # Errors
+/// [`RunError::Scenario`] for a broken scenario, [`RunError::Refused`] for an output folder
+/// with foreign files (without `force`), [`RunError::Failed`] when solving or writing fails.
+pub fn run_with_options(
+    sc: &Scenario,
+    out: Option<&Path>,
+    options: &RunOptions,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunReport, RunError> {
+    match dimension(sc)? {
+        2 => run_dim::<2>(sc, out, options, progress),
+        _ => run_dim::<3>(sc, out, options, progress),
+    }
+}
 fn file_name(p: &Path) -> String {
     p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
 }
@@ -253,11 +298,18 @@ fn step_summary(record: &StepRecord, vtu: Option<String>) -> StepSummary {
     }
 }
 
+/// The observer's error when the interrupt flag is seen.
+#[derive(Debug, thiserror::Error)]
+#[error("interrupted")]
+struct Interrupted;
+
 fn run_dim<const D: usize>(
     sc: &Scenario,
     out: Option<&Path>,
+    options: &RunOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunReport, RunError> {
+    let start = Instant::now();
     let built = build::<D>(sc)?;
     let name = built.name.clone();
     let out_dir = match (out, &built.output.dir) {
@@ -265,49 +317,92 @@ fn run_dim<const D: usize>(
         (None, Some(d)) => d.clone(),
         (None, None) => PathBuf::from("out").join(&name),
     };
-    std::fs::create_dir_all(&out_dir)
-        .map_err(|e| anyhow::anyhow!("cannot create the output directory `{}`: {e}", out_dir.display()))?;
+    let mut folder = OutDir::prepare(&out_dir, &sc.source.file, &name, options.force)?;
     let plan = built.output.clone();
     let n_steps = built.analysis.n_records();
     progress(Progress::Start { steps: n_steps });
     let mut writer: Option<QuasiStaticOutput<D>> = None;
     let mut steps: Vec<StepSummary> = Vec::with_capacity(n_steps);
-    let result = built
-        .joint
-        .run_with(|view| {
-            let index = steps.len();
-            let vtu = if plan.vtu_every > 0 && (index % plan.vtu_every == 0 || index + 1 == view.n_steps) {
-                if writer.is_none() {
-                    writer = Some(QuasiStaticOutput::with_encoding(
-                        &out_dir,
-                        &name,
-                        view.geometry,
-                        plan.encoding,
-                    )?);
+    let mut records: Vec<StepRecord> = Vec::with_capacity(n_steps);
+    let mut contact_nodes = 0;
+    let mut first_step_at: Option<f64> = None;
+    let mut interrupted = false;
+    let result = built.joint.run_with(|view| {
+        let index = steps.len();
+        if first_step_at.is_none() {
+            first_step_at = Some(start.elapsed().as_secs_f64() - view.record.step_s);
+            contact_nodes = view.geometry.len();
+        }
+        let vtu = if plan.vtu_every > 0 && (index % plan.vtu_every == 0 || index + 1 == view.n_steps) {
+            if writer.is_none() {
+                writer = Some(QuasiStaticOutput::with_encoding(
+                    folder.dir(),
+                    &name,
+                    view.geometry,
+                    plan.encoding,
+                )?);
+            }
+            match writer.as_mut() {
+                Some(w) => {
+                    // the .vtu first, then the .pvd that lists it (both atomic), then the
+                    // manifest that explains both
+                    let file = file_name(&w.write_step(view.model, view.record, view.result)?);
+                    folder.record(&file);
+                    folder.record(&file_name(w.pvd_path()));
+                    folder.write_manifest("running").map_err(|e| JointError::Observer(e.into()))?;
+                    Some(file)
                 }
-                match writer.as_mut() {
-                    Some(w) => Some(file_name(&w.write_step(view.model, view.record, view.result)?)),
-                    None => None,
-                }
-            } else {
-                None
-            };
-            steps.push(step_summary(view.record, vtu));
-            progress(Progress::Step { index, time: view.record.time });
-            Ok::<(), JointError>(())
-        })
-        .map_err(|e| anyhow::Error::new(e).context(format!("running `{}`", sc.source.file)))?;
-    let csv = out_dir.join(format!("{name}.csv"));
-    write_csv(&csv, &result.records).map_err(anyhow::Error::new)?;
+                None => None,
+            }
+        } else {
+            None
+        };
+        steps.push(step_summary(view.record, vtu));
+        records.push(view.record.clone());
+        progress(Progress::Step { index, time: view.record.time });
+        let stop = options.interrupt.as_ref().is_some_and(|f| f.load(Ordering::SeqCst));
+        if stop && index + 1 < view.n_steps {
+            interrupted = true;
+            return Err(JointError::Observer(Box::new(Interrupted)));
+        }
+        Ok::<(), JointError>(())
+    });
+    let (solver, dofs, setup_s, total_s) = match result {
+        Ok(r) => {
+            records = r.records;
+            contact_nodes = r.contact_nodes;
+            (r.solver, r.n_dofs, r.setup_s, r.total_s)
+        }
+        Err(_) if interrupted => {
+            let dofs = synovia::fem::dofs::DofMap::new(built.joint.model()).map_or(0, |m| m.n_dofs());
+            let setup = first_step_at.unwrap_or(0.0).max(0.0);
+            (built.joint.solver_name().to_string(), dofs, setup, start.elapsed().as_secs_f64())
+        }
+        Err(e) => {
+            // keep the folder explained: what was written before the failure
+            let _ = folder.write_manifest("failed");
+            return Err(RunError::Failed(
+                anyhow::Error::new(e).context(format!("running `{}`", sc.source.file)),
+            ));
+        }
+    };
+    let csv = format!("{name}.csv");
+    let csv_tmp = out_dir.join(format!("{csv}.tmp"));
+    write_csv(&csv_tmp, &records).map_err(anyhow::Error::new)?;
+    std::fs::rename(&csv_tmp, out_dir.join(&csv)).map_err(|e| {
+        let _ = std::fs::remove_file(&csv_tmp);
+        anyhow::anyhow!("cannot write `{}`: {e}", out_dir.join(&csv).display())
+    })?;
+    folder.record(&csv);
     let summary = Summary {
         scenario: sc.source.file.clone(),
         name: name.clone(),
         title: sc.doc.title.clone(),
         dimension: D,
         analysis: built.analysis.kind().to_string(),
-        solver: result.solver.clone(),
-        dofs: result.n_dofs,
-        contact_nodes: result.contact_nodes,
+        solver,
+        dofs,
+        contact_nodes,
         bodies: built
             .joint
             .model()
@@ -316,18 +411,20 @@ fn run_dim<const D: usize>(
             .map(|b| BodySummary { name: b.name.clone(), nodes: b.mesh.n_nodes(), cells: b.mesh.n_cells() })
             .collect(),
         pairs: built.joint.pairs().iter().map(|p| p.name.clone()).collect(),
-        setup_s: result.setup_s,
-        total_s: result.total_s,
+        setup_s,
+        total_s,
         files: FilesSummary {
             pvd: writer.as_ref().map(|w| file_name(w.pvd_path())),
-            csv: file_name(&csv),
+            csv,
             vtu: steps.iter().filter(|s| s.vtu.is_some()).count(),
+            manifest: MANIFEST.to_string(),
         },
         steps,
+        interrupted,
+        steps_planned: n_steps,
     };
     let json = serde_json::to_string_pretty(&summary).map_err(anyhow::Error::new)?;
-    let path = out_dir.join("summary.json");
-    std::fs::write(&path, json + "\n")
-        .map_err(|e| anyhow::anyhow!("cannot write `{}`: {e}", path.display()))?;
+    folder.write(SUMMARY, (json + "\n").as_bytes())?;
+    folder.write_manifest(if interrupted { "interrupted" } else { "complete" })?;
     Ok(RunReport { summary, out_dir })
 }
