@@ -10,6 +10,9 @@ use synovia_uzawa::DualMprgp;
 /// Names accepted by [`by_name`] for the four basic solvers.
 pub const SOLVER_NAMES: &[&str] = &["pdas", "au-pdas", "uzawa-mprgp", "dual-mprgp"];
 
+/// The solver a new [`crate::builder::JointModel`] uses (and the CLI/scenario default).
+pub const DEFAULT_SOLVER: &str = "pdas";
+
 /// Further names accepted by [`by_name`]: combinators of the basic solvers ([`PdasFallback`]).
 pub const COMBINATOR_NAMES: &[&str] = &["pdas-fallback"];
 
