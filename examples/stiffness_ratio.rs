@@ -71,7 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut default_worst_force = 0.0_f64;
     let mut rows = Vec::new();
     println!(
-        "{:>8} {:>22} {:>6} {:>10} {:>10}  solver that ran",
+        "{:>8} {:>24} {:>6} {:>10} {:>10}  solver that ran",
         "E1/E2", "solver", "iters", "KKT", "force err"
     );
     for ratio in RATIOS {
@@ -97,7 +97,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 Err(e) => (0, f64::INFINITY, f64::INFINITY, format!("failed: {e}")),
             };
-            println!("{ratio:>8.0e} {label:>22} {iters:>6} {kkt:>10.2e} {force_err:>10.2e}  {ran}");
+            println!("{ratio:>8.0e} {label:>24} {iters:>6} {kkt:>10.2e} {force_err:>10.2e}  {ran}");
             rows.push(format!(
                 "{{\"ratio\":{ratio:e},\"solver\":\"{name}\",\"iterations\":{iters},\"kkt\":{}}}",
                 if kkt.is_finite() { format!("{kkt:e}") } else { "null".to_string() }
