@@ -433,8 +433,8 @@ SynStatus syn_model_add_contact_plane(struct SynModel *model,
                                       size_t *pair);
 
 /**
- * Chooses the contact solver by name: `"pdas"` (default), `"au-pdas"`, `"uzawa-mprgp"`,
- * `"dual-mprgp"`.
+ * Chooses the contact solver by name: `"pdas-fallback"` (default), `"pdas"`, `"au-pdas"`,
+ * `"uzawa-mprgp"`, `"dual-mprgp"`.
  *
  * # Safety
  * `name` must be a NUL-terminated string.

@@ -306,7 +306,8 @@ fn empty_geometry<const D: usize>() -> ContactGeometry<D> {
 const OBSERVER_FAILED: &str = "the step observer failed";
 
 impl<const D: usize> JointModel<D> {
-    /// An empty model: no bodies, solver `"pdas"`, default parameters, no analysis.
+    /// An empty model: no bodies, solver [`crate::solvers::DEFAULT_SOLVER`] (`"pdas-fallback"`),
+    /// default parameters, no analysis.
     pub fn new() -> Self {
         Self {
             model: Model::new(),
@@ -314,7 +315,7 @@ impl<const D: usize> JointModel<D> {
             friction_laws: Vec::new(),
             dynamic: Vec::new(),
             initial_velocity: Vec::new(),
-            solver: "pdas".to_string(),
+            solver: crate::solvers::DEFAULT_SOLVER.to_string(),
             contact_params: ContactParams::default(),
             elastic_params: ElasticParams::default(),
             quasistatic_params: QuasiStaticParams::default(),

@@ -10,6 +10,15 @@ use synovia_uzawa::DualMprgp;
 /// Names accepted by [`by_name`] for the four basic solvers.
 pub const SOLVER_NAMES: &[&str] = &["pdas", "au-pdas", "uzawa-mprgp", "dual-mprgp"];
 
+/// The solver a new [`crate::builder::JointModel`] uses (and so the scenario/CLI default when
+/// no `solver.name` is given): [`PdasFallback`], i.e. PDAS (superlinear, usually a few
+/// iterations) handing over to `dual-mprgp` if PDAS cycles, stalls or meets a singular
+/// interface system. Which solver produced a solution is in its
+/// [`SolverReport::solver`](synovia_contact::SolverReport) (`"pdas"` or `"dual-mprgp"`) and
+/// [`SolverReport::fallback`](synovia_contact::SolverReport) (why PDAS was abandoned).
+/// `examples/stiffness_ratio.rs` checks it on two stacked blocks for `E₁/E₂ = 1 … 1e6`.
+pub const DEFAULT_SOLVER: &str = "pdas-fallback";
+
 /// Further names accepted by [`by_name`]: combinators of the basic solvers ([`PdasFallback`]).
 pub const COMBINATOR_NAMES: &[&str] = &["pdas-fallback"];
 

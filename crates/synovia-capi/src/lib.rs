@@ -727,8 +727,8 @@ pub unsafe extern "C" fn syn_model_add_contact_plane(
     })
 }
 
-/// Chooses the contact solver by name: `"pdas"` (default), `"au-pdas"`, `"uzawa-mprgp"`,
-/// `"dual-mprgp"`.
+/// Chooses the contact solver by name: `"pdas-fallback"` (default), `"pdas"`, `"au-pdas"`,
+/// `"uzawa-mprgp"`, `"dual-mprgp"`.
 ///
 /// # Safety
 /// `name` must be a NUL-terminated string.

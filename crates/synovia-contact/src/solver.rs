@@ -8,7 +8,9 @@ use crate::problem::ContactProblem;
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
 pub struct ContactParams {
-    /// Stopping tolerance on the relative complementarity residuals (default `1e-10`).
+    /// Stopping tolerance on the relative complementarity residuals (default `1e-10`). The
+    /// PDAS solvers also accept an iterate whose interface residuals stall at rounding level
+    /// when all relative residuals of [`crate::check_kkt`] are below it (see `synovia_pdas`).
     pub tolerance: f64,
     /// Maximum outer iterations (default `200`).
     pub max_iterations: usize,

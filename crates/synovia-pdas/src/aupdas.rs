@@ -107,7 +107,9 @@ impl ContactSolver for AuPdas {
             history.push(IterationResidual { iteration: it, normal, tangential, set_changes });
             sets = new_sets;
             cells_used = Some(used.cells);
-            if set_changes == 0 && normal <= tol && tangential <= tol {
+            let converged = (set_changes == 0 && normal <= tol && tangential <= tol)
+                || crate::sets::stalled_but_kkt_converged(&mut st, problem, &nu, &history, tol)?;
+            if converged {
                 let report = SolverReport {
                     solver: name.to_string(),
                     iterations: it,

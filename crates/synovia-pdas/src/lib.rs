@@ -56,8 +56,13 @@
 //!    `P = I − ζ_c ζ_cᵀ/‖ζ_c‖²`. The fixed entries are eliminated; the remaining dense
 //!    symmetric positive definite system (see [`Pdas`]) is solved by Cholesky.
 //! 4. `y^{k+1} = w − S ν^{k+1}`; compute the residuals and the new sets.
-//! 5. If the sets did not change and both relative residuals are `≤ tolerance`, stop;
-//!    otherwise `k ← k + 1` and go to 3 with the new sets.
+//! 5. If the sets did not change and both relative residuals are `≤ tolerance`, stop. If the
+//!    sets did not change in the last two iterations and the residual made no progress (it is
+//!    at the rounding level of `y = w − S ν`, `≈ ε κ(A) ‖w‖`, which grows with the stiffness
+//!    ratio of the bodies: `2e-10` for two stacked blocks with `E₁/E₂ = 1e5`), stop if every
+//!    relative residual of [`synovia_contact::check_kkt`] at `U = A⁻¹ (F − Cᵀ ν)` is
+//!    `≤ tolerance` (scale-aware: the same problem in other units stops at the same
+//!    iteration). Otherwise `k ← k + 1` and go to 3 with the new sets.
 //! 6. `U = A⁻¹ (F − Cᵀ ν)`, `Λ_n = ν_n / κ`, `Λ_t = ν_t`.
 //!
 //! ### The 3D slip linearisation

@@ -8,7 +8,7 @@ use synovia_contact::{
     SolveContext, SolverReport,
 };
 
-use crate::sets::{finish, CellState, Sets, State};
+use crate::sets::{finish, stalled_but_kkt_converged, CellState, Sets, State};
 
 /// Primal–dual active set method (PDAS) = semismooth Newton method for the contact problem of
 /// docs/model.md §5 (frictionless or Tresca, 2D or 3D), condensed on the contact interface.
@@ -44,7 +44,12 @@ use crate::sets::{finish, CellState, Sets, State};
 /// 3. `y^{k+1} = w − S ν^{k+1}` (only the columns of `S` of rows with `ν ≠ 0` are used,
 ///    each computed once by one solve with the factor of `A`).
 /// 4. Stop when the sets computed from `(ν^{k+1}, y^{k+1})` equal those of step 1 and both
-///    relative residuals (see [`IterationResidual`]) are at most `tolerance`.
+///    relative residuals (see [`IterationResidual`]) are at most `tolerance`; or, when the sets
+///    were unchanged in the last two iterations and the residual stopped decreasing (it is at
+///    the rounding level of `y = w − S ν`, which grows with the condition number of `A`, e.g.
+///    with the stiffness ratio of the bodies), when every relative residual of
+///    [`synovia_contact::check_kkt`] at `U = A⁻¹ (F − Cᵀ ν)` is at most `tolerance` (a
+///    scale-aware test: equilibrium relative to the forces, gaps to the displacements).
 ///
 /// A row whose switching quantity lies within `1e-12` (relative) of its threshold keeps its
 /// state (weakly active rows, where both states solve the problem). Normal rows with an empty
@@ -206,7 +211,9 @@ impl Pdas {
                     recent.pop_front();
                 }
                 sets = new_sets;
-                if set_changes == 0 && normal <= tol && tangential <= tol {
+                let converged = (set_changes == 0 && normal <= tol && tangential <= tol)
+                    || stalled_but_kkt_converged(&mut st, problem, &nu, &history, tol)?;
+                if converged {
                     let report = SolverReport {
                         solver: name.to_string(),
                         iterations: it,
