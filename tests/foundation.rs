@@ -180,7 +180,7 @@ fn vtu_output_of_a_solution_reads_back() {
 }
 
 /// The trailing block of a factorisation with the interface dofs ordered last
-/// (`ElasticSolver::new_with_ordering` with `InterfaceBlockParams::ordering`) reproduces `(A⁻¹)_cc` computed with the whole factor, for
+/// (`ElasticSolver::new_with_ordering` with `interface_ordering`) reproduces `(A⁻¹)_cc` computed with the whole factor, for
 /// the simplicial (small) and the supernodal (larger) factor layouts of faer.
 #[test]
 fn trailing_block_of_the_factor_gives_the_interface_inverse() {
@@ -196,17 +196,8 @@ fn trailing_block_of_the_factor_gives_the_interface_inverse() {
         let mut nodes: Vec<(BodyId, usize)> = top.iter().map(|&i| (b, i)).collect();
         nodes.sort_unstable();
         nodes.dedup();
-        let solver =
-            ElasticSolver::new_with_ordering(&model, ElasticParams::default(), false, &|dofs, base| {
-                let groups: Vec<std::ops::Range<usize>> = nodes
-                    .iter()
-                    .map(|&(b, i)| {
-                        let g = &dofs.groups()[dofs.group_of(b, i)];
-                        g.first_dof..g.first_dof + g.n_dofs
-                    })
-                    .collect();
-                Ok(synovia::linalg::InterfaceBlockParams::default().ordering(base, &groups, dofs.n_dofs()))
-            })
+        let ordering = synovia::contact::interface_ordering(&nodes, Default::default());
+        let solver = ElasticSolver::new_with_ordering(&model, ElasticParams::default(), false, &ordering)
             .expect("factor");
         let chol = solver.cholesky();
         let block = chol.trailing().expect("trailing block");

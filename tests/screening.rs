@@ -62,10 +62,9 @@ fn rows_in_block<const D: usize>(sc: &StaticContact<D>) -> Vec<bool> {
         .iter()
         .map(|n| {
             let others = n.partner.iter().copied().chain(n.master.iter().map(|&(b, j, _)| (b, j)));
-            std::iter::once(n.node).chain(others).all(|(b, i)| {
-                let g = &dofs.groups()[dofs.group_of(b, i)];
-                (g.first_dof..g.first_dof + g.n_dofs).all(|d| block.position[d] != usize::MAX)
-            })
+            std::iter::once(n.node)
+                .chain(others)
+                .all(|(b, i)| dofs.node_dofs(b, i).all(|d| block.position[d] != usize::MAX))
         })
         .collect()
 }

@@ -685,20 +685,15 @@ fn interface_nodes<const D: usize>(
     Ok(out)
 }
 
-/// The ordering of the contact set-up: the dofs of the `interface` nodes (in priority order)
-/// last, as [`InterfaceBlockParams`] selects them.
-fn interface_ordering<const D: usize>(
+/// The ordering of the contact set-up, for [`ElasticSolver::new_with_ordering`]: the dofs of
+/// the `interface` nodes (in priority order) last, as [`InterfaceBlockParams`] selects them.
+pub fn interface_ordering<const D: usize>(
     interface: &[(synovia_fem::BodyId, usize)],
     block: InterfaceBlockParams,
 ) -> impl Fn(&DofMap<D>, synovia_linalg::Ordering) -> Result<synovia_linalg::Ordering, FemError> + '_ {
     move |dofs, base| {
-        let groups: Vec<std::ops::Range<usize>> = interface
-            .iter()
-            .map(|&(b, i)| {
-                let g = &dofs.groups()[dofs.group_of(b, i)];
-                g.first_dof..g.first_dof + g.n_dofs
-            })
-            .collect();
+        let groups: Vec<std::ops::Range<usize>> =
+            interface.iter().map(|&(b, i)| dofs.node_dofs(b, i)).collect();
         Ok(block.ordering(base, &groups, dofs.n_dofs()))
     }
 }

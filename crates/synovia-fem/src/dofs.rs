@@ -251,6 +251,11 @@ impl<const D: usize> DofMap<D> {
     pub fn group_of(&self, body: BodyId, node: usize) -> usize {
         self.group_of[self.node_offset[body.0] + node]
     }
+    /// The reduced dofs of node `node` of body `body` (those of its node group).
+    pub fn node_dofs(&self, body: BodyId, node: usize) -> std::ops::Range<usize> {
+        let g = &self.groups[self.group_of(body, node)];
+        g.first_dof..g.first_dof + g.n_dofs
+    }
     /// Offset of body `body`'s nodes in the global node numbering.
     pub fn node_offset(&self, body: BodyId) -> usize {
         self.node_offset[body.0]
