@@ -300,6 +300,19 @@ impl<'a, const D: usize> JointSession<'a, D> {
     pub fn setup_s(&self) -> f64 {
         self.setup_s
     }
+    /// Bytes held now by the caches the contact solves reuse (kept columns of the interface
+    /// operator and row solves, [`SolveContext::bytes`]); bounded by
+    /// [`SolveContext::memory_budget`], and constant once a periodic loading has visited its
+    /// states — the figure to watch in a long navigation loop. 0 without contact pairs.
+    ///
+    /// [`SolveContext::bytes`]: synovia_contact::SolveContext::bytes
+    /// [`SolveContext::memory_budget`]: synovia_contact::SolveContext::memory_budget
+    pub fn cache_bytes(&self) -> usize {
+        match &self.engine {
+            Engine::Contact(stepper) => stepper.contact().context().bytes(),
+            Engine::Elastic { .. } => 0,
+        }
+    }
 }
 
 fn contact_report<const D: usize>(

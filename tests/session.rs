@@ -3,6 +3,7 @@
 //! steps is the quasi-static run.
 
 use synovia::prelude::*;
+use synovia::time::history::FnHistory;
 use synovia::time::quasistatic::QuasiStaticParams;
 
 /// The navigation inputs: depth and sideways shift of the tool (the block's top), and a
@@ -243,4 +244,37 @@ fn elastic_session_without_contact() {
     assert!(rel_diff(&u2, &doubled) < 1e-12);
     assert_eq!(session.step(1.0).expect("step").step, 1);
     assert!(session.step(0.5).is_err());
+}
+
+/// A navigation loop keeps memory flat: under a periodic motion with friction (the slip
+/// bounds `g_c`, which scale the friction rows, change at every step) the solve caches reach
+/// their size in the first period and do not grow over the next ones (issue 15: before the
+/// row solves were keyed by direction, every step added the solves of its rescaled friction
+/// rows until the budget).
+#[test]
+fn periodic_frictional_loop_keeps_the_caches_flat() {
+    let period = 11.0;
+    let w = 2.0 * std::f64::consts::PI / period;
+    let depth = FnHistory::new(move |t| 0.02 * (1.0 + 0.5 * (w * t).sin()));
+    let shift = FnHistory::new(move |t| 0.01 * (w * t).cos());
+    let joint = block_on_disc(depth, shift, Constant(0.0), Constant(1.0), 0.3, QuasiStaticParams::default());
+    let mut session = joint.prepare().expect("prepare");
+    let mut after_first_period = 0;
+    let mut bounds_changed = 0;
+    let mut last_tangential = None;
+    for step in 1..=(3 * period as usize) {
+        let report = session.step(step as Real).expect("step");
+        assert!(report.kkt < 1e-8, "step {step}: KKT {:.2e}", report.kkt);
+        let tangential = session.record().map(|r| r.pairs[0].tangential_force);
+        if last_tangential.is_some() && tangential != last_tangential {
+            bounds_changed += 1;
+        }
+        last_tangential = tangential;
+        if step == period as usize {
+            after_first_period = session.cache_bytes();
+        }
+    }
+    assert!(bounds_changed > 20, "the friction state must change from step to step ({bounds_changed})");
+    assert!(after_first_period > 0, "the contact solves keep row solves and columns");
+    assert_eq!(session.cache_bytes(), after_first_period, "the caches grew after the first period");
 }

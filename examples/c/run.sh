@@ -39,8 +39,14 @@ echo "== compiling against the static library (libsynovia_capi.a)"
 "$CC" "${cflags[@]}" "$here/main.c" -o "$out/synovia_example_static" \
     "$lib/libsynovia_capi.a" -lm -lpthread -ldl
 
+echo "== compiling the soak program (examples/c/soak.c, shared library)"
+"$CC" "${cflags[@]}" "$here/soak.c" -o "$out/synovia_soak" \
+    -L"$lib" -lsynovia_capi -Wl,-rpath,"$lib" -lm -lpthread -ldl
+
 echo "== running (shared)"
 "$out/synovia_example_shared" "${reference[@]}"
 echo "== running (static)"
 "$out/synovia_example_static" "${reference[@]}" >/dev/null
+echo "== soak smoke run: 3 steps of the 43k-DOF frictional model (10 000 steps: docs/reliability.md)"
+"$out/synovia_soak" 3
 echo "examples/c: the C API agrees with the Rust API (shared and static library)"

@@ -12,8 +12,11 @@ use crate::operator::{CholeskyOperator, FactorisedOperator, RowStack};
 /// Solves of single interface rows kept between interfaces that share rows (the coarse levels
 /// of a nested iteration, a frictionless and a Tresca solve, the passes of a screened solve):
 /// `x_c = L₂₂⁻ᵀ L₂₂⁻¹ c` for the rows `c` on the trailing block of a Cholesky factor, keyed by
-/// the row's entries and the block. Holds at most [`BlockSolveStore::budget_bytes`]; a solve
-/// that would exceed it empties the store first, so it never grows without bound.
+/// the block and the row's *direction* `d = c / s` (`s`: the entry of largest magnitude), so
+/// rows that differ only by a factor share one solve `x_c = s x_d` — the friction rows
+/// `g_c,r κ_r T_rᵀ` of docs/model.md (5.6) change their scale `g_c,r` at every time level but
+/// not their direction. Holds at most [`BlockSolveStore::budget_bytes`]; a solve that would
+/// exceed it empties the store first, so it never grows without bound.
 #[derive(Debug)]
 pub struct BlockSolveStore {
     inner: Mutex<BlockSolves>,
@@ -23,8 +26,56 @@ pub struct BlockSolveStore {
 #[derive(Debug, Default)]
 struct BlockSolves {
     block: usize,
-    solves: HashMap<u64, Arc<Vec<f64>>>,
+    solves: HashMap<u64, StoredSolve>,
     bytes: usize,
+}
+
+/// A kept solve `x_d` of the row direction `d`.
+#[derive(Debug)]
+struct StoredSolve {
+    direction: Vec<(usize, f64)>,
+    solve: Vec<f64>,
+}
+
+/// A row in trailing positions as `s · d`: `s` its entry of largest magnitude (the first of
+/// equal ones; 1 for an empty or zero row) and `d = row / s`.
+#[derive(Debug)]
+pub(crate) struct RowDirection {
+    scale: f64,
+    direction: Vec<(usize, f64)>,
+    key: u64,
+}
+
+impl RowDirection {
+    /// Relative agreement of two directions for a kept solve to be reused.
+    const SAME: f64 = 1e-13;
+
+    pub(crate) fn new(row: &[(usize, f64)]) -> Self {
+        use std::hash::{Hash, Hasher};
+        let mut scale = 0.0_f64;
+        for &(_, v) in row {
+            if v.abs() > scale.abs() {
+                scale = v;
+            }
+        }
+        if scale == 0.0 || !scale.is_finite() {
+            scale = 1.0;
+        }
+        let direction: Vec<(usize, f64)> = row.iter().map(|&(p, v)| (p, v / scale)).collect();
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        for &(p, v) in &direction {
+            p.hash(&mut h);
+            // coarse enough that rounding of `(g a) / (g b)` against `a / b` rarely changes it;
+            // a hit is confirmed entry by entry (`SAME`)
+            ((v * (1u64 << 32) as f64).round() as i64).hash(&mut h);
+        }
+        Self { scale, direction, key: h.finish() }
+    }
+
+    fn matches(&self, other: &[(usize, f64)]) -> bool {
+        self.direction.len() == other.len()
+            && self.direction.iter().zip(other).all(|(&(p, a), &(q, b))| p == q && (a - b).abs() <= Self::SAME)
+    }
 }
 
 impl Default for BlockSolveStore {
@@ -56,23 +107,39 @@ impl BlockSolveStore {
     fn lock(&self) -> std::sync::MutexGuard<'_, BlockSolves> {
         self.inner.lock().unwrap_or_else(|e| e.into_inner())
     }
-    fn get(&self, block: usize, key: u64) -> Option<Arc<Vec<f64>>> {
+    /// The solve of `row` (`s x_d` from the kept `x_d`), if its direction is kept.
+    fn get(&self, block: usize, row: &RowDirection) -> Option<Vec<f64>> {
         let store = self.lock();
         if store.block != block {
             return None;
         }
-        store.solves.get(&key).cloned()
+        let kept = store.solves.get(&row.key).filter(|k| row.matches(&k.direction))?;
+        Some(kept.solve.iter().map(|x| row.scale * x).collect())
     }
-    fn put(&self, block: usize, key: u64, x: Arc<Vec<f64>>) {
-        let bytes = x.len() * std::mem::size_of::<f64>();
+    /// Keeps the solve `x` of `row` as `x_d = x / s`.
+    fn put(&self, block: usize, row: &RowDirection, x: &[f64]) {
+        let bytes = (x.len() + 2 * row.direction.len()) * std::mem::size_of::<f64>();
+        let solve: Vec<f64> = x.iter().map(|v| v / row.scale).collect();
         let mut store = self.lock();
         if store.block != block || store.bytes + bytes > self.budget_bytes {
             *store = BlockSolves { block, ..Default::default() };
         }
         if bytes <= self.budget_bytes {
+            let stored = StoredSolve { direction: row.direction.clone(), solve };
+            if let Some(old) = store.solves.insert(row.key, stored) {
+                let old_bytes = (old.solve.len() + 2 * old.direction.len()) * std::mem::size_of::<f64>();
+                store.bytes -= old_bytes.min(store.bytes);
+            }
             store.bytes += bytes;
-            store.solves.insert(key, x);
         }
+    }
+    /// Number of kept solves.
+    pub fn len(&self) -> usize {
+        self.lock().solves.len()
+    }
+    /// `true` if no solve is kept.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 }
 
@@ -200,16 +267,16 @@ pub(crate) fn cholesky_interface_columns(
     }
     // trailing solves kept in the store (rows shared with earlier interfaces), the others
     let block_id = block_fingerprint(&block);
-    let keys: Vec<u64> = inside.iter().map(|&j| row_fingerprint(mapped[j].as_deref())).collect();
-    let mut solves: Vec<Option<Arc<Vec<f64>>>> = keys.iter().map(|&key| kept.get(block_id, key)).collect();
+    let directions: Vec<RowDirection> =
+        inside.iter().map(|&j| RowDirection::new(mapped[j].as_deref().unwrap_or(&[]))).collect();
+    let mut solves: Vec<Option<Vec<f64>>> = directions.iter().map(|d| kept.get(block_id, d)).collect();
     let todo: Vec<usize> = (0..inside.len()).filter(|&a| solves[a].is_none()).collect();
     let todo_rows: Vec<usize> = todo.iter().map(|&a| inside[a]).collect();
     let computed = in_two_halves(&todo_rows, block.dofs.len() >= 256, |cols| {
         Ok(trailing_solves(&block, &mapped, cols))
     })?;
     for (&a, (_, x)) in todo.iter().zip(computed) {
-        let x = Arc::new(x);
-        kept.put(block_id, keys[a], x.clone());
+        kept.put(block_id, &directions[a], &x);
         solves[a] = Some(x);
     }
     for (&j, x) in inside.iter().zip(&solves) {
@@ -260,13 +327,88 @@ fn block_fingerprint(block: &TrailingBlock) -> usize {
     h.finish() as usize
 }
 
-/// A fingerprint of a row in trailing positions.
-fn row_fingerprint(row: Option<&[(usize, f64)]>) -> u64 {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    for &(p, v) in row.into_iter().flatten() {
-        p.hash(&mut h);
-        v.to_bits().hash(&mut h);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Ordering, SparseCholesky, SparseRows, SymmetricMatrix};
+
+    /// The SPD tridiagonal matrix `tridiag(−1, 2.5, −1)` of size `n`.
+    fn tridiagonal(n: usize) -> SymmetricMatrix {
+        let columns = (0..n).map(|j| if j + 1 < n { vec![j, j + 1] } else { vec![j] }).collect();
+        let mut a = SymmetricMatrix::from_columns(n, columns).expect("pattern");
+        for j in 0..n {
+            a.add(j, j, 2.5).expect("diagonal");
+            if j + 1 < n {
+                a.add(j + 1, j, -1.0).expect("off-diagonal");
+            }
+        }
+        a
     }
-    h.finish()
+
+    /// `S = C A⁻¹ Cᵀ` by dense whole solves, the reference.
+    fn reference_columns(op: &SparseCholesky, rows: &SparseRows) -> Vec<Vec<f64>> {
+        (0..rows.nrows())
+            .map(|j| {
+                let mut x = vec![0.0; op.n()];
+                rows.add_row_to(j, 1.0, &mut x);
+                op.solve_in_place(&mut x).expect("solve");
+                rows.mul(&x)
+            })
+            .collect()
+    }
+
+    /// Rows on the trailing block that differ only by a factor (the friction rows
+    /// `g_c,r κ_r T_rᵀ` of successive time levels) share one kept solve, and the columns of `S`
+    /// built from it agree with fresh solves; a row of another direction is solved anew.
+    #[test]
+    fn rescaled_rows_share_a_kept_solve() {
+        let n = 40;
+        let last: Vec<usize> = (30..n).collect();
+        let op = SparseCholesky::new(tridiagonal(n), &Ordering::Trailing { base: Box::new(Ordering::Amd), last })
+            .expect("factor");
+        let rows_scaled = |g: &[f64]| {
+            let mut rows = SparseRows::new(n);
+            rows.push_row([(31, g[0] * 1.0), (32, g[0] * -0.5)]);
+            rows.push_row([(35, g[1] * 0.25), (36, g[1] * 0.75), (37, g[1] * -0.1)]);
+            rows
+        };
+        let store = BlockSolveStore::default();
+        let mut solved = 0;
+        for g in [[1.0, 2.0], [0.37, 1e-3], [5.5e4, 0.9]] {
+            let rows = rows_scaled(&g);
+            let stack = RowStack::new(&rows, None);
+            let mut columns = vec![None; rows.nrows()];
+            solved += op.view().interface_columns(stack, &[0, 1], &mut columns, &store).expect("columns");
+            let reference = reference_columns(&op, &rows);
+            for (j, col) in columns.iter().enumerate() {
+                let col = col.as_ref().expect("column computed");
+                for (i, (&x, &y)) in col.iter().zip(&reference[j]).enumerate() {
+                    let scale = reference[j].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+                    assert!((x - y).abs() <= 1e-13 * scale, "S[{i},{j}] at g = {g:?}: {x} vs {y}");
+                }
+            }
+        }
+        assert_eq!(store.len(), 2, "one kept solve per row direction");
+        // another direction of the first row: a new solve
+        let mut rows = SparseRows::new(n);
+        rows.push_row([(31, 1.0), (32, -0.4)]);
+        let mut columns = vec![None; 1];
+        op.view().interface_columns(RowStack::new(&rows, None), &[0], &mut columns, &store).expect("columns");
+        assert_eq!(store.len(), 3);
+        assert!(solved >= 2);
+    }
+
+    #[test]
+    fn row_direction_normalises_by_the_largest_entry() {
+        let a = RowDirection::new(&[(3, 2.0), (4, -6.0)]);
+        let b = RowDirection::new(&[(3, -0.1), (4, 0.3)]);
+        assert_eq!(a.key, b.key);
+        assert!(a.matches(&b.direction));
+        assert_eq!(a.scale, -6.0);
+        let zero = RowDirection::new(&[(1, 0.0)]);
+        assert_eq!(zero.scale, 1.0);
+        let c = RowDirection::new(&[(3, 2.0), (4, -6.0 * (1.0 + 1e-9))]);
+        assert!(!a.matches(&c.direction) || a.key != c.key);
+    }
 }
