@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use synovia_mesh::MeshError;
+use synovia_mesh::{MeshError, SurfaceError};
 use thiserror::Error;
 
 /// Everything that can go wrong when writing or reading VTK XML files.
@@ -145,6 +145,15 @@ pub enum IoError {
         body: String,
         /// The mesh error.
         source: MeshError,
+    },
+    /// The triangles of an STL file do not form a valid
+    /// [`synovia_mesh::TriangleSurface`] (degenerate triangle, non-finite vertex, …).
+    #[error("STL file `{}`: {source}", path.display())]
+    Surface {
+        /// The file.
+        path: PathBuf,
+        /// The surface error.
+        source: SurfaceError,
     },
 }
 

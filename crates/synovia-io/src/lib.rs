@@ -14,6 +14,8 @@
 //!   binary): [`read_msh`] parses a file, [`GmshMesh::bodies`] turns its physical groups into
 //!   one synovia [`Mesh`](synovia_mesh::Mesh) per body with named boundary parts (see the
 //!   [`gmsh`] module for the mapping and the part-kind naming convention).
+//! * [`stl`]: STL surfaces (binary and ASCII) as [`TriangleSurface`](synovia_mesh::TriangleSurface)s:
+//!   [`read_stl`], [`parse_stl`], [`write_stl`].
 //!
 //! Every problem is an [`IoError`]; nothing here panics on user input. Fields with NaN or
 //! infinite values are rejected ([`IoError::NonFinite`], naming the field and the index)
@@ -122,6 +124,7 @@ pub mod field;
 pub mod gmsh;
 pub mod pvd;
 pub mod read;
+pub mod stl;
 mod util;
 pub mod vtu;
 
@@ -133,4 +136,5 @@ pub use gmsh::{
 };
 pub use pvd::{read_pvd, PvdEntry, PvdWriter, TimeSeriesWriter};
 pub use read::{parse_vtu, read_vtu, VtuData, VtuPiece};
+pub use stl::{parse_stl, read_stl, write_stl};
 pub use vtu::{write_vtu, Encoding, VtuWriter, BODY_FIELD, VTK_TETRA, VTK_TRIANGLE};

@@ -20,7 +20,9 @@ pub mod matching;
 pub mod math;
 pub mod mesh;
 pub mod refine;
+pub mod surface;
 
 pub use error::MeshError;
 pub use math::{Point, Real, Tensor, Vector};
 pub use mesh::{BoundaryFacet, BoundaryKind, BoundaryPart, CellOrientation, Mesh};
+pub use surface::{SurfaceError, TriangleSurface};
