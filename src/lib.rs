@@ -85,6 +85,7 @@ pub mod prelude {
     pub use crate::builder::{Analysis, BodyMaterial, BodyRef, JointError, JointModel, RunResult, StepView};
     pub use crate::session::{JointSession, SolveReport};
     pub use synovia_contact::operators::{CylinderObstacle, FnObstacle, PlaneObstacle, SphereObstacle};
+    pub use synovia_contact::SurfaceObstacle;
     pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction, FrictionLaw};
     pub use synovia_fem::{
         solve_elastic, BodyFields, BodyId, ComponentMask, ElasticParams, ElasticSolution, ElasticSolver,
@@ -96,6 +97,7 @@ pub mod prelude {
     };
     pub use synovia_mesh::generators::{box_mesh, rectangle, Grading};
     pub use synovia_mesh::math::{Point, Real, Vector};
+    pub use synovia_mesh::TriangleSurface;
     pub use synovia_mesh::{BoundaryKind, Mesh, MeshError};
     pub use synovia_time::history::{
         Constant, LoadHistory, Periodic, PiecewiseLinear, RigidMotion, SharedValue,

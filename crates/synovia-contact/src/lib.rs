@@ -38,6 +38,7 @@ pub mod problem;
 pub mod search;
 pub mod solver;
 pub mod static_contact;
+pub mod surface_obstacle;
 pub mod testing;
 
 pub use context::SolveContext;
@@ -50,4 +51,5 @@ pub use kkt::{check_kkt, KktReport};
 pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};
 pub use static_contact::{StaticContact, StaticContactResult};
+pub use surface_obstacle::{SurfaceObstacle, SurfacePoint};
 pub use synovia_linalg::SparseRows;

@@ -36,11 +36,11 @@ const INSIDE_TOL: Real = 1e-6;
 
 /// One facet in the tree: its corners embedded in 3D (`z = 0` in 2D) and bounding box.
 #[derive(Debug, Clone)]
-struct FacetEntry {
-    facet: usize,
-    corners: [Vector3<Real>; 3],
-    n_corners: usize,
-    envelope: AABB<[Real; 3]>,
+pub(crate) struct FacetEntry {
+    pub(crate) facet: usize,
+    pub(crate) corners: [Vector3<Real>; 3],
+    pub(crate) n_corners: usize,
+    pub(crate) envelope: AABB<[Real; 3]>,
 }
 
 impl RTreeObject for FacetEntry {
@@ -60,7 +60,7 @@ impl PointDistance for FacetEntry {
 
 /// Closest point of a segment (2 corners) or triangle (3 corners) to `x`: barycentric weights
 /// (clamped, `≥ 0`, sum 1) and the point.
-fn closest(c: &[Vector3<Real>], x: &Vector3<Real>) -> ([Real; 3], Vector3<Real>) {
+pub(crate) fn closest(c: &[Vector3<Real>], x: &Vector3<Real>) -> ([Real; 3], Vector3<Real>) {
     if c.len() == 2 {
         let t = segment_parameter(&c[0], &c[1], x).clamp(0.0, 1.0);
         return ([1.0 - t, t, 0.0], c[0] + (c[1] - c[0]) * t);

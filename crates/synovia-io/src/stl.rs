@@ -43,7 +43,10 @@ fn parse_stl_at(bytes: &[u8], path: &Path) -> Result<TriangleSurface, IoError> {
     let ascii = bytes.starts_with(b"solid") && bytes[5..bytes.len().min(1024)].iter().all(|b| b.is_ascii());
     if !ascii {
         if bytes.len() < 84 {
-            return Err(IoError::parse(path, format!("{} bytes: too short for a binary STL file", bytes.len())));
+            return Err(IoError::parse(
+                path,
+                format!("{} bytes: too short for a binary STL file", bytes.len()),
+            ));
         }
         let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
         let expected = 84 + 50 * count;
@@ -61,7 +64,8 @@ fn parse_stl_at(bytes: &[u8], path: &Path) -> Result<TriangleSurface, IoError> {
     let vertices: Vec<Point<3>> =
         mesh.vertices.iter().map(|v| Point::<3>::new(v[0] as f64, v[1] as f64, v[2] as f64)).collect();
     let triangles: Vec<[usize; 3]> = mesh.faces.iter().map(|f| f.vertices).collect();
-    TriangleSurface::new(vertices, triangles).map_err(|source| IoError::Surface { path: path.to_path_buf(), source })
+    TriangleSurface::new(vertices, triangles)
+        .map_err(|source| IoError::Surface { path: path.to_path_buf(), source })
 }
 
 /// Writes `surface` as a binary STL file (single precision, normals from the vertex order).
@@ -74,7 +78,10 @@ pub fn write_stl(path: impl AsRef<Path>, surface: &TriangleSurface) -> Result<()
     let triangles: Vec<stl_io::Triangle> = (0..surface.len())
         .map(|t| {
             let [a, b, c] = surface.corners(t);
-            stl_io::Triangle { normal: to_f32(&surface.normal(t)), vertices: [to_f32(&a), to_f32(&b), to_f32(&c)] }
+            stl_io::Triangle {
+                normal: to_f32(&surface.normal(t)),
+                vertices: [to_f32(&a), to_f32(&b), to_f32(&c)],
+            }
         })
         .collect();
     let mut file = std::io::BufWriter::new(std::fs::File::create(&path).map_err(|e| IoError::io(&path, e))?);

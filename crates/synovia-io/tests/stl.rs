@@ -58,7 +58,8 @@ fn corrupt_files_are_typed_errors() {
     let err = parse_stl(&one).expect_err("degenerate");
     assert!(matches!(err, IoError::Surface { source: SurfaceError::DegenerateTriangle { .. }, .. }), "{err}");
     // an ASCII file cut in the middle
-    let err = parse_stl(b"solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0").expect_err("cut");
+    let err = parse_stl(b"solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0")
+        .expect_err("cut");
     assert!(matches!(err, IoError::Parse { .. }), "{err}");
     // missing file
     assert!(matches!(read_stl("/nonexistent/knee.stl"), Err(IoError::Io { .. })));
@@ -85,7 +86,10 @@ fn implant_surfaces_of_the_grand_challenge_data() {
             Err(e) => panic!("{name}: {e}"),
         }
         let (lo, hi) = s.bounding_box().expect("box");
-        assert!(hi.iter().chain(lo.iter()).all(|x| x.abs() < 0.05), "{name}: metres, within 5 cm: {lo:?} {hi:?}");
+        assert!(
+            hi.iter().chain(lo.iter()).all(|x| x.abs() < 0.05),
+            "{name}: metres, within 5 cm: {lo:?} {hi:?}"
+        );
     }
     let insert = read_stl(data("tibial_insert.stl")).expect("insert");
     let (lo, _) = insert.bounding_box().expect("box");

@@ -74,7 +74,11 @@ impl RowDirection {
 
     fn matches(&self, other: &[(usize, f64)]) -> bool {
         self.direction.len() == other.len()
-            && self.direction.iter().zip(other).all(|(&(p, a), &(q, b))| p == q && (a - b).abs() <= Self::SAME)
+            && self
+                .direction
+                .iter()
+                .zip(other)
+                .all(|(&(p, a), &(q, b))| p == q && (a - b).abs() <= Self::SAME)
     }
 }
 
@@ -327,7 +331,6 @@ fn block_fingerprint(block: &TrailingBlock) -> usize {
     h.finish() as usize
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -365,8 +368,9 @@ mod tests {
     fn rescaled_rows_share_a_kept_solve() {
         let n = 40;
         let last: Vec<usize> = (30..n).collect();
-        let op = SparseCholesky::new(tridiagonal(n), &Ordering::Trailing { base: Box::new(Ordering::Amd), last })
-            .expect("factor");
+        let op =
+            SparseCholesky::new(tridiagonal(n), &Ordering::Trailing { base: Box::new(Ordering::Amd), last })
+                .expect("factor");
         let rows_scaled = |g: &[f64]| {
             let mut rows = SparseRows::new(n);
             rows.push_row([(31, g[0] * 1.0), (32, g[0] * -0.5)]);

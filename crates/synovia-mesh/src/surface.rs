@@ -147,7 +147,7 @@ impl TriangleSurface {
         let tiny = DEGENERATE_AREA * diag * diag;
         for (triangle, t) in surface.triangles.iter().enumerate() {
             let area = surface.area_vector(triangle).norm();
-            if !(area > tiny) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+            if area.is_nan() || area <= tiny || t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
                 let c = surface.centroid(triangle);
                 return Err(SurfaceError::DegenerateTriangle {
                     triangle,
@@ -168,11 +168,11 @@ impl TriangleSurface {
     /// non-finite tolerance.
     pub fn from_soup(corners: &[[Point<3>; 3]], tolerance: Real) -> Result<Self, SurfaceError> {
         if !(tolerance.is_finite() && tolerance >= 0.0) {
-            return Err(SurfaceError::InvalidParameter(format!("merge tolerance {tolerance} must be finite and ≥ 0")));
+            return Err(SurfaceError::InvalidParameter(format!(
+                "merge tolerance {tolerance} must be finite and ≥ 0"
+            )));
         }
-        if let Some(vertex) =
-            corners.iter().flatten().position(|p| p.iter().any(|x| !x.is_finite()))
-        {
+        if let Some(vertex) = corners.iter().flatten().position(|p| p.iter().any(|x| !x.is_finite())) {
             return Err(SurfaceError::NonFiniteVertex { vertex });
         }
         // grid hashing with cells of the tolerance: a corner is compared with the vertices of
@@ -198,7 +198,9 @@ impl TriangleSurface {
                         for dy in -1..=1 {
                             for dz in -1..=1 {
                                 if let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
-                                    if let Some(&v) = list.iter().find(|&&v| (vertices[v] - p).norm() <= tolerance) {
+                                    if let Some(&v) =
+                                        list.iter().find(|&&v| (vertices[v] - p).norm() <= tolerance)
+                                    {
                                         found = Some(v);
                                         break 'search;
                                     }
@@ -265,9 +267,7 @@ impl TriangleSurface {
     pub fn signed_volume(&self) -> Real {
         self.triangles
             .iter()
-            .map(|&[a, b, c]| {
-                self.vertices[a].dot(&self.vertices[b].cross(&self.vertices[c])) / 6.0
-            })
+            .map(|&[a, b, c]| self.vertices[a].dot(&self.vertices[b].cross(&self.vertices[c])) / 6.0)
             .sum()
     }
     /// Axis-aligned bounding box `(min, max)` of the vertices used by triangles.
@@ -290,19 +290,28 @@ impl TriangleSurface {
     /// [`SurfaceError::InvalidParameter`] unless `factor` is finite and > 0.
     pub fn scaled(&self, factor: Real) -> Result<Self, SurfaceError> {
         if !(factor.is_finite() && factor > 0.0) {
-            return Err(SurfaceError::InvalidParameter(format!("scale factor {factor} must be finite and > 0")));
+            return Err(SurfaceError::InvalidParameter(format!(
+                "scale factor {factor} must be finite and > 0"
+            )));
         }
-        Ok(Self { vertices: self.vertices.iter().map(|p| p * factor).collect(), triangles: self.triangles.clone() })
+        Ok(Self {
+            vertices: self.vertices.iter().map(|p| p * factor).collect(),
+            triangles: self.triangles.clone(),
+        })
     }
     /// The same surface with every triangle's orientation reversed (normals flipped).
     pub fn flipped(&self) -> Self {
-        Self { vertices: self.vertices.clone(), triangles: self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect() }
+        Self {
+            vertices: self.vertices.clone(),
+            triangles: self.triangles.iter().map(|&[a, b, c]| [a, c, b]).collect(),
+        }
     }
 
     /// Each undirected edge `(min, max)` with the triangles on it and whether each traverses it
     /// from `min` to `max`.
     fn edge_map(&self) -> HashMap<(usize, usize), Vec<(usize, bool)>> {
-        let mut edges: HashMap<(usize, usize), Vec<(usize, bool)>> = HashMap::with_capacity(3 * self.len() / 2 + 1);
+        let mut edges: HashMap<(usize, usize), Vec<(usize, bool)>> =
+            HashMap::with_capacity(3 * self.len() / 2 + 1);
         for (t, tri) in self.triangles.iter().enumerate() {
             for k in 0..3 {
                 let (a, b) = (tri[k], tri[(k + 1) % 3]);
@@ -363,10 +372,14 @@ impl TriangleSurface {
         self.check_manifold()?;
         let boundary = self.boundary_edges();
         if let Some(&[a, b]) = boundary.first() {
-            return Err(SurfaceError::Open { boundary_edges: boundary.len(), edge: [a, b], at: self.midpoint(a, b) });
+            return Err(SurfaceError::Open {
+                boundary_edges: boundary.len(),
+                edge: [a, b],
+                at: self.midpoint(a, b),
+            });
         }
         let v = self.signed_volume();
-        if !(v > 0.0) {
+        if v.is_nan() || v <= 0.0 {
             return Err(SurfaceError::InvalidParameter(format!(
                 "the closed surface has inward normals (signed volume {v:e}); flip its orientation"
             )));
@@ -495,7 +508,7 @@ mod tests {
         tris.push(tris[0]);
         let dup = TriangleSurface::new(s.vertices().to_vec(), tris).expect("soup");
         assert!(matches!(dup.check_closed(), Err(SurfaceError::NonManifoldEdge { triangles: 3, .. })));
-        let msg = open.check_closed().unwrap_err().to_string();
+        let msg = open.check_closed().expect_err("open").to_string();
         assert!(msg.contains("open") && msg.contains("3 edges"), "{msg}");
     }
 
@@ -513,7 +526,10 @@ mod tests {
         nan[2][1].x = Real::NAN;
         assert!(matches!(TriangleSurface::from_soup(&nan, 0.0), Err(SurfaceError::NonFiniteVertex { .. })));
         let flat = [[Point::<3>::zeros(), Point::<3>::new(1.0, 0.0, 0.0), Point::<3>::new(2.0, 0.0, 0.0)]];
-        assert!(matches!(TriangleSurface::from_soup(&flat, 0.0), Err(SurfaceError::DegenerateTriangle { .. })));
+        assert!(matches!(
+            TriangleSurface::from_soup(&flat, 0.0),
+            Err(SurfaceError::DegenerateTriangle { .. })
+        ));
         assert!(matches!(TriangleSurface::from_soup(&[], 0.0), Err(SurfaceError::Empty)));
     }
 }
