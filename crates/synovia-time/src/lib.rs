@@ -11,5 +11,6 @@ pub mod error;
 pub mod history;
 pub mod quasistatic;
 pub mod results;
+pub mod table;
 
 pub use error::TimeError;
