@@ -75,6 +75,12 @@ pub struct ContactRun {
     pub c: Real,
     /// Cattaneo–Mindlin only: analytic stick half-width.
     pub c_exact: Real,
+    /// 3D Cattaneo–Mindlin only: the stick radius `sqrt(A_stick/π)` of the area of the stick
+    /// cells (0 elsewhere).
+    pub c_stick_area: Real,
+    /// 3D only: the contact radius `sqrt(A_contact/π)` of the area of the nodes in contact
+    /// (0 elsewhere).
+    pub a_contact_area: Real,
     /// Cattaneo–Mindlin only: relative L² error of the tangential traction.
     pub traction_l2_err: Real,
     /// Cattaneo–Mindlin only: `max (|q| − μ p)` over the contact nodes (≤ 0 up to round-off).
@@ -111,6 +117,12 @@ impl ContactRun {
             s.push_str(&format!(
                 ",\"q_ratio\":{:.4},\"c\":{:.6e},\"c_exact\":{:.6e},\"c_rel_err\":{:.3e},\"traction_l2_err\":{:.3e},\"coulomb_excess\":{:.2e}",
                 self.q_ratio, self.c, self.c_exact, self.c_rel_err(), self.traction_l2_err, self.coulomb_excess
+            ));
+        }
+        if self.c_stick_area > 0.0 {
+            s.push_str(&format!(
+                ",\"c_stick_area\":{:.6e},\"a_contact_area\":{:.6e}",
+                self.c_stick_area, self.a_contact_area
             ));
         }
         s.push('}');
@@ -394,6 +406,8 @@ fn hertz_run<const D: usize>(
         q_ratio: 0.0,
         c: 0.0,
         c_exact: 0.0,
+        c_stick_area: 0.0,
+        a_contact_area: 0.0,
         traction_l2_err: 0.0,
         coulomb_excess: 0.0,
         kkt: res.kkt.max(),
@@ -917,13 +931,14 @@ pub fn hertz3d_block(
 /// ```text
 /// a_Hertz = (3 P R*/(4 E*))^{1/3},  R* = R/2,  1/E* = 2 (1 − ν²)/E,     p₀ = 3P/(2π a²),
 /// c_exact = a_Hertz (1 − Q/(μP))^{1/3}                                    (Mindlin),
-/// c_FE    = sqrt(A_stick / π),   A_stick = Σ_{stick cells} κ_r   (cells with ‖Λ_t‖ < 1 − 10⁻⁶),
+/// c_FE    = Mindlin's traction ratio fitted to ‖Λ_t,r‖ = |q_r|/(μ p_r)   ([`fit_stick_radius`]),
+/// c_area  = sqrt(A_stick / π),   A_stick = Σ_{stick cells} κ_r   (cells with ‖Λ_t‖ < 1 − 10⁻⁶),
 /// q(r)    = μ p₀ sqrt(1 − r²/a²) − (c/a) μ p₀ sqrt(1 − r²/c²)   (second term for r ≤ c),
 /// ```
 ///
 /// `a` (fit of the pressure, [`fit_elliptic`]), the relative L² error of `|q|` and the
-/// Coulomb check `max(|q| − μ p)`. The stick radius is the one of the area of the stick cells
-/// (the dual cells of the sticking nodes), insensitive to the orientation of the mesh.
+/// Coulomb check `max(|q| − μ p)`. `c_FE` uses every node in contact; `c_area` (the area of
+/// the dual cells of the sticking nodes) moves by whole cells and is reported beside it.
 /// Mindlin's solution (uniform tangential displacement of the stick zone, traction parallel to
 /// the load) is exact for `ν = 0`; for `ν > 0` it neglects a small transverse traction.
 ///
@@ -998,7 +1013,7 @@ pub fn cattaneo_mindlin_3d(
     let mut warm: Option<synovia_contact::ContactSolution> = None;
     let iterations = std::cell::Cell::new(0);
     let solve = |shift: Real,
-                     warm: &mut Option<synovia_contact::ContactSolution>|
+                 warm: &mut Option<synovia_contact::ContactSolution>|
      -> Result<(StaticContactResult<3>, Real), ContactError> {
         let res = sc.solve(&model, shift, solver, Some(&gc), Some(&normal.displacement), warm.as_ref())?;
         iterations.set(iterations.get() + res.solution.report.iterations);
@@ -1030,6 +1045,7 @@ pub fn cattaneo_mindlin_3d(
         q_prev = q1;
         let c_exact = a_exact * (1.0 - q1).cbrt();
         let (mut stick_area, mut num, mut den, mut excess) = (0.0, 0.0, 0.0, Real::NEG_INFINITY);
+        let mut ratio_points = Vec::with_capacity(res.cell_node.len());
         for c in 0..res.cell_node.len() {
             let (node, norm, q) = traction(&res, c);
             let w = geo.nodes[node].weight;
@@ -1037,6 +1053,9 @@ pub fn cattaneo_mindlin_3d(
                 stick_area += w;
             }
             let x = radial(&geo.nodes[node].position);
+            if res.solution.lambda_n[node] > 0.0 {
+                ratio_points.push((x, norm, w));
+            }
             let s1 = 1.0 - (x / a_exact).powi(2);
             let s2 = 1.0 - (x / c_exact).powi(2);
             let mut qe = if s1 > 0.0 { mu * p0_exact * s1.sqrt() } else { 0.0 };
@@ -1061,7 +1080,16 @@ pub fn cattaneo_mindlin_3d(
         run.iterations = iterations.get();
         run.coarse_iterations = normal.coarse_iterations;
         run.q_ratio = q1;
-        run.c = (stick_area / std::f64::consts::PI).sqrt();
+        run.c = fit_stick_radius(&ratio_points, a_exact);
+        run.c_stick_area = (stick_area / std::f64::consts::PI).sqrt();
+        let contact_area: Real = geo
+            .nodes
+            .iter()
+            .zip(&normal.solution.lambda_n)
+            .filter(|(_, &l)| l > 0.0)
+            .map(|(n, _)| n.weight)
+            .sum();
+        run.a_contact_area = (contact_area / std::f64::consts::PI).sqrt();
         run.c_exact = c_exact;
         run.traction_l2_err = (num / den).sqrt();
         run.coulomb_excess = excess;
@@ -1069,4 +1097,42 @@ pub fn cattaneo_mindlin_3d(
         runs.push(run);
     }
     Ok(runs)
+}
+
+/// The stick radius `c` of Mindlin's traction ratio fitted to the nodal ratios `φ_r = |q_r|/(μ p_r)`
+/// (`= ‖Λ_t,r‖` when `g_c = μ p`): with the Hertz radius `a`,
+///
+/// ```text
+/// φ(r; c) = 1 − sqrt((c² − r²)⁺ / (a² − r²))      (r < a),
+/// c = argmin_{0 ≤ c ≤ a} Σ_r κ_r (φ_r − φ(r_r; c))²   over the points (r_r, φ_r, κ_r) with r_r < a,
+/// ```
+///
+/// by a scan of 400 values and a golden-section refinement around the best one.
+pub fn fit_stick_radius(points: &[(Real, Real, Real)], a: Real) -> Real {
+    let cost = |c: Real| -> Real {
+        points
+            .iter()
+            .filter(|(r, _, _)| *r < a)
+            .map(|&(r, phi, w)| {
+                let model = 1.0 - ((c * c - r * r).max(0.0) / (a * a - r * r)).sqrt();
+                w * (phi - model).powi(2)
+            })
+            .sum()
+    };
+    let n = 400;
+    let best = (0..=n)
+        .map(|k| a * k as Real / n as Real)
+        .min_by(|x, y| cost(*x).total_cmp(&cost(*y)))
+        .unwrap_or(0.0);
+    let (mut lo, mut hi) = ((best - a / n as Real).max(0.0), (best + a / n as Real).min(a));
+    let golden = 0.5 * (5.0_f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let (x1, x2) = (hi - golden * (hi - lo), lo + golden * (hi - lo));
+        if cost(x1) < cost(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    0.5 * (lo + hi)
 }

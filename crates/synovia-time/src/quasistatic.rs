@@ -37,6 +37,14 @@
 //!   solution is the last one (computed with `g^k`). After `max_fixed_point` solves without
 //!   convergence the run stops with [`TimeError::FixedPoint`].
 //!
+//! * **Bodies held by friction** (docs/model.md §7.1, (7.2a)–(7.2b)): for a model with bodies
+//!   that only contact holds, a level whose Tresca solve fails (the bound frozen from `t_{i−1}`
+//!   cannot hold the load at `t_i`), and a step 0 whose frictionless problem is unbalanced
+//!   while the pairs have friction, are solved as the Coulomb fixed point at that level,
+//!   started from the normal problem with the unbalanced rigid-body load withheld
+//!   ([`synovia_contact::floating::withhold_unbalanced`]). When the tangential load exceeds the
+//!   Coulomb capacity `μ·P` the run stops with [`TimeError::Slides`] (both forces given).
+//!
 //! The factorisation of `A` is done once, in [`QuasiStaticStepper::new`], and reused at every
 //! level and fixed-point iteration (docs/model.md §7).
 //!
