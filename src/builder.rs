@@ -21,7 +21,8 @@
 //!
 //! * [`JointModel::run_static`]: one contact problem at time `t` (step 0 of the quasi-static
 //!   scheme: frictionless, or with [`QuasiStaticParams::initial_friction`] a Tresca solve with
-//!   `g_c` from the frictionless pressure);
+//!   `g_c` from the frictionless pressure; a body held by friction alone, whose frictionless
+//!   problem has no solution, is solved with Coulomb friction, docs/model.md §7.1);
 //! * [`JointModel::run_quasistatic`]: the quasi-static scheme of docs/model.md §7 over the given times;
 //! * [`JointModel::run_dynamic`]: the semi-implicit Kelvin–Voigt scheme with `dt` and `steps`
 //!   (every body needs a density: a [`KelvinVoigt`] material, [`JointModel::set_density`] or

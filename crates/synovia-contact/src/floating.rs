@@ -77,6 +77,52 @@ pub fn check_balance(
     Err(ContactError::Unbalanced { bodies, residual, load: target_norm })
 }
 
+/// The load `F` with the part of its rigid-body load that no normal contact force can balance
+/// withheld (docs/model.md §4, §7.1): with the orthonormal kernel vectors `r_m` of
+/// `stabilisation`, `t = Rᵀ F` and the non-negative least-squares fit
+/// `ν* = argmin_{ν ≥ 0} ‖Rᵀ B_hnᵀ ν − t‖` ([`nnls`]), the unbalanced part is
+/// `δ = t − Rᵀ B_hnᵀ ν*` and the returned load is
+///
+/// ```text
+/// F_w = F − Σ_m δ_m r_m,      so that   Rᵀ F_w = Rᵀ B_hnᵀ ν*   (balanced by normal contact).
+/// ```
+///
+/// For a body held by friction, `δ` is the tangential load that friction must carry, and the
+/// frictionless problem with `F_w` gives the normal pressure from which the Coulomb fixed point
+/// starts (`synovia_time::quasistatic`). Also returns `‖δ‖`. A coercive model (no modes)
+/// returns `F` unchanged.
+pub fn withhold_unbalanced(
+    stabilisation: &Stabilisation,
+    load: &[f64],
+    normal: &NormalConstraints,
+) -> (Vec<f64>, f64) {
+    let modes: Vec<&Vec<f64>> = stabilisation.components.iter().flat_map(|c| c.modes.iter()).collect();
+    if modes.is_empty() {
+        return (load.to_vec(), 0.0);
+    }
+    let target: Vec<f64> = modes.iter().map(|r| dot(r, load)).collect();
+    let per_mode: Vec<Vec<f64>> = modes.iter().map(|r| normal.rows.mul(r)).collect();
+    let columns: Vec<Vec<f64>> = (0..normal.rows.nrows())
+        .map(|row| per_mode.iter().map(|pm| pm[row]).collect::<Vec<f64>>())
+        .filter(|col| col.iter().any(|c| *c != 0.0))
+        .collect();
+    let (x, _) = nnls(&columns, &target);
+    let mut delta = target;
+    for (xj, col) in x.iter().zip(&columns) {
+        for (d, c) in delta.iter_mut().zip(col) {
+            *d -= xj * c;
+        }
+    }
+    let mut out = load.to_vec();
+    for (d, r) in delta.iter().zip(&modes) {
+        for (o, rv) in out.iter_mut().zip(r.iter()) {
+            *o -= d * rv;
+        }
+    }
+    let norm = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
+    (out, norm)
+}
+
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }

@@ -75,6 +75,12 @@ pub struct ContactRun {
     pub c: Real,
     /// Cattaneo–Mindlin only: analytic stick half-width.
     pub c_exact: Real,
+    /// 3D Cattaneo–Mindlin only: the stick radius `sqrt(A_stick/π)` of the area of the stick
+    /// cells (0 elsewhere).
+    pub c_stick_area: Real,
+    /// 3D only: the contact radius `sqrt(A_contact/π)` of the area of the nodes in contact
+    /// (0 elsewhere).
+    pub a_contact_area: Real,
     /// Cattaneo–Mindlin only: relative L² error of the tangential traction.
     pub traction_l2_err: Real,
     /// Cattaneo–Mindlin only: `max (|q| − μ p)` over the contact nodes (≤ 0 up to round-off).
@@ -111,6 +117,12 @@ impl ContactRun {
             s.push_str(&format!(
                 ",\"q_ratio\":{:.4},\"c\":{:.6e},\"c_exact\":{:.6e},\"c_rel_err\":{:.3e},\"traction_l2_err\":{:.3e},\"coulomb_excess\":{:.2e}",
                 self.q_ratio, self.c, self.c_exact, self.c_rel_err(), self.traction_l2_err, self.coulomb_excess
+            ));
+        }
+        if self.c_stick_area > 0.0 {
+            s.push_str(&format!(
+                ",\"c_stick_area\":{:.6e},\"a_contact_area\":{:.6e}",
+                self.c_stick_area, self.a_contact_area
             ));
         }
         s.push('}');
@@ -394,6 +406,8 @@ fn hertz_run<const D: usize>(
         q_ratio: 0.0,
         c: 0.0,
         c_exact: 0.0,
+        c_stick_area: 0.0,
+        a_contact_area: 0.0,
         traction_l2_err: 0.0,
         coulomb_excess: 0.0,
         kkt: res.kkt.max(),
@@ -902,4 +916,223 @@ pub fn hertz3d_block(
     let h = (part_h(&model, 0, "contact"), part_h(&model, 1, "top"));
     run.h = if p.slave_indenter { h.0 } else { h.1 };
     Ok((run, h))
+}
+
+/// Solves the 3D Cattaneo–Mindlin problem: two identical hemispheres (parameters `p`: radius
+/// `R`, `E`, `ν`, refinement; the upper one `"upper"` touches the mirrored lower one `"lower"`
+/// at the origin, contact parts their caps `|z| < 0.15 R`, node to node with the fixed normal
+/// `−e_z`) are pressed together by the prescribed displacement `−push e_z` of the upper top
+/// (lower top clamped), frictionless; then sheared by a tangential displacement `s e_x` of the
+/// upper top with Tresca friction `g_c = μ p` from the normal state and slip measured from it.
+/// Identical materials give Dundurs `β = 0`, so the pressure does not change under the shear
+/// and this Tresca problem is the Coulomb problem. For each `Q/(μP)` of `q_ratios` (each
+/// in `(0, 1)`), `s` is tuned by a secant to within 0.5 %; the run records
+///
+/// ```text
+/// a_Hertz = (3 P R*/(4 E*))^{1/3},  R* = R/2,  1/E* = 2 (1 − ν²)/E,     p₀ = 3P/(2π a²),
+/// c_exact = a_Hertz (1 − Q/(μP))^{1/3}                                    (Mindlin),
+/// c_FE    = Mindlin's traction ratio fitted to ‖Λ_t,r‖ = |q_r|/(μ p_r)   ([`fit_stick_radius`]),
+/// c_area  = sqrt(A_stick / π),   A_stick = Σ_{stick cells} κ_r   (cells with ‖Λ_t‖ < 1 − 10⁻⁶),
+/// q(r)    = μ p₀ sqrt(1 − r²/a²) − (c/a) μ p₀ sqrt(1 − r²/c²)   (second term for r ≤ c),
+/// ```
+///
+/// `a` (fit of the pressure, [`fit_elliptic`]), the relative L² error of `|q|` and the
+/// Coulomb check `max(|q| − μ p)`. `c_FE` uses every node in contact; `c_area` (the area of
+/// the dual cells of the sticking nodes) moves by whole cells and is reported beside it.
+/// Mindlin's solution (uniform tangential displacement of the stick zone, traction parallel to
+/// the load) is exact for `ν = 0`; for `ν > 0` it neglects a small transverse traction.
+///
+/// # Errors
+/// [`ContactError::InvalidParameter`] for `μ ≤ 0` or a ratio outside `(0, 1)`; the errors of the
+/// model set-up and of the solves.
+pub fn cattaneo_mindlin_3d(
+    p: &Hertz3d,
+    mu: Real,
+    q_ratios: &[Real],
+    solver: &dyn ContactSolver,
+) -> Result<Vec<ContactRun>, ContactError> {
+    if !(mu > 0.0 && mu.is_finite()) || q_ratios.iter().any(|q| !(*q > 0.0 && *q < 1.0)) {
+        return Err(ContactError::InvalidParameter(format!(
+            "need μ > 0 and 0 < Q/(μP) < 1, got {mu}, {q_ratios:?}"
+        )));
+    }
+    let r = p.radius;
+    let mut upper = hemisphere_refined(
+        Point::<3>::new(0.0, 0.0, r),
+        r,
+        p.n,
+        Point::<3>::zeros(),
+        p.refine_radius * r,
+        p.levels,
+    )?;
+    upper.set_part_kind("top", BoundaryKind::Prescribed)?;
+    let mut lower = upper.reflected(2, 0.0)?;
+    lower.set_part_kind("top", BoundaryKind::Clamped)?;
+    upper.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] < 0.15 * r && n[2] < 0.0)?;
+    lower.add_boundary_part("contact", BoundaryKind::Contact, move |x, n| x[2] > -0.15 * r && n[2] > 0.0)?;
+    let material = Arc::new(isotropic(p.e, p.nu).map_err(fem)?);
+    let mut model = Model::<3>::new();
+    let up = model.add_body("upper", upper, material.clone()).map_err(fem)?;
+    let lo = model.add_body("lower", lower, material).map_err(fem)?;
+    let push = p.push;
+    model.prescribe(up, "top", move |_, t| Vector::<3>::new(t, 0.0, -push)).map_err(fem)?;
+    let mut pair = ContactPair::node_to_node("upper-lower", up, "contact", lo, "contact")
+        .with_fixed_normal(Vector::<3>::new(0.0, 0.0, -1.0));
+    pair.friction = mu;
+    let pairs = vec![pair];
+    let linear_solve_s = linear_solve_time(&model)?;
+    let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default())?;
+    sc.set_nested_iteration(p.nested.then_some(32));
+    let geo = sc.geometry().clone();
+    let t0 = Instant::now();
+    let normal = sc.solve(&model, 0.0, solver, None, None, None)?;
+    let normal_s = t0.elapsed().as_secs_f64();
+    let force = normal.normal_force(&geo, 0..geo.len());
+    let gc = geo.slip_bounds_from_pressure(&normal.solution.lambda_n);
+    let e_star = p.e / (2.0 * (1.0 - p.nu * p.nu));
+    let r_star = r / 2.0;
+    let a_exact = (3.0 * force * r_star / (4.0 * e_star)).cbrt();
+    let p0_exact = 3.0 * force / (2.0 * std::f64::consts::PI * a_exact * a_exact);
+    let radial = |x: &Point<3>| (x[0] * x[0] + x[1] * x[1]).sqrt();
+    // the friction force of a cell c: g_c κ_c Σ_j Λ_t,c,j T_c,j
+    let traction = |res: &StaticContactResult<3>, c: usize| -> (usize, Real, Vector<3>) {
+        let node = res.cell_node[c];
+        let n = &geo.nodes[node];
+        let (l1, l2) = (res.solution.lambda_t[2 * c], res.solution.lambda_t[2 * c + 1]);
+        (node, (l1 * l1 + l2 * l2).sqrt(), (n.tangents[0] * l1 + n.tangents[1] * l2) * res.slip_bound[c])
+    };
+    let tangential_force = |res: &StaticContactResult<3>| -> Real {
+        (0..res.cell_node.len())
+            .map(|c| {
+                let (node, _, q) = traction(res, c);
+                q * geo.nodes[node].weight
+            })
+            .sum::<Vector<3>>()
+            .norm()
+    };
+    let mut warm: Option<synovia_contact::ContactSolution> = None;
+    let iterations = std::cell::Cell::new(0);
+    let solve = |shift: Real,
+                 warm: &mut Option<synovia_contact::ContactSolution>|
+     -> Result<(StaticContactResult<3>, Real), ContactError> {
+        let res = sc.solve(&model, shift, solver, Some(&gc), Some(&normal.displacement), warm.as_ref())?;
+        iterations.set(iterations.get() + res.solution.report.iterations);
+        *warm = Some(res.solution.clone());
+        let q = tangential_force(&res) / (mu * force);
+        Ok((res, q))
+    };
+    let mut runs = Vec::new();
+    let (mut s_prev, mut q_prev) = (0.0, 0.0);
+    for &target in q_ratios {
+        let t_tangential = Instant::now();
+        // secant on the shift from the last converged point (the origin for the first ratio)
+        let mut s0 = if s_prev > 0.0 { s_prev } else { 1e-4 * r };
+        let (_, mut q0) = solve(s0, &mut warm)?;
+        let mut s1 =
+            if s_prev > 0.0 && q_prev > 0.0 { s_prev * target / q_prev } else { s0 * target / q0.max(1e-12) };
+        let (mut res, mut q1) = solve(s1, &mut warm)?;
+        for _ in 0..20 {
+            if (q1 - target).abs() < 5e-3 * target || q1 == q0 {
+                break;
+            }
+            let s2 = s1 + (target - q1) * (s1 - s0) / (q1 - q0);
+            s0 = s1;
+            q0 = q1;
+            s1 = s2;
+            (res, q1) = solve(s1, &mut warm)?;
+        }
+        s_prev = s1;
+        q_prev = q1;
+        let c_exact = a_exact * (1.0 - q1).cbrt();
+        let (mut stick_area, mut num, mut den, mut excess) = (0.0, 0.0, 0.0, Real::NEG_INFINITY);
+        let mut ratio_points = Vec::with_capacity(res.cell_node.len());
+        for c in 0..res.cell_node.len() {
+            let (node, norm, q) = traction(&res, c);
+            let w = geo.nodes[node].weight;
+            if norm < 1.0 - 1e-6 {
+                stick_area += w;
+            }
+            let x = radial(&geo.nodes[node].position);
+            if res.solution.lambda_n[node] > 0.0 {
+                ratio_points.push((x, norm, w));
+            }
+            let s1 = 1.0 - (x / a_exact).powi(2);
+            let s2 = 1.0 - (x / c_exact).powi(2);
+            let mut qe = if s1 > 0.0 { mu * p0_exact * s1.sqrt() } else { 0.0 };
+            if s2 > 0.0 {
+                qe -= c_exact / a_exact * mu * p0_exact * s2.sqrt();
+            }
+            num += w * (q.norm() - qe).powi(2);
+            den += w * qe * qe;
+            excess = excess.max(q.norm() - mu * res.solution.lambda_n[node].abs());
+        }
+        let mut run = hertz_run(
+            "cattaneo_mindlin_3d",
+            p.levels,
+            &model,
+            &sc,
+            &res,
+            solver,
+            (normal_s + t_tangential.elapsed().as_secs_f64(), linear_solve_s),
+            (force, a_exact, p0_exact),
+            radial,
+        );
+        run.iterations = iterations.get();
+        run.coarse_iterations = normal.coarse_iterations;
+        run.q_ratio = q1;
+        run.c = fit_stick_radius(&ratio_points, a_exact);
+        run.c_stick_area = (stick_area / std::f64::consts::PI).sqrt();
+        let contact_area: Real = geo
+            .nodes
+            .iter()
+            .zip(&normal.solution.lambda_n)
+            .filter(|(_, &l)| l > 0.0)
+            .map(|(n, _)| n.weight)
+            .sum();
+        run.a_contact_area = (contact_area / std::f64::consts::PI).sqrt();
+        run.c_exact = c_exact;
+        run.traction_l2_err = (num / den).sqrt();
+        run.coulomb_excess = excess;
+        run.kkt = res.kkt.max().max(normal.kkt.max());
+        runs.push(run);
+    }
+    Ok(runs)
+}
+
+/// The stick radius `c` of Mindlin's traction ratio fitted to the nodal ratios `φ_r = |q_r|/(μ p_r)`
+/// (`= ‖Λ_t,r‖` when `g_c = μ p`): with the Hertz radius `a`,
+///
+/// ```text
+/// φ(r; c) = 1 − sqrt((c² − r²)⁺ / (a² − r²))      (r < a),
+/// c = argmin_{0 ≤ c ≤ a} Σ_r κ_r (φ_r − φ(r_r; c))²   over the points (r_r, φ_r, κ_r) with r_r < a,
+/// ```
+///
+/// by a scan of 400 values and a golden-section refinement around the best one.
+pub fn fit_stick_radius(points: &[(Real, Real, Real)], a: Real) -> Real {
+    let cost = |c: Real| -> Real {
+        points
+            .iter()
+            .filter(|(r, _, _)| *r < a)
+            .map(|&(r, phi, w)| {
+                let model = 1.0 - ((c * c - r * r).max(0.0) / (a * a - r * r)).sqrt();
+                w * (phi - model).powi(2)
+            })
+            .sum()
+    };
+    let n = 400;
+    let best = (0..=n)
+        .map(|k| a * k as Real / n as Real)
+        .min_by(|x, y| cost(*x).total_cmp(&cost(*y)))
+        .unwrap_or(0.0);
+    let (mut lo, mut hi) = ((best - a / n as Real).max(0.0), (best + a / n as Real).min(a));
+    let golden = 0.5 * (5.0_f64.sqrt() - 1.0);
+    for _ in 0..60 {
+        let (x1, x2) = (hi - golden * (hi - lo), lo + golden * (hi - lo));
+        if cost(x1) < cost(x2) {
+            hi = x2;
+        } else {
+            lo = x1;
+        }
+    }
+    0.5 * (lo + hi)
 }

@@ -46,4 +46,23 @@ pub enum TimeError {
         /// Last relative change of the slip bound.
         change: f64,
     },
+    /// Bodies held only by contact carry a tangential load above what Coulomb friction can
+    /// hold at this level, `|Q_t| > Σ_r F_c κ_r |Λ_n,r| = μ·P` (docs/model.md §7.1): no static
+    /// equilibrium exists, the body slides. Forces in the model's force unit (newtons for the
+    /// usual mm–N–MPa units; per unit thickness in 2D).
+    #[error("time step {step} (t = {time}): the tangential load {tangential:.6e} N on {bodies:?} exceeds the friction capacity μ·P = {capacity:.6e} N (normal force P = {normal:.6e} N); the body slides")]
+    Slides {
+        /// Step index.
+        step: usize,
+        /// Time.
+        time: f64,
+        /// The bodies held by friction (one floating component).
+        bodies: Vec<String>,
+        /// Magnitude of the tangential part of the load resultant on those bodies.
+        tangential: f64,
+        /// The friction capacity `Σ_r g_c,r κ_r` (`μ·P` for a constant coefficient).
+        capacity: f64,
+        /// The normal contact force `P = Σ_r κ_r Λ_n,r` on those bodies.
+        normal: f64,
+    },
 }

@@ -37,6 +37,14 @@
 //!   solution is the last one (computed with `g^k`). After `max_fixed_point` solves without
 //!   convergence the run stops with [`TimeError::FixedPoint`].
 //!
+//! * **Bodies held by friction** (docs/model.md §7.1, (7.2a)–(7.2b)): for a model with bodies
+//!   that only contact holds, a level whose Tresca solve fails (the bound frozen from `t_{i−1}`
+//!   cannot hold the load at `t_i`), and a step 0 whose frictionless problem is unbalanced
+//!   while the pairs have friction, are solved as the Coulomb fixed point at that level,
+//!   started from the normal problem with the unbalanced rigid-body load withheld
+//!   ([`synovia_contact::floating::withhold_unbalanced`]). When the tangential load exceeds the
+//!   Coulomb capacity `μ·P` the run stops with [`TimeError::Slides`] (both forces given).
+//!
 //! The factorisation of `A` is done once, in [`QuasiStaticStepper::new`], and reused at every
 //! level and fixed-point iteration (docs/model.md §7).
 //!
@@ -89,11 +97,11 @@ use std::time::Instant;
 
 use synovia_contact::operators::{ContactGeometry, ContactPair};
 use synovia_contact::{
-    slip_speeds, ContactSolution, ContactSolver, FrictionLaw, PairFrictionLaws, SolverReport, StaticContact,
-    StaticContactResult,
+    slip_speeds, ContactError, ContactSolution, ContactSolver, FrictionLaw, PairFrictionLaws, SolverReport,
+    StaticContact, StaticContactResult,
 };
 use synovia_fem::post::body_fields;
-use synovia_fem::{ElasticParams, Model};
+use synovia_fem::{BodyId, ElasticParams, Model};
 use synovia_io::{Encoding, Field, TimeSeriesWriter, VtuWriter};
 use synovia_mesh::math::{Real, Vector};
 
@@ -482,7 +490,16 @@ impl<const D: usize> QuasiStaticStepper<D> {
                     self.laws.slip_bounds(self.contact.geometry(), &prev.solution.lambda_n, &self.slip_rate);
                 let origin = self.params.incremental_slip.then_some(prev.displacement.as_slice());
                 let rate_from = Some((prev.displacement.as_slice(), dt));
-                self.tresca_level(model, step, t, solver, g, origin, rate_from, Some(prev))?
+                match self.tresca_level(model, step, t, solver, g, origin, rate_from, Some(prev)) {
+                    Ok(solved) => solved,
+                    // the bound frozen from t_{i−1} cannot hold the load at t_i: Coulomb at t_i
+                    Err(e) if self.held_by_friction(&e) => {
+                        let none = vec![0.0; self.contact.geometry().len()];
+                        let warm = warm_start(self.contact.geometry(), prev, &none);
+                        self.coulomb_from_normal(model, step, t, solver, origin, rate_from, Some(warm))?
+                    }
+                    Err(e) => return Err(e),
+                }
             }
         };
         let geometry = self.contact.geometry();
@@ -534,10 +551,17 @@ impl<const D: usize> QuasiStaticStepper<D> {
         solver: &dyn ContactSolver,
         warm: Option<&ContactSolution>,
     ) -> Result<(StaticContactResult<D>, usize), TimeError> {
-        let pre = self
-            .contact
-            .solve(model, t, solver, None, None, warm)
-            .map_err(|source| TimeError::Contact { step: 0, time: t, source })?;
+        let pre = match self.contact.solve(model, t, solver, None, None, warm) {
+            Ok(pre) => pre,
+            Err(source) => {
+                let e = TimeError::Contact { step: 0, time: t, source };
+                // a body held by friction alone: the static problem with Coulomb friction
+                if self.held_by_friction(&e) {
+                    return self.coulomb_from_normal(model, 0, t, solver, None, None, warm.cloned());
+                }
+                return Err(e);
+            }
+        };
         let its = pre.solution.report.iterations + pre.coarse_iterations;
         let geometry = self.contact.geometry();
         if !(self.params.initial_friction && self.laws.any_friction(geometry)) {
@@ -593,6 +617,166 @@ impl<const D: usize> QuasiStaticStepper<D> {
             g = g_new;
         }
         Err(TimeError::FixedPoint { step, iterations: max, change })
+    }
+}
+
+impl<const D: usize> QuasiStaticStepper<D> {
+    /// Whether `e` is the failure of a model with bodies held only by contact and with friction
+    /// whose load contact forces cannot balance with the slip bound given to the solve (the
+    /// rigid-load check, or the proximal iteration stagnating): the case for
+    /// [`QuasiStaticStepper::coulomb_from_normal`].
+    fn held_by_friction(&self, e: &TimeError) -> bool {
+        self.contact.elastic().stabilisation().is_some()
+            && self.laws.any_friction(self.contact.geometry())
+            && matches!(
+                e,
+                TimeError::Contact {
+                    source: ContactError::Unbalanced { .. } | ContactError::NoConvergence { .. },
+                    ..
+                }
+            )
+    }
+
+    /// The Coulomb fixed point (docs/model.md (3.8), §7.1) of the level at `t` of a model whose
+    /// bodies are held by friction, started from the normal problem:
+    ///
+    /// ```text
+    /// Λ_n⁰ = Λ_n of the frictionless problem with the load F_w (F without the rigid-body load
+    ///        that no normal contact force balances, synovia_contact::floating::withhold_unbalanced),
+    /// g⁰   = F_c |Λ_n⁰|,
+    /// g^{m+1} = F_c(v^m) |Λ_n(g^m)|   (Tresca at t with the full load F and g^m, slip from `origin`),
+    /// stop when max_r |g^{m+1}_r − g^m_r| ≤ ε max_r |g^{m+1}_r|,
+    /// ```
+    ///
+    /// each solve warm-started from the last (`ε` = [`QuasiStaticParams::fixed_point_tolerance`],
+    /// at most [`QuasiStaticParams::max_fixed_point`] Tresca solves). `warm` warm-starts the
+    /// normal problem (`U`, `Λ_n`).
+    ///
+    /// # Errors
+    /// [`TimeError::Slides`] when a Tresca solve fails and the tangential load on the floating
+    /// bodies exceeds their friction capacity `Σ_r g^m_r κ_r = μ·P`; [`TimeError::FixedPoint`]
+    /// when the iteration does not converge; [`TimeError::Contact`] for other solver failures.
+    #[allow(clippy::too_many_arguments)]
+    fn coulomb_from_normal(
+        &self,
+        model: &Model<D>,
+        step: usize,
+        t: Real,
+        solver: &dyn ContactSolver,
+        origin: Option<&[Vec<Vector<D>>]>,
+        rate_from: Option<(&[Vec<Vector<D>>], Real)>,
+        warm: Option<ContactSolution>,
+    ) -> Result<(StaticContactResult<D>, usize), TimeError> {
+        let contact_error = |source| TimeError::Contact { step, time: t, source };
+        let elastic = self.contact.elastic();
+        let geometry = self.contact.geometry();
+        let Some(stabilisation) = elastic.stabilisation() else {
+            return Err(TimeError::InvalidParameter(
+                "the Coulomb start from the normal problem needs bodies held only by contact".into(),
+            ));
+        };
+        let (load, lifts) = elastic.rhs(model, t)?;
+        let normal = geometry.normal_constraints(elastic.dofs(), &lifts);
+        let (withheld, _) = synovia_contact::floating::withhold_unbalanced(stabilisation, &load, &normal);
+        let pre = self
+            .contact
+            .solve_load(&withheld, &lifts, solver, None, None, warm.as_ref())
+            .map_err(contact_error)?;
+        let mut iterations = pre.solution.report.iterations + pre.coarse_iterations;
+        let rest = vec![0.0; geometry.len()];
+        let mut pressure = pre.solution.lambda_n.clone();
+        let mut g = self.laws.slip_bounds(geometry, &pressure, &rest);
+        let mut warm = warm_start(geometry, &pre, &g);
+        let mut change = Real::INFINITY;
+        for _ in 0..self.params.max_fixed_point {
+            let res = match self.contact.solve(model, t, solver, Some(&g), origin, Some(&warm)) {
+                Ok(res) => res,
+                Err(source) => {
+                    return Err(self
+                        .slides(model, step, t, &load, &g, &pressure)
+                        .unwrap_or_else(|| contact_error(source)))
+                }
+            };
+            iterations += res.solution.report.iterations + res.coarse_iterations;
+            let rate = match rate_from {
+                Some((prev, dt)) => slip_speeds(geometry, &res.displacement, prev, dt),
+                None => rest.clone(),
+            };
+            let g_new = self.laws.slip_bounds(geometry, &res.solution.lambda_n, &rate);
+            change = relative_change(&g, &g_new);
+            if change <= self.params.fixed_point_tolerance {
+                return Ok((res, iterations));
+            }
+            warm = warm_start(geometry, &res, &g_new);
+            pressure.clone_from(&res.solution.lambda_n);
+            g = g_new;
+        }
+        Err(TimeError::FixedPoint { step, iterations: self.params.max_fixed_point, change })
+    }
+
+    /// [`TimeError::Slides`] for the first floating component whose tangential load exceeds its
+    /// friction capacity with the slip bounds `g` computed from the pressures `pressure`:
+    /// the load resultant `f = (t_kᵀ F)_k` (`t_k` the reduced unknowns of a unit translation
+    /// `e_k` of the component's bodies), the contact normal `n̄ = Σ_r κ_r Λ_n,r n_r / ‖·‖` over
+    /// the component's contact nodes, `Q_t = ‖f − (f·n̄) n̄‖`, `P = Σ_r κ_r Λ_n,r` and the
+    /// capacity `Σ_r κ_r g_r`; `None` if no component has `Q_t` above its capacity.
+    fn slides(
+        &self,
+        model: &Model<D>,
+        step: usize,
+        t: Real,
+        load: &[Real],
+        g: &[Real],
+        pressure: &[Real],
+    ) -> Option<TimeError> {
+        let elastic = self.contact.elastic();
+        let geometry = self.contact.geometry();
+        for component in &elastic.stabilisation()?.components {
+            let inside = |b: BodyId| component.body_ids.contains(&b);
+            let mut f = Vector::<D>::zeros();
+            for k in 0..D {
+                let full: Vec<Vec<Vector<D>>> = model
+                    .bodies()
+                    .iter()
+                    .enumerate()
+                    .map(|(b, body)| {
+                        let mut e = Vector::<D>::zeros();
+                        if inside(BodyId(b)) {
+                            e[k] = 1.0;
+                        }
+                        vec![e; body.mesh.n_nodes()]
+                    })
+                    .collect();
+                let translation = elastic.dofs().restrict(&full);
+                f[k] = translation.iter().zip(load).map(|(a, b)| a * b).sum();
+            }
+            let (mut n_sum, mut normal, mut capacity) = (Vector::<D>::zeros(), 0.0, 0.0);
+            for (r, node) in geometry.nodes.iter().enumerate() {
+                let on_k = inside(node.node.0);
+                let on_l = node.partner.is_some_and(|(b, _)| inside(b))
+                    || node.master.iter().any(|&(b, _, _)| inside(b));
+                if !(on_k || on_l) {
+                    continue;
+                }
+                let force = node.weight * pressure.get(r).copied().unwrap_or(0.0).abs();
+                n_sum += node.normal * if on_k { force } else { -force };
+                normal += force;
+                capacity += node.weight * g.get(r).copied().unwrap_or(0.0);
+            }
+            let n_bar = n_sum.try_normalize(0.0)?;
+            let tangential = (f - n_bar * f.dot(&n_bar)).norm();
+            if normal > 0.0 && tangential > capacity {
+                return Some(TimeError::Slides {
+                    step,
+                    time: t,
+                    bodies: component.bodies.clone(),
+                    tangential,
+                    capacity,
+                    normal,
+                });
+            }
+        }
+        None
     }
 }
 
