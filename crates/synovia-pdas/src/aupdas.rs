@@ -69,6 +69,8 @@ impl ContactSolver for AuPdas {
         let start = Instant::now();
         let name = self.name();
         let mut st = State::new(problem, context, &self.params)?;
+        // a convergent step length for the projected-gradient update of the slipping cells
+        st.bound_tangential_rho()?;
         let mut nu = st.initial_nu(problem, context.warm_start())?;
         let mut y = st.values(&nu)?;
         let mut sets =
