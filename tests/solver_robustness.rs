@@ -214,3 +214,43 @@ fn every_solver_on_two_body_shear_with_friction() {
         }
     }
 }
+
+/// The per-step records name the solver that produced each accepted solution: with the
+/// default `pdas-fallback`, `"pdas"` — or `"dual-mprgp"` (with the reason in `fallback`)
+/// when PDAS is cut short, here by an iteration limit of 1.
+#[test]
+fn records_name_the_solver_that_ran() {
+    let delta = 1e-2;
+    let shear = move |t: f64| {
+        Vector::<3>::new(if t > 1.0 { 2.0 * delta * (t - 1.0) } else { 0.0 }, 0.0, -delta * t.min(1.0))
+    };
+    let mut joint = stacked3(MU, shear);
+    let run = joint.run_quasistatic(&[0.0, 1.0, 1.5, 2.0]).expect("default solver");
+    assert_eq!(run.solver, DEFAULT_SOLVER);
+    for r in &run.records {
+        assert_eq!(r.solver, "pdas", "{r:?}");
+        assert!(r.fallback.is_none());
+    }
+    joint.contact_params(ContactParams::default().with_max_iterations(1));
+    let run = joint.run_quasistatic(&[0.0, 1.0, 1.5, 2.0]).expect("fallback");
+    let mut handed_over = 0;
+    for r in &run.records {
+        match r.solver.as_str() {
+            "pdas" => assert!(r.fallback.is_none(), "{r:?}"),
+            "dual-mprgp" => {
+                assert!(r.fallback.as_deref().is_some_and(|f| f.contains("pdas failed")), "{r:?}");
+                handed_over += 1;
+            }
+            other => panic!("unexpected solver {other}"),
+        }
+    }
+    assert!(handed_over >= 1, "PDAS limited to one iteration must hand over at least once");
+    let last = run.records.last().expect("record");
+    assert_eq!(last.solver, run.contact.as_ref().expect("contact").solution.report.solver);
+    // the session's record carries it too
+    let mut session = joint.prepare().expect("session");
+    session.solve_static(2.0).expect("solve");
+    let rec = session.record().expect("record");
+    assert!(rec.solver == "pdas" || rec.solver == "dual-mprgp", "{rec:?}");
+    println!("records: {:?}", run.records.iter().map(|r| r.solver.as_str()).collect::<Vec<_>>());
+}
