@@ -39,7 +39,7 @@ use crate::sets::{finish, CellState, Sets, State};
 /// which converges only for `ρ` below roughly `2/λ_max(S_tt)`. AU-PDAS is therefore
 /// `ρ`-sensitive (unlike [`Pdas`](crate::Pdas)): the automatic `ρ` made it oscillate on 3D
 /// problems (touching blocks, two-body shear), so the friction cells' `ρ_c` is bounded by the
-/// step of a convergent projected-gradient step, `ρ_c ≤ 1/(1.05 λ̂ D_c)` (docs/model.md §6.2;
+/// step of a convergent projected-gradient step, `ρ_c ≤ 1.8/(λ̂ D_c)` (docs/model.md §6.2;
 /// `λ̂ ≈ λ_max(D^{-½} S_tt D^{-½})` by the power method, `D_c` the cell mean of `diag S_tt`).
 /// On badly conditioned `S_tt` (a floating body on its stabilised operator) convergence is then
 /// slow and the solver may return [`ContactError::NoConvergence`].
