@@ -27,7 +27,9 @@ pub const COMBINATOR_NAMES: &[&str] = &["pdas-fallback"];
 pub fn by_name(name: &str) -> Result<Box<dyn ContactSolver>, ContactError> {
     Ok(match name {
         "pdas" => Box::new(synovia_pdas::Pdas::default()),
-        "au-pdas" => Box::new(synovia_pdas::AuPdas::default()),
+        "au-pdas" => Box::new(synovia_pdas::AuPdas::new(
+            ContactParams::default().with_max_iterations(AU_PDAS_MIN_ITERATIONS),
+        )),
         "uzawa-mprgp" => Box::new(synovia_uzawa::UzawaMprgp::default()),
         "dual-mprgp" => Box::new(synovia_uzawa::DualMprgp::default()),
         "pdas-fallback" => Box::new(PdasFallback::default()),
@@ -35,12 +37,31 @@ pub fn by_name(name: &str) -> Result<Box<dyn ContactSolver>, ContactError> {
     })
 }
 
-/// The solver called `name` with the given parameters.
+/// Least outer-iteration limit of `uzawa-mprgp` built by [`by_name_with`] (that of
+/// [`synovia_uzawa::UzawaMprgp::default`]; [`ContactParams::default`] has 200).
+pub const UZAWA_MIN_ITERATIONS: usize = 2000;
+
+/// Least iteration limit of `au-pdas` built by [`by_name`] and [`by_name_with`]: AU-PDAS is a
+/// block Gauss–Seidel iteration between normal and tangential rows and converges linearly (3D
+/// two-body shear with the bounded step of docs/model.md §6.2: a few hundred iterations).
+pub const AU_PDAS_MIN_ITERATIONS: usize = 1000;
+
+/// The solver called `name` with the given parameters (`au-pdas`: at least
+/// [`AU_PDAS_MIN_ITERATIONS`] iterations; `uzawa-mprgp`: at least
+/// [`UZAWA_MIN_ITERATIONS`] outer iterations; `pdas-fallback`: at least 10 000 iterations of
+/// its `dual-mprgp` phase).
 pub fn by_name_with(name: &str, params: ContactParams) -> Result<Box<dyn ContactSolver>, ContactError> {
     Ok(match name {
         "pdas" => Box::new(synovia_pdas::Pdas::new(params)),
-        "au-pdas" => Box::new(synovia_pdas::AuPdas::new(params)),
-        "uzawa-mprgp" => Box::new(synovia_uzawa::UzawaMprgp::new(params)),
+        // AU-PDAS converges linearly (docs/model.md §6.2): at least AU_PDAS_MIN_ITERATIONS
+        "au-pdas" => Box::new(synovia_pdas::AuPdas::new(
+            params.with_max_iterations(params.max_iterations.max(AU_PDAS_MIN_ITERATIONS)),
+        )),
+        // outer Uzawa iterations: at least those of UzawaMprgp::default (its accelerated
+        // projected-gradient iteration needs hundreds where PDAS needs a handful)
+        "uzawa-mprgp" => Box::new(synovia_uzawa::UzawaMprgp::new(
+            params.with_max_iterations(params.max_iterations.max(UZAWA_MIN_ITERATIONS)),
+        )),
         "dual-mprgp" => Box::new(synovia_uzawa::DualMprgp::new(params)),
         "pdas-fallback" => Box::new(PdasFallback::new(params)),
         _ => {

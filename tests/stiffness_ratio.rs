@@ -105,3 +105,18 @@ fn pdas_and_au_pdas_stop_at_the_same_relative_accuracy_in_any_units_and_ratio() 
         }
     }
 }
+
+/// `uzawa-mprgp` stalled at `E₁/E₂ ≥ 1e5` (normal residual 6.1e-10 / 3.0e-9 against 1e-10 for
+/// 2000 iterations) before its scale-aware test (issue 15): it now stops when the residual
+/// stalls at rounding level and `check_kkt` holds relative to the problem's scales.
+#[test]
+fn uzawa_mprgp_converges_at_stiffness_ratios_1e5_and_1e6() {
+    let uzawa = by_name("uzawa-mprgp").expect("solver");
+    for ratio in [1e5, 1e6] {
+        for scale in [1.0, 1e9] {
+            let (it, _, ran) = check(ratio, scale, uzawa.as_ref());
+            assert_eq!(ran, "uzawa-mprgp");
+            assert!(it <= 10, "{it} iterations at {ratio:e}");
+        }
+    }
+}

@@ -37,9 +37,12 @@ use crate::sets::{finish, CellState, Sets, State};
 /// Gauss–Seidel iteration between the normal and tangential rows, and in 3D
 /// `Λ_t ← π(Λ_t + ρ (y − s))` is a projected-gradient (Uzawa) step on the slip directions,
 /// which converges only for `ρ` below roughly `2/λ_max(S_tt)`. AU-PDAS is therefore
-/// `ρ`-sensitive (unlike [`Pdas`](crate::Pdas)): on the test problems it cycles for
-/// `rho_scale ≥ 10` in 2D and `rho_scale ≥ 0.5` in 3D, and then returns
-/// [`ContactError::NoConvergence`].
+/// `ρ`-sensitive (unlike [`Pdas`](crate::Pdas)): the automatic `ρ` made it oscillate on 3D
+/// problems (touching blocks, two-body shear), so the friction cells' `ρ_c` is bounded by the
+/// step of a convergent projected-gradient step, `ρ_c ≤ 1.8/(λ̂ D_c)` (docs/model.md §6.2;
+/// `λ̂ ≈ λ_max(D^{-½} S_tt D^{-½})` by the power method, `D_c` the cell mean of `diag S_tt`).
+/// On badly conditioned `S_tt` (a floating body on its stabilised operator) convergence is then
+/// slow and the solver may return [`ContactError::NoConvergence`].
 ///
 /// [`SolverReport::inner_iterations`] counts the dense interface solves (two per iteration
 /// with friction).
@@ -69,6 +72,8 @@ impl ContactSolver for AuPdas {
         let start = Instant::now();
         let name = self.name();
         let mut st = State::new(problem, context, &self.params)?;
+        // a convergent step length for the projected-gradient update of the slipping cells
+        st.bound_tangential_rho()?;
         let mut nu = st.initial_nu(problem, context.warm_start())?;
         let mut y = st.values(&nu)?;
         let mut sets =

@@ -258,6 +258,78 @@ impl<'p> State<'p> {
         }
     }
 
+    /// Bounds `ρ_c` of the friction cells by the step length of a convergent projected
+    /// gradient step (AU-PDAS, docs/model.md §6.2):
+    ///
+    /// ```text
+    /// ρ_c ← min(ρ_c, 1.8 / (λ̂ D_c)),   D_c = mean of diag S_tt over cell c,
+    /// λ̂ = power-method estimate of λ_max(D^{-½} S_tt D^{-½}) (non-pinned cells).
+    /// ```
+    ///
+    /// AU-PDAS updates the slipping cells by `Λ_t,c ← π(Λ_t,c + ρ_c (y_c − s_c))` with the
+    /// normal multipliers frozen, a projected-gradient (Uzawa) step on the dual function whose
+    /// gradient `y_t − s` is Lipschitz with constant `λ_max(S_tt)`; it converges only for
+    /// `ρ < 2 / λ_max` in the metric `D`. The automatic `ρ` of
+    /// [`ContactProblem::default_rho`] does not know `S_tt` and was 3–10× above that limit on
+    /// 3D problems (two touching blocks, two-body shear, a floating block held by friction),
+    /// where AU-PDAS then oscillated for ever. The solution does not depend on `ρ`.
+    /// Columns of `S` for every friction row are computed (`m_t` solves, once).
+    pub fn bound_tangential_rho(&mut self) -> Result<(), ContactError> {
+        let rows: Vec<usize> = (0..self.n_cells)
+            .filter(|&c| self.pinned.get(c).is_none_or(|p| p.is_none()))
+            .flat_map(|c| (0..self.comps).map(move |k| (c, k)))
+            .map(|(c, k)| self.cell_row(c, k))
+            .collect();
+        if rows.is_empty() {
+            return Ok(());
+        }
+        self.iface.ensure_columns(&rows)?;
+        let diag_of = |r: usize| self.iface.column(r).map_or(0.0, |col| col[r]);
+        // D per row: the cell mean of diag S_tt (discs stay discs)
+        let mut d = vec![0.0; rows.len()];
+        for (chunk, dc) in rows.chunks(self.comps).zip(d.chunks_mut(self.comps)) {
+            let mean = chunk.iter().map(|&r| diag_of(r)).sum::<f64>() / self.comps as f64;
+            dc.iter_mut().for_each(|v| *v = mean);
+        }
+        if d.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
+            return Ok(()); // a degenerate row: keep the automatic ρ
+        }
+        let isq: Vec<f64> = d.iter().map(|v| 1.0 / v.sqrt()).collect();
+        // power method on H = D^{-½} S_tt D^{-½}
+        let mut v: Vec<f64> = (0..rows.len()).map(|i| 1.0 + 0.1 * ((i % 7) as f64)).collect();
+        let mut lambda = 0.0_f64;
+        for _ in 0..30 {
+            let nv = v.iter().map(|a| a * a).sum::<f64>().sqrt();
+            if !(nv > 0.0 && nv.is_finite()) {
+                break;
+            }
+            v.iter_mut().for_each(|a| *a /= nv);
+            let mut hv = vec![0.0; rows.len()];
+            for (j, &rj) in rows.iter().enumerate() {
+                let col = self.iface.column(rj).ok_or_else(|| {
+                    ContactError::InvalidParameter(format!("internal: column {rj} of S not computed"))
+                })?;
+                let xj = v[j] * isq[j];
+                for (i, &ri) in rows.iter().enumerate() {
+                    hv[i] += col[ri] * xj;
+                }
+            }
+            hv.iter_mut().zip(&isq).for_each(|(a, s)| *a *= s);
+            lambda = lambda.max(v.iter().zip(&hv).map(|(a, b)| a * b).sum::<f64>());
+            v = hv;
+        }
+        if !(lambda.is_finite() && lambda > 0.0) {
+            return Ok(());
+        }
+        for (&r, dr) in rows.iter().zip(&d) {
+            let bound = RHO_STEP / (lambda * dr);
+            if bound < self.rho[r] {
+                self.rho[r] = bound;
+            }
+        }
+        Ok(())
+    }
+
     /// Interface row of component `k` of cell `c`.
     pub fn cell_row(&self, c: usize, k: usize) -> usize {
         self.m + c * self.comps + k
@@ -574,6 +646,11 @@ pub(crate) fn finish(
 /// is measured with `check_kkt` (whose tangential residuals are scaled by the whole
 /// displacement field and accept a less accurate `Λ_t`).
 pub(crate) const STALL_FACTOR: f64 = 0.99;
+
+/// Step factor of [`State::bound_tangential_rho`]: `ρ_c ≤ RHO_STEP / (λ̂ D_c)`, below the limit
+/// `2 / λ_max` of a convergent projected-gradient step (`λ̂` from the power method is a lower
+/// bound of `λ_max`, accurate to a few per cent after 30 steps).
+const RHO_STEP: f64 = 1.8;
 
 /// The scale-aware stopping test used when the interface residuals stall above the tolerance.
 ///

@@ -744,6 +744,8 @@ impl<const D: usize> DynamicStepper<D> {
                 / dt2;
             friction_work = fwork / dt2;
             new_pressure.clone_from(&scaled.solution.lambda_n);
+            record.solver.clone_from(&scaled.solution.report.solver);
+            record.fallback.clone_from(&scaled.solution.report.fallback);
             let physical = ContactSolution {
                 u: scaled.solution.u.clone(),
                 lambda_n: scaled.solution.lambda_n.iter().map(|l| l / dt2).collect(),

@@ -522,6 +522,8 @@ impl<const D: usize> QuasiStaticStepper<D> {
             viscous_dissipation: 0.0,
             iterations,
             step_s: start.elapsed().as_secs_f64(),
+            solver: result.solution.report.solver.clone(),
+            fallback: result.solution.report.fallback.clone(),
         };
         self.cumulative = cumulative;
         self.slip_rate = slip_rate;

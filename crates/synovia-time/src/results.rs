@@ -53,6 +53,13 @@ pub struct StepRecord {
     pub iterations: usize,
     /// Wall time of the step (s).
     pub step_s: Real,
+    /// The contact solver that produced the accepted solution of this step
+    /// ([`SolverReport::solver`](synovia_contact::SolverReport): e.g. `"pdas"`, or
+    /// `"dual-mprgp"` after the `pdas-fallback` hand-over); empty without contact pairs.
+    pub solver: String,
+    /// Why the configured solver handed over to another one, if it did
+    /// ([`SolverReport::fallback`](synovia_contact::SolverReport)).
+    pub fallback: Option<String>,
 }
 
 /// Computes the pair records of a contact solution.

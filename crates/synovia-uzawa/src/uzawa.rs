@@ -15,6 +15,10 @@ use crate::common::{
 use crate::qp::{estimate_norm, solve_qp, QpOptions};
 use crate::schur::{ScaledBlock, SchurOperator};
 
+/// Factor by which the normal residual must drop between outer iterations to count as still
+/// converging; a residual that does not is measured by `check_kkt` (see [`UzawaMprgp`]).
+const STALL_FACTOR: f64 = 0.99;
+
 /// Uzawa's method with MPRGP inner solves (docs/model.md §6.3), in the force multipliers
 /// `ν = (ν_n, Λ_t) = (κ Λ_n, Λ_t)` on the interface (`S`, `w`, `g = (d, s)` as in
 /// [`DualMprgp`](crate::DualMprgp)).
@@ -63,7 +67,12 @@ use crate::schur::{ScaledBlock, SchurOperator};
 /// `‖Λ_t^{k+1} − Λ̂_t^k‖_∞`, the normal residual `‖Λ_n − (Λ_n + ρ(B_hn U − d))⁺‖_∞ / max Λ_n`
 /// and the tangential residual `‖Λ_t − π(Λ_t + ρ (B_Ht U − s))‖_∞` (`ρ` from
 /// [`ContactProblem::default_rho`]) are all at most `params.tolerance`; if the inner solves are
-/// not accurate enough for that, their tolerance is tightened (by 10⁻², down to 10⁻¹⁵).
+/// not accurate enough for that, their tolerance is tightened (by 10⁻², down to 10⁻¹⁵). If the
+/// normal residual, computed from `y = w − S ν`, stalls above the tolerance at its rounding
+/// level `ε κ(A) ‖w‖` (stiffness ratios ≥ 1e5, floating bodies on the stabilised `A + S`) while
+/// the friction step and residual are converged, the iterate is accepted when every relative
+/// residual of `synovia_contact::check_kkt` is at most the tolerance (the scale-aware test of
+/// `synovia_pdas`, docs/reliability.md).
 /// `params.max_iterations` bounds the outer iterations — tight tolerances need a few hundred
 /// (the default of [`UzawaMprgp::default`] is 2000; that of [`ContactParams`] is 200). A
 /// normal row acting on no free unknown is fixed at `ν_n = 0`, or reported as
@@ -222,7 +231,17 @@ impl ContactSolver for UzawaMprgp {
                 set_changes: res.changes(&last),
             });
             let inner_ok = qrep.converged && res.normal <= tol;
-            if inner_ok && delta <= tol && res.tangential <= tol {
+            // scale-aware test (as in synovia_pdas): the normal residual, computed from
+            // y = w − S ν, stalls at the rounding level ε κ(A) ‖w‖ above the tolerance on
+            // ill-conditioned problems (stiffness ratios ≥ 1e5, floating bodies); the iterate
+            // is then measured by check_kkt, relative to the force and displacement scales
+            let stalled = qrep.converged
+                && res.normal > tol
+                && delta <= tol
+                && res.tangential <= tol
+                && history.len() >= 2
+                && res.normal >= STALL_FACTOR * history[history.len() - 2].normal;
+            if (inner_ok && delta <= tol && res.tangential <= tol) || stalled {
                 let report = SolverReport {
                     solver: self.name().to_string(),
                     iterations: k,
@@ -235,11 +254,17 @@ impl ContactSolver for UzawaMprgp {
                 // problems the displacements are tiny and the stick condition must also hold
                 // relative to them (the scale of `check_kkt`): otherwise keep iterating.
                 // (a multipliers-only solve has no U to check: its multiplier test above holds)
-                if mt == 0
-                    || sol.u.is_empty()
-                    || synovia_contact::check_kkt(problem, &sol.u, &sol.lambda_n, &sol.lambda_t).max()
-                        <= 100.0 * tol
-                {
+                let accept = if stalled {
+                    !sol.u.is_empty()
+                        && synovia_contact::check_kkt(problem, &sol.u, &sol.lambda_n, &sol.lambda_t).max()
+                            <= tol
+                } else {
+                    mt == 0
+                        || sol.u.is_empty()
+                        || synovia_contact::check_kkt(problem, &sol.u, &sol.lambda_n, &sol.lambda_t).max()
+                            <= 100.0 * tol
+                };
+                if accept {
                     sol.report.time_s = t0.elapsed().as_secs_f64();
                     return Ok(sol);
                 }
