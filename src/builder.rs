@@ -61,6 +61,9 @@ use synovia_time::TimeError;
 
 use crate::session::JointSession;
 
+mod setup;
+pub use setup::{InitialPenetration, SetupInfo, PENETRATION_TOLERANCE};
+
 /// Everything that can go wrong while building or running a [`JointModel`].
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -98,6 +101,10 @@ pub enum JointError {
     /// Invalid input to the builder (names, sizes, missing data).
     #[error("{0}")]
     Invalid(String),
+    /// Contact nodes start inside their partner and the model refuses it
+    /// ([`JointModel::refuse_initial_penetration`]).
+    #[error("{0}")]
+    InitialPenetration(Box<InitialPenetration>),
     /// An error returned by a step observer.
     #[error("{0}")]
     Observer(Box<dyn std::error::Error + Send + Sync>),
@@ -258,6 +265,8 @@ pub struct JointModel<const D: usize> {
     dynamic_params: DynamicParams,
     nested: Option<usize>,
     analysis: Option<Analysis>,
+    refuse_penetration: bool,
+    refuse_penetration_pairs: Vec<String>,
 }
 
 impl<const D: usize> fmt::Debug for JointModel<D> {
@@ -322,6 +331,8 @@ impl<const D: usize> JointModel<D> {
             dynamic_params: DynamicParams::new(1.0),
             nested: Some(32),
             analysis: None,
+            refuse_penetration: false,
+            refuse_penetration_pairs: Vec::new(),
         }
     }
 
@@ -687,6 +698,7 @@ impl<const D: usize> JointModel<D> {
                 pair.name, pair.friction
             )));
         }
+        self.check_pair_conflict(&pair)?;
         self.assign_kind(pair.body, &pair.part, BoundaryKind::Contact)?;
         if let Some((body, part)) = pair.partner_part() {
             self.assign_kind(body, part, BoundaryKind::Contact)?;
@@ -802,6 +814,7 @@ impl<const D: usize> JointModel<D> {
         &self,
         observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
+        self.check_penetration_policy()?;
         match self.analysis.clone() {
             None => Err(JointError::Invalid("no analysis set (use set_analysis)".into())),
             Some(Analysis::Static { time }) => self.run_levels(&[time], observer),
@@ -880,6 +893,7 @@ impl<const D: usize> JointModel<D> {
     /// As [`JointModel::run_static`] for the set-up: invalid model, contact set-up, unknown
     /// solver.
     pub fn prepare(&self) -> Result<JointSession<'_, D>, JointError> {
+        self.check_penetration_policy()?;
         JointSession::new(self)
     }
 

@@ -117,6 +117,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod duplicates;
 pub mod error;
 pub mod field;
 pub mod gmsh;
@@ -125,6 +126,7 @@ pub mod read;
 mod util;
 pub mod vtu;
 
+pub use duplicates::{coincident_nodes, CoincidentNodes, COINCIDENT_TOLERANCE};
 pub use error::IoError;
 pub use field::{Field, FieldLocation};
 pub use gmsh::{
