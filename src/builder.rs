@@ -812,9 +812,26 @@ impl<const D: usize> JointModel<D> {
     /// As [`JointModel::run`]; whatever `observer` returns.
     pub fn run_with(
         &self,
-        observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
+        mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
         self.check_penetration_policy()?;
+        let solver = self.solver.clone();
+        // one log line per step (`tracing`, level debug; the library installs no subscriber)
+        let observer = move |v: &StepView<'_, D>| {
+            let ran = &v.result.solution.report.solver;
+            tracing::debug!(
+                step = v.record.step,
+                time = v.record.time,
+                iterations = v.record.iterations,
+                kkt = if v.geometry.is_empty() { 0.0 } else { v.result.kkt.max() },
+                step_s = v.record.step_s,
+                solver = if ran.is_empty() { solver.as_str() } else { ran.as_str() },
+                "step {} of {} done",
+                v.record.step + 1,
+                v.n_steps
+            );
+            observer(v)
+        };
         match self.analysis.clone() {
             None => Err(JointError::Invalid("no analysis set (use set_analysis)".into())),
             Some(Analysis::Static { time }) => self.run_levels(&[time], observer),
