@@ -428,7 +428,10 @@ impl<const D: usize> JointModel<D> {
         velocity: Vector<D>,
     ) -> Result<&mut Self, JointError> {
         if velocity.iter().any(|v| !v.is_finite()) {
-            return Err(JointError::Invalid(format!("initial velocity {velocity:?} is not finite")));
+            return Err(JointError::Invalid(format!(
+                "initial velocity {} is not finite",
+                synovia_fem::error::fmt_point(velocity.as_slice())
+            )));
         }
         let id = body.resolve(&self.model)?;
         self.initial_velocity[id.0] = Some(velocity);

@@ -87,7 +87,11 @@ impl<const D: usize> JointModel<D> {
     ///
     /// # Errors
     /// [`JointError::Invalid`] for an unknown pair.
-    pub fn refuse_initial_penetration_in(&mut self, pair: &str, refuse: bool) -> Result<&mut Self, JointError> {
+    pub fn refuse_initial_penetration_in(
+        &mut self,
+        pair: &str,
+        refuse: bool,
+    ) -> Result<&mut Self, JointError> {
         if !self.pairs.iter().any(|p| p.name == pair) {
             return Err(JointError::Invalid(format!("no contact pair `{pair}`")));
         }
@@ -188,7 +192,10 @@ impl<const D: usize> JointModel<D> {
         let dynamic = matches!(self.analysis, Some(super::Analysis::Dynamic { .. }));
         let (estimate, geometry) = if self.pairs.is_empty() {
             let identity = |_: &DofMap<D>, o: synovia_linalg::Ordering| Ok(o);
-            (ElasticSolver::estimate_with_ordering(&self.model, self.elastic_params, dynamic, &identity)?, None)
+            (
+                ElasticSolver::estimate_with_ordering(&self.model, self.elastic_params, dynamic, &identity)?,
+                None,
+            )
         } else {
             let (g, e) = StaticContact::estimate(&self.model, &self.pairs, self.elastic_params)?;
             (e, Some(g))
@@ -219,8 +226,12 @@ impl<const D: usize> JointModel<D> {
 
     /// Errors if two contact pairs would constrain the same nodes twice: the same contact part
     /// (body `k` side) in two pairs, or the same two parts paired twice.
-    pub(super) fn check_pair_conflict(&self, pair: &synovia_contact::operators::ContactPair<D>) -> Result<(), JointError> {
-        let body_name = |id: synovia_fem::BodyId| self.model.body(id).map_or_else(|_| String::new(), |b| b.name.clone());
+    pub(super) fn check_pair_conflict(
+        &self,
+        pair: &synovia_contact::operators::ContactPair<D>,
+    ) -> Result<(), JointError> {
+        let body_name =
+            |id: synovia_fem::BodyId| self.model.body(id).map_or_else(|_| String::new(), |b| b.name.clone());
         for p in &self.pairs {
             if p.body == pair.body && p.part == pair.part {
                 return Err(JointError::Invalid(format!(

@@ -21,13 +21,13 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use clap::{ArgAction, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use synovia_cli::run::{self, Progress, RunError, RunOptions};
+use synovia_cli::Scenario;
 use tracing::Level;
 use tracing_subscriber::fmt::format::{self, FormatEvent, FormatFields};
 use tracing_subscriber::fmt::FmtContext;
 use tracing_subscriber::registry::LookupSpan;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use synovia_cli::run::{self, Progress, RunError, RunOptions};
-use synovia_cli::Scenario;
 
 #[derive(Parser)]
 #[command(name = "synovia", version, about = "Finite-element contact mechanics of human joints")]
@@ -109,22 +109,14 @@ fn init_logging(verbose: u8, quiet: bool) {
         .try_init();
 }
 
-fn gib(bytes: u64) -> String {
-    let b = bytes as f64;
-    if b >= 1024.0 * 1024.0 * 1024.0 {
-        format!("{:.2} GiB", b / (1024.0 * 1024.0 * 1024.0))
-    } else {
-        format!("{:.1} MiB", b / (1024.0 * 1024.0))
-    }
-}
-
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let quiet = cli.quiet;
     init_logging(cli.verbose, quiet);
     match cli.command {
         Command::Check { scenario } => {
-            let checked = Scenario::from_file(&scenario).map_err(RunError::from).and_then(|sc| run::check(&sc));
+            let checked =
+                Scenario::from_file(&scenario).and_then(|sc| run::check(&sc)).map_err(RunError::from);
             match checked {
                 Ok(info) => {
                     for w in &info.warnings {
@@ -146,7 +138,10 @@ fn main() -> ExitCode {
                         for (p, n) in &info.contact_nodes {
                             println!("  contact pair {p}: {n} contact candidates");
                         }
-                        println!("  factorisation: ≈ {} of memory", gib(info.memory_bytes));
+                        println!(
+                            "  factorisation: ≈ {} of memory",
+                            synovia::linalg::error::fmt_bytes(info.memory_bytes)
+                        );
                         println!("  ok: {} warning(s)", info.warnings.len());
                     }
                     ExitCode::SUCCESS

@@ -234,11 +234,12 @@ fn dimension(sc: &Scenario) -> Result<usize, ScenarioError> {
 /// estimate, initial penetration) without solving.
 ///
 /// # Errors
-/// [`RunError::Scenario`] for a broken scenario, [`RunError::Failed`] for the first set-up
-/// error a run would meet (the same message as the run's).
-pub fn check(sc: &Scenario) -> Result<ModelInfo, RunError> {
-    fn info<const D: usize>(b: &Built<D>) -> Result<ModelInfo, RunError> {
-        let setup = b.joint.check().map_err(|e| RunError::Failed(anyhow::Error::new(e)))?;
+/// The scenario's first problem; a set-up error a run would meet (initial penetration
+/// refused, memory, ties, pairs) is a [`ScenarioError`] about the whole file with the same
+/// message as the run's.
+pub fn check(sc: &Scenario) -> Result<ModelInfo, ScenarioError> {
+    fn info<const D: usize>(sc: &Scenario, b: &Built<D>) -> Result<ModelInfo, ScenarioError> {
+        let setup = b.joint.check().map_err(|e| sc.source.file_error(error_message(&e)))?;
         let mut warnings = b.warnings.clone();
         warnings.extend(setup.penetration.iter().map(ToString::to_string));
         if !setup.floating_bodies.is_empty() {
@@ -264,8 +265,8 @@ pub fn check(sc: &Scenario) -> Result<ModelInfo, RunError> {
         })
     }
     match dimension(sc)? {
-        2 => info(&build::<2>(sc)?),
-        _ => info(&build::<3>(sc)?),
+        2 => info(sc, &build::<2>(sc)?),
+        _ => info(sc, &build::<3>(sc)?),
     }
 }
 
@@ -394,7 +395,13 @@ fn run_dim<const D: usize>(
     let mut warnings = built.warnings.clone();
     // initial penetration (refused by the run itself when the scenario says so)
     if let Ok(found) = built.joint.initial_penetration() {
-        warnings.extend(found.iter().map(ToString::to_string));
+        // (a refused one is the run's error, not a warning)
+        warnings.extend(
+            found
+                .iter()
+                .filter(|p| !built.joint.refuses_initial_penetration(&p.pair))
+                .map(ToString::to_string),
+        );
     }
     // bodies held only by contact, and the pairs that hold them (not in dynamic runs: the
     // mass holds them)
@@ -469,7 +476,8 @@ fn run_dim<const D: usize>(
         };
         let has_contact = !view.geometry.is_empty();
         let kkt = if has_contact { view.result.kkt.max() } else { 0.0 };
-        let mut summary = step_summary(view.record, vtu, kkt, solver_that_ran(&configured_solver, view.result));
+        let mut summary =
+            step_summary(view.record, vtu, kkt, solver_that_ran(&configured_solver, view.result));
         summary.position_undetermined = !floating.is_empty()
             && summary.pairs.iter().filter(|p| holding.contains(&p.name)).all(|p| p.normal_force == 0.0);
         if summary.position_undetermined {

@@ -53,7 +53,7 @@ pub enum FemError {
         given: &'static str,
     },
     /// A function of the problem data (load, prescribed displacement) returned NaN or ∞.
-    #[error("{what} is not finite at x = {x:?}, t = {t}")]
+    #[error("{what} is not finite at x = {}, t = {t}", fmt_point(x))]
     NonFiniteData {
         /// Which data.
         what: String,
@@ -78,7 +78,7 @@ pub enum FemError {
     UnmatchedInterface(Box<UnmatchedInterface>),
     /// Some bodies are not held against rigid motion (docs/model.md §4): the elastic problem is
     /// semi-coercive and its stiffness matrix singular.
-    #[error("bodies {bodies:?} are semi-coercive: {free_modes} rigid-body mode(s) are not restrained by Dirichlet or symmetry data; add boundary conditions or solve it as a contact problem")]
+    #[error("bodies {} are semi-coercive: {free_modes} rigid-body mode(s) are not restrained by Dirichlet or symmetry data; add boundary conditions or solve it as a contact problem", fmt_names(bodies))]
     SemiCoercive {
         /// Names of the bodies of the unrestrained component.
         bodies: Vec<String>,
@@ -158,4 +158,9 @@ pub struct UnmatchedInterface {
 pub fn fmt_point(x: &[f64]) -> String {
     let parts: Vec<String> = x.iter().map(|v| format!("{v:.6}")).collect();
     format!("({})", parts.join(", "))
+}
+
+/// Names as `` `a`, `b` ``, for messages.
+pub fn fmt_names(names: &[String]) -> String {
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
 }

@@ -129,7 +129,10 @@ pub fn memory_limit() -> Option<(u64, String)> {
     if let Ok(v) = std::env::var(MEMORY_LIMIT_ENV) {
         if let Ok(mb) = v.trim().parse::<f64>() {
             if mb.is_finite() && mb >= 0.0 {
-                return Some(((mb * 1024.0 * 1024.0) as u64, format!("allowed by {MEMORY_LIMIT_ENV}={}", v.trim())));
+                return Some((
+                    (mb * 1024.0 * 1024.0) as u64,
+                    format!("allowed by {MEMORY_LIMIT_ENV}={}", v.trim()),
+                ));
             }
         }
     }
@@ -271,8 +274,8 @@ impl CholeskySolver {
         if let Some((available, origin)) = limit {
             if estimate.total_bytes().saturating_sub(held) > available {
                 return Err(LinalgError::OutOfMemory {
-                    needed_gib: estimate.total_gib(),
-                    available_gib: available as f64 / GIB,
+                    needed: estimate.total_bytes(),
+                    available,
                     origin,
                     dofs: estimate.dofs,
                     factor_entries: estimate.factor_entries,

@@ -601,7 +601,11 @@ fn mesh<const D: usize>(
         let rk = key(k, "reflect");
         let axis = r.get_ref().axis.get_ref();
         let a = AXES.iter().take(D).position(|x| x == axis).ok_or_else(|| {
-            cx.err(key(&rk, "axis"), r.get_ref().axis.span(), format!("axis must be one of {:?}", &AXES[..D]))
+            cx.err(
+                key(&rk, "axis"),
+                r.get_ref().axis.span(),
+                format!("axis must be one of {}", AXES[..D].join(", ")),
+            )
         })?;
         mesh = mesh.reflected(a, r.get_ref().at).map_err(|e| cx.err(&rk, r.span(), e.to_string()))?;
     }
@@ -1164,7 +1168,7 @@ fn boundary<const D: usize>(
                 }
                 for (j, comp) in c.get_ref().iter().enumerate() {
                     let a = AXES.iter().take(D).position(|x| x == comp.get_ref()).ok_or_else(|| {
-                        cx.err(format!("{ck}[{j}]"), comp.span(), format!("a component is one of {:?}", &AXES[..D]))
+                        cx.err(format!("{ck}[{j}]"), comp.span(), format!("a component is one of {}", AXES[..D].join(", ")))
                     })?;
                     m[a] = true;
                 }
@@ -1241,7 +1245,11 @@ fn boundary<const D: usize>(
             let p = match v.get_ref() {
                 NumOrVec::Num(x) if x.is_finite() => *x,
                 other => {
-                    return Err(cx.err(key(k, "value"), v.span(), format!("a pressure is one finite number, got {other:?}")))
+                    let got = match other {
+                        NumOrVec::Num(x) => x.to_string(),
+                        NumOrVec::Vec(v) => format!("a list of {} numbers", v.len()),
+                    };
+                    return Err(cx.err(key(k, "value"), v.span(), format!("a pressure is one finite number, got {got}")));
                 }
             };
             joint.pressure(body.as_str(), &part, p, history()?).map_err(built_err)?;
