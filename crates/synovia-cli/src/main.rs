@@ -198,10 +198,8 @@ fn main() -> ExitCode {
             bar.finish_and_clear();
             match result {
                 Ok(report) if report.summary.interrupted => {
+                    // printed also with -q: it explains the exit code 130
                     let s = &report.summary;
-                    if quiet {
-                        return ExitCode::from(130);
-                    }
                     eprintln!(
                         "interrupted after {} of {} steps; {} holds their results (summary.json has \"interrupted\": true)",
                         s.steps.len(),
