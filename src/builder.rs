@@ -62,6 +62,9 @@ use synovia_time::TimeError;
 
 use crate::session::JointSession;
 
+mod setup;
+pub use setup::{InitialPenetration, SetupInfo, PENETRATION_TOLERANCE};
+
 /// Everything that can go wrong while building or running a [`JointModel`].
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -99,6 +102,10 @@ pub enum JointError {
     /// Invalid input to the builder (names, sizes, missing data).
     #[error("{0}")]
     Invalid(String),
+    /// Contact nodes start inside their partner and the model refuses it
+    /// ([`JointModel::refuse_initial_penetration`]).
+    #[error("{0}")]
+    InitialPenetration(Box<InitialPenetration>),
     /// An error returned by a step observer.
     #[error("{0}")]
     Observer(Box<dyn std::error::Error + Send + Sync>),
@@ -259,6 +266,8 @@ pub struct JointModel<const D: usize> {
     dynamic_params: DynamicParams,
     nested: Option<usize>,
     analysis: Option<Analysis>,
+    refuse_penetration: bool,
+    refuse_penetration_pairs: Vec<String>,
 }
 
 impl<const D: usize> fmt::Debug for JointModel<D> {
@@ -323,6 +332,8 @@ impl<const D: usize> JointModel<D> {
             dynamic_params: DynamicParams::new(1.0),
             nested: Some(32),
             analysis: None,
+            refuse_penetration: false,
+            refuse_penetration_pairs: Vec::new(),
         }
     }
 
@@ -418,7 +429,10 @@ impl<const D: usize> JointModel<D> {
         velocity: Vector<D>,
     ) -> Result<&mut Self, JointError> {
         if velocity.iter().any(|v| !v.is_finite()) {
-            return Err(JointError::Invalid(format!("initial velocity {velocity:?} is not finite")));
+            return Err(JointError::Invalid(format!(
+                "initial velocity {} is not finite",
+                synovia_fem::error::fmt_point(velocity.as_slice())
+            )));
         }
         let id = body.resolve(&self.model)?;
         self.initial_velocity[id.0] = Some(velocity);
@@ -688,6 +702,7 @@ impl<const D: usize> JointModel<D> {
                 pair.name, pair.friction
             )));
         }
+        self.check_pair_conflict(&pair)?;
         self.assign_kind(pair.body, &pair.part, BoundaryKind::Contact)?;
         if let Some((body, part)) = pair.partner_part() {
             self.assign_kind(body, part, BoundaryKind::Contact)?;
@@ -801,8 +816,26 @@ impl<const D: usize> JointModel<D> {
     /// As [`JointModel::run`]; whatever `observer` returns.
     pub fn run_with(
         &self,
-        observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
+        mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
+        self.check_penetration_policy()?;
+        let solver = self.solver.clone();
+        // one log line per step (`tracing`, level debug; the library installs no subscriber)
+        let observer = move |v: &StepView<'_, D>| {
+            let ran = &v.result.solution.report.solver;
+            tracing::debug!(
+                step = v.record.step,
+                time = v.record.time,
+                iterations = v.record.iterations,
+                kkt = if v.geometry.is_empty() { 0.0 } else { v.result.kkt.max() },
+                step_s = v.record.step_s,
+                solver = if ran.is_empty() { solver.as_str() } else { ran.as_str() },
+                "step {} of {} done",
+                v.record.step + 1,
+                v.n_steps
+            );
+            observer(v)
+        };
         match self.analysis.clone() {
             None => Err(JointError::Invalid("no analysis set (use set_analysis)".into())),
             Some(Analysis::Static { time }) => self.run_levels(&[time], observer),
@@ -881,6 +914,7 @@ impl<const D: usize> JointModel<D> {
     /// As [`JointModel::run_static`] for the set-up: invalid model, contact set-up, unknown
     /// solver.
     pub fn prepare(&self) -> Result<JointSession<'_, D>, JointError> {
+        self.check_penetration_policy()?;
         JointSession::new(self)
     }
 

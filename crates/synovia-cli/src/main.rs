@@ -2,7 +2,8 @@
 //!
 //! ```text
 //! synovia run SCENARIO.toml --out DIR    # solve; write DIR/NAME.pvd, NAME_*.vtu, NAME.csv, summary.json, manifest.json
-//! synovia check SCENARIO.toml            # read and build the model without solving
+//! synovia check SCENARIO.toml            # build everything up to the solve, report sizes
+//! synovia -v run …                       # one log line per step; -vv: everything; -q: errors only
 //! ```
 //!
 //! Exit codes: 0 success, 1 the solve or the output failed, 2 a broken scenario (the message on
@@ -19,14 +20,25 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use clap::{Parser, Subcommand};
+use clap::{ArgAction, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use synovia_cli::run::{self, Progress, RunError, RunOptions};
 use synovia_cli::Scenario;
+use tracing::Level;
+use tracing_subscriber::fmt::format::{self, FormatEvent, FormatFields};
+use tracing_subscriber::fmt::FmtContext;
+use tracing_subscriber::registry::LookupSpan;
 
 #[derive(Parser)]
 #[command(name = "synovia", version, about = "Finite-element contact mechanics of human joints")]
 struct Cli {
+    /// More output on stderr: `-v` one line per step (time, iterations, KKT residual, step
+    /// time, solver) instead of the progress bar, `-vv` everything the library logs.
+    #[arg(long, short, action = ArgAction::Count, global = true)]
+    verbose: u8,
+    /// Errors only: no progress bar, no report, no warnings.
+    #[arg(long, short, global = true, conflicts_with = "verbose")]
+    quiet: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -40,50 +52,107 @@ enum Command {
         /// Output directory (default: `output.dir` of the scenario, or out/NAME).
         #[arg(long, short)]
         out: Option<PathBuf>,
-        /// No progress bar and no closing report.
-        #[arg(long, short)]
-        quiet: bool,
         /// Write into an output directory that holds files no earlier run wrote (they are
         /// kept; the outputs of earlier runs are always replaced).
         #[arg(long)]
         force: bool,
     },
-    /// Read a scenario and build its model (meshes, materials, conditions) without solving.
+    /// Build everything `run` builds before solving (model, ties, contact geometry, symbolic
+    /// factorisation and its memory estimate) and report it, without solving.
     Check {
         /// The scenario file.
         scenario: PathBuf,
     },
 }
 
+/// Log lines as `warning: message key=value …` on stderr.
+struct Plain;
+
+impl<S, N> FormatEvent<S, N> for Plain
+where
+    S: tracing::Subscriber + for<'a> LookupSpan<'a>,
+    N: for<'a> FormatFields<'a> + 'static,
+{
+    fn format_event(
+        &self,
+        ctx: &FmtContext<'_, S, N>,
+        mut writer: format::Writer<'_>,
+        event: &tracing::Event<'_>,
+    ) -> std::fmt::Result {
+        let level = match *event.metadata().level() {
+            Level::ERROR => "error",
+            Level::WARN => "warning",
+            Level::INFO => "info",
+            Level::DEBUG => "debug",
+            Level::TRACE => "trace",
+        };
+        write!(writer, "{level}: ")?;
+        ctx.field_format().format_fields(writer.by_ref(), event)?;
+        writeln!(writer)
+    }
+}
+
+/// Installs the log subscriber: errors only with `-q`, warnings by default, debug with `-v`,
+/// trace with `-vv`.
+fn init_logging(verbose: u8, quiet: bool) {
+    let level = match (quiet, verbose) {
+        (true, _) => Level::ERROR,
+        (false, 0) => Level::WARN,
+        (false, 1) => Level::DEBUG,
+        _ => Level::TRACE,
+    };
+    let _ = tracing_subscriber::fmt()
+        .with_max_level(level)
+        .with_writer(std::io::stderr)
+        .with_ansi(false)
+        .event_format(Plain)
+        .try_init();
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let quiet = cli.quiet;
+    init_logging(cli.verbose, quiet);
     match cli.command {
         Command::Check { scenario } => {
-            let checked = Scenario::from_file(&scenario).and_then(|sc| run::check(&sc));
+            let checked =
+                Scenario::from_file(&scenario).and_then(|sc| run::check(&sc)).map_err(RunError::from);
             match checked {
                 Ok(info) => {
-                    println!(
-                        "{}: {}D, {} steps ({})",
-                        scenario.display(),
-                        info.dimension,
-                        info.steps,
-                        info.analysis
-                    );
-                    for (name, nodes, cells) in &info.bodies {
-                        println!("  body {name}: {nodes} nodes, {cells} cells");
+                    for w in &info.warnings {
+                        tracing::warn!("{w}");
                     }
-                    for p in &info.pairs {
-                        println!("  contact pair {p}");
+                    if !quiet {
+                        println!(
+                            "{}: {}D, {} steps ({}), {} dofs, solver {}",
+                            scenario.display(),
+                            info.dimension,
+                            info.steps,
+                            info.analysis,
+                            info.dofs,
+                            info.solver
+                        );
+                        for (name, nodes, cells) in &info.bodies {
+                            println!("  body {name}: {nodes} nodes, {cells} cells");
+                        }
+                        for (p, n) in &info.contact_nodes {
+                            println!("  contact pair {p}: {n} contact candidates");
+                        }
+                        println!(
+                            "  factorisation: ≈ {} of memory",
+                            synovia::linalg::error::fmt_bytes(info.memory_bytes)
+                        );
+                        println!("  ok: {} warning(s)", info.warnings.len());
                     }
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
-                    eprintln!("error: {e}");
+                    report_error(&scenario, &e);
                     ExitCode::from(2)
                 }
             }
         }
-        Command::Run { scenario, out, quiet, force } => {
+        Command::Run { scenario, out, force } => {
             let sc = match Scenario::from_file(&scenario) {
                 Ok(sc) => sc,
                 Err(e) => {
@@ -91,14 +160,14 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            let target = if !quiet && std::io::stderr().is_terminal() {
+            let target = if !quiet && cli.verbose == 0 && std::io::stderr().is_terminal() {
                 ProgressDrawTarget::stderr()
             } else {
                 ProgressDrawTarget::hidden()
             };
             let bar = ProgressBar::with_draw_target(None, target);
             if let Ok(style) = ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} steps  {msg}",
+                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} steps, ETA {eta}  {msg}",
             ) {
                 bar.set_style(style);
             }
@@ -129,6 +198,7 @@ fn main() -> ExitCode {
             bar.finish_and_clear();
             match result {
                 Ok(report) if report.summary.interrupted => {
+                    // printed also with -q: it explains the exit code 130
                     let s = &report.summary;
                     eprintln!(
                         "interrupted after {} of {} steps; {} holds their results (summary.json has \"interrupted\": true)",
@@ -153,6 +223,12 @@ fn main() -> ExitCode {
                             s.total_s
                         );
                         if let Some(last) = s.steps.last() {
+                            if !last.pairs.is_empty() {
+                                println!(
+                                    "  last step (t = {}): KKT residual {:.3e} (solver {})",
+                                    last.time, last.kkt, last.solver
+                                );
+                            }
                             for p in &last.pairs {
                                 println!(
                                     "  last step (t = {}): pair {}: normal force {:.5e}, contact area {:.5e}, peak pressure {:.5e}",
@@ -170,19 +246,28 @@ fn main() -> ExitCode {
                     }
                     ExitCode::SUCCESS
                 }
-                Err(RunError::Refused(e)) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(2)
-                }
-                Err(RunError::Scenario(e)) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(2)
-                }
-                Err(RunError::Failed(e)) => {
-                    eprintln!("error: {e:#}");
+                Err(e @ RunError::Failed(_)) => {
+                    report_error(&scenario, &e);
                     ExitCode::FAILURE
                 }
+                Err(e) => {
+                    report_error(&scenario, &e);
+                    ExitCode::from(2)
+                }
             }
+        }
+    }
+}
+
+/// Prints an error once on stderr: a scenario error (it names the file, key and position), or
+/// a set-up / solve failure prefixed with the scenario file.
+fn report_error(scenario: &std::path::Path, e: &RunError) {
+    match e {
+        RunError::Scenario(e) => eprintln!("error: {e}"),
+        RunError::Refused(e) => eprintln!("error: {e}"),
+        RunError::Failed(e) => {
+            let inner: &(dyn std::error::Error + 'static) = e.as_ref();
+            eprintln!("error: {}: {}", scenario.display(), run::error_message(inner));
         }
     }
 }

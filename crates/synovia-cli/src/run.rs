@@ -90,6 +90,16 @@ pub struct StepSummary {
     pub kinetic_energy: f64,
     /// Friction work of the step.
     pub friction_dissipation: f64,
+    /// The largest relative KKT residual of the step's contact solution (equilibrium,
+    /// penetration, complementarity, friction; 0 without contact).
+    pub kkt: f64,
+    /// The contact solver that produced the step's solution (e.g. `dual-mprgp` when
+    /// `pdas-fallback` fell back; [`solver_that_ran`]).
+    pub solver: String,
+    /// `true` when a body held only by contact carries no contact force at this step: its
+    /// position is then not determined by the equations (any rigid motion of it is a
+    /// solution; the one reported is the solver's).
+    pub position_undetermined: bool,
     /// The step's `.vtu` file (relative to the output directory), if written.
     pub vtu: Option<String>,
 }
@@ -131,7 +141,8 @@ pub struct Summary {
     pub dimension: usize,
     /// `static`, `quasistatic` or `dynamic`.
     pub analysis: String,
-    /// Contact solver.
+    /// Contact solver (as configured; each step's [`StepSummary::solver`] names the one that
+    /// ran).
     pub solver: String,
     /// Reduced unknowns.
     pub dofs: usize,
@@ -154,6 +165,11 @@ pub struct Summary {
     pub interrupted: bool,
     /// Steps the analysis would have produced (`steps.len()` unless interrupted).
     pub steps_planned: usize,
+    /// The KKT residual of the last step (`steps.last().kkt`; 0 without steps).
+    pub final_kkt: f64,
+    /// Warnings of the build and the run (initial penetration, unused duplicate nodes,
+    /// undetermined positions), also printed by the CLI.
+    pub warnings: Vec<String>,
 }
 
 /// Options of [`run_with_options`].
@@ -176,8 +192,8 @@ pub struct RunReport {
     pub out_dir: PathBuf,
 }
 
-/// A short description of a built model (`synovia check`).
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// A short description of a built and checked model (`synovia check`).
+#[derive(Debug, Clone, PartialEq)]
 pub struct ModelInfo {
     /// Dimension.
     pub dimension: usize,
@@ -189,6 +205,16 @@ pub struct ModelInfo {
     pub analysis: String,
     /// Steps the analysis will produce.
     pub steps: usize,
+    /// Reduced unknowns.
+    pub dofs: usize,
+    /// Contact candidates (contact nodes) per pair `(name, count)`.
+    pub contact_nodes: Vec<(String, usize)>,
+    /// The memory estimate of the factorisation, bytes.
+    pub memory_bytes: u64,
+    /// The contact solver.
+    pub solver: String,
+    /// Warnings (initial penetration, unused duplicate nodes, floating bodies).
+    pub warnings: Vec<String>,
 }
 
 fn dimension(sc: &Scenario) -> Result<usize, ScenarioError> {
@@ -203,14 +229,23 @@ fn dimension(sc: &Scenario) -> Result<usize, ScenarioError> {
     }
 }
 
-/// Builds the model of a scenario without solving it (reads the meshes, checks every name and
-/// value).
+/// Builds everything [`run`] builds before solving (meshes, every name and value, dofs and
+/// ties, contact geometry and pair conflicts, the symbolic factorisation and its memory
+/// estimate, initial penetration) without solving.
 ///
 /// # Errors
-/// The scenario's first problem.
+/// The scenario's first problem; a set-up error a run would meet (initial penetration
+/// refused, memory, ties, pairs) is a [`ScenarioError`] about the whole file with the same
+/// message as the run's.
 pub fn check(sc: &Scenario) -> Result<ModelInfo, ScenarioError> {
-    fn info<const D: usize>(b: &Built<D>) -> ModelInfo {
-        ModelInfo {
+    fn info<const D: usize>(sc: &Scenario, b: &Built<D>) -> Result<ModelInfo, ScenarioError> {
+        let setup = b.joint.check().map_err(|e| sc.source.file_error(error_message(&e)))?;
+        let mut warnings = b.warnings.clone();
+        warnings.extend(setup.penetration.iter().map(ToString::to_string));
+        if !setup.floating_bodies.is_empty() {
+            warnings.push(floating_note(&setup.floating_bodies));
+        }
+        Ok(ModelInfo {
             dimension: D,
             bodies: b
                 .joint
@@ -222,12 +257,54 @@ pub fn check(sc: &Scenario) -> Result<ModelInfo, ScenarioError> {
             pairs: b.joint.pairs().iter().map(|p| p.name.clone()).collect(),
             analysis: b.analysis.kind().to_string(),
             steps: b.analysis.n_records(),
-        }
+            dofs: setup.n_dofs,
+            contact_nodes: setup.contact_nodes,
+            memory_bytes: setup.memory.total_bytes(),
+            solver: b.joint.solver_name().to_string(),
+            warnings,
+        })
     }
     match dimension(sc)? {
-        2 => Ok(info(&build::<2>(sc)?)),
-        _ => Ok(info(&build::<3>(sc)?)),
+        2 => info(sc, &build::<2>(sc)?),
+        _ => info(sc, &build::<3>(sc)?),
     }
+}
+
+fn floating_note(bodies: &[String]) -> String {
+    format!(
+        "bodies {} are held only by contact: at a step where no contact force acts on them their position is undetermined (summary.json: `position_undetermined`)",
+        bodies.iter().map(|b| format!("`{b}`")).collect::<Vec<_>>().join(", ")
+    )
+}
+
+/// The name of the contact solver that produced a step's solution: the one its report names,
+/// else the configured one (a step without contact solve).
+pub fn solver_that_ran<const D: usize>(
+    configured: &str,
+    result: &synovia::contact_ops::StaticContactResult<D>,
+) -> String {
+    let ran = &result.solution.report.solver;
+    if ran.is_empty() {
+        configured.to_string()
+    } else {
+        ran.clone()
+    }
+}
+
+/// An error and its causes as one line, each cause once: a cause whose text the message
+/// already holds (errors that print their source) is not repeated.
+pub fn error_message(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut out = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        let text = c.to_string();
+        if !out.contains(&text) {
+            out.push_str(": ");
+            out.push_str(&text);
+        }
+        cause = c.source();
+    }
+    out
 }
 
 /// Runs a scenario and writes its results to `out` (default: `output.dir` of the scenario, or
@@ -270,7 +347,7 @@ fn file_name(p: &Path) -> String {
     p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
 }
 
-fn step_summary(record: &StepRecord, vtu: Option<String>) -> StepSummary {
+fn step_summary(record: &StepRecord, vtu: Option<String>, kkt: f64, solver: String) -> StepSummary {
     StepSummary {
         step: record.step,
         time: record.time,
@@ -294,6 +371,9 @@ fn step_summary(record: &StepRecord, vtu: Option<String>) -> StepSummary {
         strain_energy: record.strain_energy,
         kinetic_energy: record.kinetic_energy,
         friction_dissipation: record.friction_dissipation,
+        kkt,
+        solver,
+        position_undetermined: false,
         vtu,
     }
 }
@@ -312,6 +392,43 @@ fn run_dim<const D: usize>(
     let start = Instant::now();
     let built = build::<D>(sc)?;
     let name = built.name.clone();
+    let mut warnings = built.warnings.clone();
+    // initial penetration (refused by the run itself when the scenario says so)
+    if let Ok(found) = built.joint.initial_penetration() {
+        // (a refused one is the run's error, not a warning)
+        warnings.extend(
+            found
+                .iter()
+                .filter(|p| !built.joint.refuses_initial_penetration(&p.pair))
+                .map(ToString::to_string),
+        );
+    }
+    // bodies held only by contact, and the pairs that hold them (not in dynamic runs: the
+    // mass holds them)
+    let floating: Vec<String> = if built.analysis.kind() == "dynamic" {
+        Vec::new()
+    } else {
+        synovia::fem::dofs::DofMap::new(built.joint.model())
+            .map(|m| m.floating_components(built.joint.model()).into_iter().flat_map(|c| c.bodies).collect())
+            .unwrap_or_default()
+    };
+    let holding: Vec<String> = built
+        .joint
+        .pairs()
+        .iter()
+        .filter(|p| {
+            let body = |id: synovia::fem::BodyId| {
+                built.joint.model().body(id).map_or(false, |b| floating.contains(&b.name))
+            };
+            body(p.body) || p.partner_part().is_some_and(|(b, _)| body(b))
+        })
+        .map(|p| p.name.clone())
+        .collect();
+    for w in &warnings {
+        tracing::warn!("{w}");
+    }
+    let configured_solver = built.joint.solver_name().to_string();
+    let mut undetermined_steps = 0usize;
     let out_dir = match (out, &built.output.dir) {
         (Some(o), _) => o.to_path_buf(),
         (None, Some(d)) => d.clone(),
@@ -357,7 +474,16 @@ fn run_dim<const D: usize>(
         } else {
             None
         };
-        steps.push(step_summary(view.record, vtu));
+        let has_contact = !view.geometry.is_empty();
+        let kkt = if has_contact { view.result.kkt.max() } else { 0.0 };
+        let mut summary =
+            step_summary(view.record, vtu, kkt, solver_that_ran(&configured_solver, view.result));
+        summary.position_undetermined = !floating.is_empty()
+            && summary.pairs.iter().filter(|p| holding.contains(&p.name)).all(|p| p.normal_force == 0.0);
+        if summary.position_undetermined {
+            undetermined_steps += 1;
+        }
+        steps.push(summary);
         records.push(view.record.clone());
         progress(Progress::Step { index, time: view.record.time });
         let stop = options.interrupt.as_ref().is_some_and(|f| f.load(Ordering::SeqCst));
@@ -381,11 +507,18 @@ fn run_dim<const D: usize>(
         Err(e) => {
             // keep the folder explained: what was written before the failure
             let _ = folder.write_manifest("failed");
-            return Err(RunError::Failed(
-                anyhow::Error::new(e).context(format!("running `{}`", sc.source.file)),
-            ));
+            return Err(RunError::Failed(anyhow::Error::new(e)));
         }
     };
+    if undetermined_steps > 0 {
+        let w = format!(
+            "bodies {} are held only by contact, and at {undetermined_steps} step(s) no contact force acts on them: their position there is undetermined (`position_undetermined` in summary.json)",
+            floating.iter().map(|b| format!("`{b}`")).collect::<Vec<_>>().join(", ")
+        );
+        tracing::warn!("{w}");
+        warnings.push(w);
+    }
+    let final_kkt = steps.last().map_or(0.0, |s| s.kkt);
     let csv = format!("{name}.csv");
     let csv_tmp = out_dir.join(format!("{csv}.tmp"));
     write_csv(&csv_tmp, &records).map_err(anyhow::Error::new)?;
@@ -422,6 +555,8 @@ fn run_dim<const D: usize>(
         steps,
         interrupted,
         steps_planned: n_steps,
+        final_kkt,
+        warnings,
     };
     let json = serde_json::to_string_pretty(&summary).map_err(anyhow::Error::new)?;
     folder.write(SUMMARY, (json + "\n").as_bytes())?;

@@ -78,7 +78,7 @@ pub enum ContactError {
     /// Bodies held only by contact (semi-coercive, docs/model.md §4) carry a load whose rigid part no
     /// admissible contact force balances: the load pulls them away from, or slides them off,
     /// their contact partners.
-    #[error("bodies {bodies:?} are held only by contact, and contact forces cannot balance their load (unbalanced rigid-body load {residual:.3e} of {load:.3e}): the load pulls them away or slides them off; add Dirichlet or symmetry data, friction, or change the load")]
+    #[error("bodies {} are held only by contact, and contact forces cannot balance their load (unbalanced rigid-body load {residual:.3e} of {load:.3e}): the load pulls them away or slides them off; add Dirichlet or symmetry data, friction, or change the load", synovia_fem::error::fmt_names(bodies))]
     Unbalanced {
         /// The floating bodies.
         bodies: Vec<String>,

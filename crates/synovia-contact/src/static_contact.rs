@@ -100,6 +100,31 @@ impl<const D: usize> StaticContact<D> {
         })
     }
 
+    /// Everything [`StaticContact::new`] does before the numeric factorisation: the contact
+    /// geometry of `pairs` (nodes, normals, initial gaps; invalid pairs are errors), the dofs,
+    /// the interface ordering and the symbolic analysis with the memory check of the
+    /// factorisation ([`ElasticSolver::estimate_with_ordering`]). For checking a model
+    /// without solving it.
+    ///
+    /// # Errors
+    /// As [`StaticContact::new`] up to the factorisation (including
+    /// [`synovia_linalg::LinalgError::OutOfMemory`]).
+    pub fn estimate(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        params: ElasticParams,
+    ) -> Result<(ContactGeometry<D>, synovia_fem::ElasticEstimate), ContactError> {
+        let geometry = ContactGeometry::new(model, pairs)?;
+        let interface = interface_nodes(model, pairs, &geometry)?;
+        let estimate = ElasticSolver::estimate_with_ordering(
+            model,
+            params,
+            true,
+            &interface_ordering(&interface, InterfaceBlockParams::default()),
+        )?;
+        Ok((geometry, estimate))
+    }
+
     /// The context of the solves (kept columns, recycled load solves, memory budget).
     pub fn context(&self) -> &SolveContext {
         &self.context

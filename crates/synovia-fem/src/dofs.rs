@@ -115,7 +115,7 @@ impl<const D: usize> DofMap<D> {
         // 1. ties
         let mut uf = UnionFind((0..total).collect());
         let mut body_uf = UnionFind((0..bodies.len()).collect());
-        for tie in model.ties() {
+        for (tie_index, tie) in model.ties().iter().enumerate() {
             let (ba, bb) = (model.body(tie.body_a)?, model.body(tie.body_b)?);
             let pa = ba
                 .mesh
@@ -133,7 +133,25 @@ impl<const D: usize> DofMap<D> {
                 .tolerance
                 .unwrap_or_else(|| 1e-8 * ba.mesh.min_edge_length().min(bb.mesh.min_edge_length()));
             let pairs = match_nodes(&xa, &xb, tol).map_err(|u| {
+                // the unmatched node farthest from the other part (the first 2000 of each side)
+                let nearest = |x: &Point<D>, other: &[Point<D>]| {
+                    other.iter().map(|y| (x - y).norm()).fold(Real::INFINITY, Real::min)
+                };
+                let mut worst: Option<(Real, String, usize, Vec<f64>)> = None;
+                let sides = [(&u.first, &xa, &xb, &pa, &ba.name), (&u.second, &xb, &xa, &pb, &bb.name)];
+                for (unmatched, xs, other, ids, name) in sides {
+                    for &i in unmatched.iter().take(2000) {
+                        let d = nearest(&xs[i], other);
+                        if worst.as_ref().is_none_or(|w| d > w.0) {
+                            worst = Some((d, name.clone(), ids[i], xs[i].iter().copied().collect()));
+                        }
+                    }
+                }
+                let max_distance = worst.as_ref().map_or(0.0, |w| w.0);
                 FemError::UnmatchedInterface(Box::new(UnmatchedInterface {
+                    tie: tie_index,
+                    max_distance,
+                    example: worst.map(|(_, b, n, x)| (b, n, x)),
                     body_a: ba.name.clone(),
                     part_a: tie.part_a.clone(),
                     body_b: bb.name.clone(),

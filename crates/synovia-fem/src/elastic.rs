@@ -40,11 +40,15 @@ pub struct ElasticParams {
     pub ordering: OrderingChoice,
     /// Quadrature degree of the load integrals (default: 2).
     pub load_degree: usize,
+    /// Most bytes the numeric factorisation may use (default `None`: the environment variable
+    /// `SYNOVIA_MEMORY_LIMIT_MB`, else the available memory of the system;
+    /// [`CholeskySolver::check_memory`]).
+    pub memory_limit: Option<u64>,
 }
 
 impl Default for ElasticParams {
     fn default() -> Self {
-        Self { ordering: OrderingChoice::Auto, load_degree: 2 }
+        Self { ordering: OrderingChoice::Auto, load_degree: 2, memory_limit: None }
     }
 }
 
@@ -59,6 +63,23 @@ impl ElasticParams {
         self.load_degree = load_degree;
         self
     }
+    /// Sets [`Self::memory_limit`] (bytes).
+    pub fn with_memory_limit(mut self, bytes: Option<u64>) -> Self {
+        self.memory_limit = bytes;
+        self
+    }
+}
+
+/// What a factorisation of the model would be, from the symbolic analysis only
+/// ([`ElasticSolver::estimate_with_ordering`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElasticEstimate {
+    /// Reduced unknowns.
+    pub n_dofs: usize,
+    /// Stored entries of the lower triangle of the matrix.
+    pub matrix_nnz: usize,
+    /// Memory of the numeric factorisation.
+    pub memory: synovia_linalg::MemoryEstimate,
 }
 
 /// Sizes and stage timings of an elastic solve, in seconds.
@@ -194,6 +215,38 @@ impl<const D: usize> ElasticSolver<D> {
         Self::build(model, params, true, Some(reorder), Some(&mut call))
     }
 
+    /// Everything [`ElasticSolver::new_with_ordering`] does before the numeric factorisation
+    /// (dofs, coercivity, pattern, ordering, symbolic analysis) and the memory check of the
+    /// factorisation ([`CholeskySolver::check_memory`] with [`ElasticParams::memory_limit`]),
+    /// without assembling or factorising: a cheap check that the model can be solved.
+    ///
+    /// # Errors
+    /// As [`ElasticSolver::new_with_ordering`] up to the factorisation, and
+    /// [`synovia_linalg::LinalgError::OutOfMemory`].
+    pub fn estimate_with_ordering(
+        model: &Model<D>,
+        params: ElasticParams,
+        semi_coercive: bool,
+        reorder: &Reorder<'_, D>,
+    ) -> Result<ElasticEstimate, FemError> {
+        let dofs = DofMap::new(model)?;
+        if !semi_coercive {
+            if let Some(c) = dofs.floating_components(model).first() {
+                return Err(FemError::SemiCoercive { bodies: c.bodies.clone(), free_modes: c.modes.len() });
+            }
+        }
+        let (stiffness, metis) = pattern(model, &dofs)?;
+        let ordering = match (params.ordering, D) {
+            (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => Ordering::Amd,
+            _ => metis,
+        };
+        let ordering = reorder(&dofs, ordering)?;
+        let mut cholesky = CholeskySolver::analyse(&stiffness, &ordering)?;
+        cholesky.set_memory_limit(params.memory_limit);
+        let memory = cholesky.check_memory()?;
+        Ok(ElasticEstimate { n_dofs: dofs.n_dofs(), matrix_nnz: stiffness.nnz(), memory })
+    }
+
     /// `system`: a caller's assembly of the matrix instead of the stiffness (no floating
     /// components are looked for).
     #[allow(clippy::type_complexity)]
@@ -248,6 +301,7 @@ impl<const D: usize> ElasticSolver<D> {
         };
         let system = stabilisation.as_ref().map_or(&stiffness, |s| &s.matrix);
         let mut cholesky = CholeskySolver::analyse(system, &ordering)?;
+        cholesky.set_memory_limit(params.memory_limit);
         cholesky.factorize(system)?;
         let ci = cholesky.info();
         let info = ElasticInfo {

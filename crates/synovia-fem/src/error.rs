@@ -53,7 +53,7 @@ pub enum FemError {
         given: &'static str,
     },
     /// A function of the problem data (load, prescribed displacement) returned NaN or ∞.
-    #[error("{what} is not finite at x = {x:?}, t = {t}")]
+    #[error("{what} is not finite at x = {}, t = {t}", fmt_point(x))]
     NonFiniteData {
         /// Which data.
         what: String,
@@ -78,7 +78,7 @@ pub enum FemError {
     UnmatchedInterface(Box<UnmatchedInterface>),
     /// Some bodies are not held against rigid motion (docs/model.md §4): the elastic problem is
     /// semi-coercive and its stiffness matrix singular.
-    #[error("bodies {bodies:?} are semi-coercive: {free_modes} rigid-body mode(s) are not restrained by Dirichlet or symmetry data; add boundary conditions or solve it as a contact problem")]
+    #[error("bodies {} are semi-coercive: {free_modes} rigid-body mode(s) are not restrained by Dirichlet or symmetry data; add boundary conditions or solve it as a contact problem", fmt_names(bodies))]
     SemiCoercive {
         /// Names of the bodies of the unrestrained component.
         bodies: Vec<String>,
@@ -127,8 +127,19 @@ pub enum FemError {
 
 /// Details of [`FemError::UnmatchedInterface`].
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("bonded interface `{body_a}:{part_a}` – `{body_b}:{part_b}`: unmatched nodes {unmatched_a:?} (first) and {unmatched_b:?} (second)")]
+#[error(
+    "tie {tie} (bonded interface `{body_a}:{part_a}` – `{body_b}:{part_b}`): the nodes of the two parts do not coincide: {} node(s) of `{body_a}:{part_a}` and {} of `{body_b}:{part_b}` have no partner at the same position{}; the largest distance to the nearest node of the other part is {max_distance:.4e}; tied parts need matching nodes (mesh them conformingly, or use a contact pair)",
+    unmatched_a.len(),
+    unmatched_b.len(),
+    example.as_ref().map(|(b, n, x)| format!(" (e.g. node {n} of `{b}` at {})", crate::error::fmt_point(x))).unwrap_or_default()
+)]
 pub struct UnmatchedInterface {
+    /// Index of the tie in the model (0-based, in the order the ties were added).
+    pub tie: usize,
+    /// The largest distance of an unmatched node to the nearest node of the other part.
+    pub max_distance: f64,
+    /// The unmatched node farthest from the other part: body name, mesh index, coordinates.
+    pub example: Option<(String, usize, Vec<f64>)>,
     /// First body.
     pub body_a: String,
     /// First part.
@@ -141,4 +152,15 @@ pub struct UnmatchedInterface {
     pub unmatched_a: Vec<usize>,
     /// Unmatched nodes of the second body (mesh indices).
     pub unmatched_b: Vec<usize>,
+}
+
+/// A point as `(x, y[, z])` with 6 significant digits, for messages.
+pub fn fmt_point(x: &[f64]) -> String {
+    let parts: Vec<String> = x.iter().map(|v| format!("{v:.6}")).collect();
+    format!("({})", parts.join(", "))
+}
+
+/// Names as `` `a`, `b` ``, for messages.
+pub fn fmt_names(names: &[String]) -> String {
+    names.iter().map(|n| format!("`{n}`")).collect::<Vec<_>>().join(", ")
 }

@@ -26,8 +26,8 @@ pub mod quadrature;
 
 pub use dofs::{DofMap, FloatingComponent};
 pub use elastic::{
-    solve_elastic, ElasticInfo, ElasticParams, ElasticSolution, ElasticSolver, OrderingChoice, Reorder,
-    Stabilisation,
+    solve_elastic, ElasticEstimate, ElasticInfo, ElasticParams, ElasticSolution, ElasticSolver,
+    OrderingChoice, Reorder, Stabilisation,
 };
 pub use error::FemError;
 pub use model::{Body, BodyId, ComponentMask, Model, TractionField, VectorField};

@@ -119,6 +119,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod duplicates;
 pub mod error;
 pub mod field;
 pub mod gmsh;
@@ -128,6 +129,7 @@ pub mod stl;
 mod util;
 pub mod vtu;
 
+pub use duplicates::{coincident_nodes, CoincidentNodes, COINCIDENT_TOLERANCE};
 pub use error::IoError;
 pub use field::{Field, FieldLocation};
 pub use gmsh::{

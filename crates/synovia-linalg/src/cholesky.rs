@@ -89,6 +89,64 @@ pub struct CholeskyInfo {
     pub factor_nnz: usize,
 }
 
+/// The memory a numeric factorisation needs, from the symbolic analysis
+/// ([`CholeskySolver::memory_estimate`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct MemoryEstimate {
+    /// Unknowns.
+    pub dofs: usize,
+    /// Stored entries of `L`.
+    pub factor_entries: usize,
+    /// Bytes of the factor's values.
+    pub factor_bytes: u64,
+    /// Bytes of faer's workspace of the numeric factorisation.
+    pub workspace_bytes: u64,
+    /// Bytes of the dense trailing block `L₂₂` of an [`Ordering::Trailing`] factorisation.
+    pub trailing_bytes: u64,
+}
+
+impl MemoryEstimate {
+    /// Total bytes.
+    pub fn total_bytes(&self) -> u64 {
+        self.factor_bytes.saturating_add(self.workspace_bytes).saturating_add(self.trailing_bytes)
+    }
+    /// Total in GiB.
+    pub fn total_gib(&self) -> f64 {
+        self.total_bytes() as f64 / GIB
+    }
+}
+
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// The environment variable that caps the memory a factorisation may use, in MiB (overrides
+/// the available memory of the system; [`memory_limit`]).
+pub const MEMORY_LIMIT_ENV: &str = "SYNOVIA_MEMORY_LIMIT_MB";
+
+/// The memory a factorisation may use, in bytes, and where the figure comes from: the
+/// environment variable [`MEMORY_LIMIT_ENV`] (MiB) if set to a number, else `MemAvailable` of
+/// `/proc/meminfo` (Linux), else `None` (unknown: no check).
+pub fn memory_limit() -> Option<(u64, String)> {
+    if let Ok(v) = std::env::var(MEMORY_LIMIT_ENV) {
+        if let Ok(mb) = v.trim().parse::<f64>() {
+            if mb.is_finite() && mb >= 0.0 {
+                return Some((
+                    (mb * 1024.0 * 1024.0) as u64,
+                    format!("allowed by {MEMORY_LIMIT_ENV}={}", v.trim()),
+                ));
+            }
+        }
+    }
+    available_memory().map(|b| (b, "available (MemAvailable of /proc/meminfo)".to_string()))
+}
+
+/// `MemAvailable` of `/proc/meminfo` in bytes (`None` where there is no such file).
+pub fn available_memory() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
+}
+
 /// A sparse Cholesky solver for a [`SymmetricMatrix`] pattern.
 #[derive(Debug, Clone)]
 pub struct CholeskySolver {
@@ -98,6 +156,7 @@ pub struct CholeskySolver {
     info: CholeskyInfo,
     trailing_dofs: Option<Vec<usize>>,
     trailing: Option<Arc<TrailingBlock>>,
+    memory_limit: Option<u64>,
 }
 
 impl CholeskySolver {
@@ -160,7 +219,70 @@ impl CholeskySolver {
             info,
             trailing_dofs,
             trailing: None,
+            memory_limit: None,
         })
+    }
+
+    /// The parallelism of the numeric factorisation: threads pay only for large factors;
+    /// below `nnz(L)² / n = 1e10` (≈ flops / 2) the sequential factorisation is faster
+    /// (docs/performance.md, "Parallel assembly").
+    fn numeric_par(&self) -> Par {
+        let len = self.symbolic.len_val();
+        let work = (len as f64) * (len as f64) / (self.symbolic.nrows().max(1) as f64);
+        if work < 1e10 {
+            Par::Seq
+        } else {
+            faer::get_global_parallelism()
+        }
+    }
+
+    /// The memory the numeric factorisation needs (factor values, faer's workspace, the dense
+    /// trailing block), from the symbolic analysis.
+    pub fn memory_estimate(&self) -> MemoryEstimate {
+        let entries = self.symbolic.len_val();
+        let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(self.numeric_par(), Default::default());
+        let k = self.trailing_dofs.as_ref().map_or(0, Vec::len) as u64;
+        MemoryEstimate {
+            dofs: self.symbolic.nrows(),
+            factor_entries: entries,
+            factor_bytes: (entries as u64).saturating_mul(8),
+            workspace_bytes: req.size_bytes() as u64,
+            trailing_bytes: k.saturating_mul(k).saturating_mul(8),
+        }
+    }
+
+    /// Caps the memory of the numeric factorisation at `bytes` (instead of [`memory_limit`]:
+    /// [`MEMORY_LIMIT_ENV`] or the available memory); `None` restores the default.
+    pub fn set_memory_limit(&mut self, bytes: Option<u64>) {
+        self.memory_limit = bytes;
+    }
+
+    /// Checks that the numeric factorisation fits in memory: the [`Self::memory_estimate`]
+    /// against the limit of [`Self::set_memory_limit`], else [`memory_limit`] (no check when
+    /// the available memory is unknown). Returns the estimate.
+    ///
+    /// # Errors
+    /// [`LinalgError::OutOfMemory`] with the bytes needed and available.
+    pub fn check_memory(&self) -> Result<MemoryEstimate, LinalgError> {
+        let estimate = self.memory_estimate();
+        let limit = match self.memory_limit {
+            Some(b) => Some((b, "allowed by the memory limit".to_string())),
+            None => memory_limit(),
+        };
+        // what is already allocated for the factor is not needed again
+        let held = (self.factor.capacity() as u64).saturating_mul(8);
+        if let Some((available, origin)) = limit {
+            if estimate.total_bytes().saturating_sub(held) > available {
+                return Err(LinalgError::OutOfMemory {
+                    needed: estimate.total_bytes(),
+                    available,
+                    origin,
+                    dofs: estimate.dofs,
+                    factor_entries: estimate.factor_entries,
+                });
+            }
+        }
+        Ok(estimate)
     }
 
     /// Numeric factorisation of `a` (same pattern as analysed), reusing the symbolic analysis.
@@ -170,16 +292,14 @@ impl CholeskySolver {
             return Err(LinalgError::Length { what: "matrix", expected: self.symbolic.nrows(), got: a.n() });
         }
         self.factorized = false;
+        self.check_memory()?;
         let len = self.symbolic.len_val();
         self.factor.clear();
         self.factor.try_reserve_exact(len).map_err(|_| {
             LinalgError::Sparse(format!("out of memory for a Cholesky factor of {len} entries"))
         })?;
         self.factor.resize(len, 0.0);
-        // Threads pay only for large factors: below `nnz(L)² / n = 1e10` (≈ flops / 2) the
-        // sequential factorisation is faster (docs/performance.md, "Parallel assembly").
-        let work = (len as f64) * (len as f64) / (a.n().max(1) as f64);
-        let par = if work < 1e10 { Par::Seq } else { faer::get_global_parallelism() };
+        let par = self.numeric_par();
         let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
         let mut mem =
             MemBuffer::try_new(req).map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;

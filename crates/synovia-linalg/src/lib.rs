@@ -31,7 +31,10 @@ pub mod recycling;
 pub mod rows;
 pub mod sparse;
 
-pub use cholesky::{CholeskyInfo, CholeskySolver, InterfaceBlockParams, Ordering, TrailingBlock};
+pub use cholesky::{
+    available_memory, memory_limit, CholeskyInfo, CholeskySolver, InterfaceBlockParams, MemoryEstimate,
+    Ordering, TrailingBlock, MEMORY_LIMIT_ENV,
+};
 pub use error::LinalgError;
 pub use interface::BlockSolveStore;
 pub use operator::{CholeskyOperator, FactorisedOperator, RowStack, SparseCholesky};

@@ -42,6 +42,9 @@ pub struct Built<const D: usize> {
     pub output: OutputPlan,
     /// Base name of the output files.
     pub name: String,
+    /// Warnings found while building (e.g. unused duplicate nodes of a mesh); the model is
+    /// usable.
+    pub warnings: Vec<String>,
 }
 
 /// Where and how often to write results.
@@ -102,6 +105,7 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 
 struct Cx<'a> {
     src: &'a Source,
+    warnings: std::cell::RefCell<Vec<String>>,
 }
 
 impl Cx<'_> {
@@ -298,7 +302,7 @@ macro_rules! present {
 /// # Errors
 /// The first problem found, located at its key.
 pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
-    let cx = Cx { src: &sc.source };
+    let cx = Cx { src: &sc.source, warnings: std::cell::RefCell::new(Vec::new()) };
     let doc = &sc.doc;
     let dim = doc.dimension.get_ref();
     if *dim != D as i64 {
@@ -378,7 +382,8 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
         }
     }
     joint.set_analysis(analysis.clone());
-    Ok(Built { joint, analysis, output: output(&cx, doc.output.as_ref())?, name: sc.name() })
+    let output = output(&cx, doc.output.as_ref())?;
+    Ok(Built { joint, analysis, output, name: sc.name(), warnings: cx.warnings.into_inner() })
 }
 
 /// Resolves a body name and one of its part names (errors list what exists).
@@ -596,7 +601,11 @@ fn mesh<const D: usize>(
         let rk = key(k, "reflect");
         let axis = r.get_ref().axis.get_ref();
         let a = AXES.iter().take(D).position(|x| x == axis).ok_or_else(|| {
-            cx.err(key(&rk, "axis"), r.get_ref().axis.span(), format!("axis must be one of {:?}", &AXES[..D]))
+            cx.err(
+                key(&rk, "axis"),
+                r.get_ref().axis.span(),
+                format!("axis must be one of {}", AXES[..D].join(", ")),
+            )
         })?;
         mesh = mesh.reflected(a, r.get_ref().at).map_err(|e| cx.err(&rk, r.span(), e.to_string()))?;
     }
@@ -605,7 +614,71 @@ fn mesh<const D: usize>(
         let v = cx.vector::<D>(t, &tk)?;
         mesh.map_nodes(|x| x + v).map_err(|e| cx.err(tk, t.span(), e.to_string()))?;
     }
+    let file = m.gmsh.as_ref().map(|f| (f.get_ref().as_str(), gmsh.get(&cx.src.resolve(f.get_ref()))));
+    check_coincident(cx, &mesh, body, k, &span, file)?;
     Ok(mesh)
+}
+
+/// Coincident nodes of a body's mesh: an error when both belong to cells (an unmerged seam,
+/// or a node written twice), a warning when one of them belongs to no cell.
+fn check_coincident<const D: usize>(
+    cx: &Cx<'_>,
+    mesh: &Mesh<D>,
+    body: &str,
+    k: &str,
+    span: &Range<usize>,
+    file: Option<(&str, Option<&GmshMesh>)>,
+) -> R<()> {
+    let found = synovia::io::coincident_nodes(mesh);
+    if found.is_empty() {
+        return Ok(());
+    }
+    // how to name the nodes: Gmsh node tags (found by position) or mesh indices
+    let describe = |(i, j): (usize, usize)| -> String {
+        let x = mesh.node(i);
+        let at = synovia::fem::error::fmt_point(x.as_slice());
+        let tags: Vec<u64> = match file {
+            Some((_, Some(g))) => g
+                .nodes
+                .iter()
+                .zip(&g.node_tags)
+                .filter(|(p, _)| (0..D).all(|a| (p[a] - x[a]).abs() <= found.tolerance.max(0.0)))
+                .map(|(_, &t)| t)
+                .collect(),
+            _ => Vec::new(),
+        };
+        if tags.len() >= 2 {
+            let list: Vec<String> = tags.iter().map(u64::to_string).collect();
+            format!("Gmsh nodes {} at {at}", list.join(" and "))
+        } else {
+            format!("nodes {i} and {j} (0-based, of the body's mesh) at {at}")
+        }
+    };
+    let fix = match file {
+        Some((f, _)) => format!(
+            "merge them in Gmsh (`Coherence;` before meshing or `Coherence Mesh;` after it in the .geo file, Geometry › Coherence in the GUI) and export `{f}` again"
+        ),
+        None => "merge them".to_string(),
+    };
+    if let Some(&first) = found.in_cells.first() {
+        return Err(cx.err(
+            k,
+            span.clone(),
+            format!(
+                "body `{body}`: the mesh has {} pair(s) of coincident nodes not shared by elements (an unmerged seam or a duplicated node: the mesh is cut there), e.g. {}: {fix}",
+                found.in_cells.len(),
+                describe(first)
+            ),
+        ));
+    }
+    if let Some(&first) = found.unused.first() {
+        cx.warnings.borrow_mut().push(format!(
+            "body `{body}` (`{k}`): {} pair(s) of coincident nodes of which one belongs to no element, e.g. {}; they are ignored",
+            found.unused.len(),
+            describe(first)
+        ));
+    }
+    Ok(())
 }
 
 fn generate<const D: usize>(
@@ -1095,7 +1168,7 @@ fn boundary<const D: usize>(
                 }
                 for (j, comp) in c.get_ref().iter().enumerate() {
                     let a = AXES.iter().take(D).position(|x| x == comp.get_ref()).ok_or_else(|| {
-                        cx.err(format!("{ck}[{j}]"), comp.span(), format!("a component is one of {:?}", &AXES[..D]))
+                        cx.err(format!("{ck}[{j}]"), comp.span(), format!("a component is one of {}", AXES[..D].join(", ")))
                     })?;
                     m[a] = true;
                 }
@@ -1172,7 +1245,11 @@ fn boundary<const D: usize>(
             let p = match v.get_ref() {
                 NumOrVec::Num(x) if x.is_finite() => *x,
                 other => {
-                    return Err(cx.err(key(k, "value"), v.span(), format!("a pressure is one finite number, got {other:?}")))
+                    let got = match other {
+                        NumOrVec::Num(x) => x.to_string(),
+                        NumOrVec::Vec(v) => format!("a list of {} numbers", v.len()),
+                    };
+                    return Err(cx.err(key(k, "value"), v.span(), format!("a pressure is one finite number, got {got}")));
                 }
             };
             joint.pressure(body.as_str(), &part, p, history()?).map_err(built_err)?;
@@ -1269,6 +1346,11 @@ fn contact<const D: usize>(
     };
     pair.friction = friction;
     joint.add_contact(pair).map_err(|e| cx.err(key(k, "part"), s.part.span(), e.to_string()))?;
+    if let Some(r) = &s.refuse_initial_penetration {
+        joint
+            .refuse_initial_penetration_in(&name, *r.get_ref())
+            .map_err(|e| cx.err(key(k, "refuse_initial_penetration"), r.span(), e.to_string()))?;
+    }
     if let Some(l) = &s.friction_law {
         let lk = key(k, "friction_law");
         if !dynamic {
@@ -1390,6 +1472,10 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
     }
     if let Some(d) = &s.load_degree {
         elastic.load_degree = cx.at_least(d, "solver.load_degree", 1)?;
+    }
+    if let Some(m) = &s.memory_limit_mb {
+        let mb = cx.positive(m, "solver.memory_limit_mb")?;
+        elastic.memory_limit = Some((mb * 1024.0 * 1024.0).min(u64::MAX as f64) as u64);
     }
     joint.elastic_params(elastic);
     Ok(())

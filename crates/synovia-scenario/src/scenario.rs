@@ -126,8 +126,13 @@ impl Source {
     fn toml_error(&self, e: &toml::de::Error) -> ScenarioError {
         let mut key = e.span().map(|s| key_path_at(&self.text, s.start)).unwrap_or_default();
         let message = e.message().trim_end().replace('\n', "; ");
-        // a missing key is named by the path of its table plus its own name
+        // a missing key is named by the path of its table plus its own name (a missing
+        // top-level key: by its name alone; the error's span is then the whole document)
         if let Some(field) = message.strip_prefix("missing field `").and_then(|m| m.split('`').next()) {
+            let top_level = e.span().is_none_or(|s| s.start == 0 && s.end >= self.text.trim_end().len());
+            if top_level {
+                key.clear();
+            }
             if !key.is_empty() {
                 key.push('.');
             }
@@ -494,6 +499,7 @@ pub struct ContactSpec {
     pub friction_law: Option<Sp<FrictionLawSpec>>,
     pub normal: Option<Sp<Vec<f64>>>,
     pub tolerance: Option<Sp<f64>>,
+    pub refuse_initial_penetration: Option<Sp<bool>>,
 }
 
 /// The other body of a node-to-node pair.
@@ -546,6 +552,7 @@ pub struct SolverSpec {
     pub nested_iteration: Option<Sp<usize>>,
     pub ordering: Option<Sp<String>>,
     pub load_degree: Option<Sp<usize>>,
+    pub memory_limit_mb: Option<Sp<f64>>,
 }
 
 /// The analysis (flat table; `type` says which keys apply).
