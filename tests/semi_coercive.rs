@@ -83,10 +83,22 @@ fn load_pulling_a_floating_body_away_is_rejected() {
         let joint = floating_block(load, false, 0.0);
         match joint.run_static(0.0) {
             Err(JointError::Time(TimeError::Contact {
-                source: ContactError::Unbalanced { bodies, residual, load },
+                source: ContactError::Unbalanced { bodies, residual, load: rigid_load, force },
                 ..
             })) => {
+                let load = rigid_load;
                 assert_eq!(bodies, vec!["floating".to_string()]);
+                // the unbalanced net force in newtons: the traction on the unit-wide top that
+                // no contact force holds (all of it pulled up; its sideways part pushed
+                // sideways, frictionless)
+                let expected = if what == "pulled up" { [0.0, P] } else { [P, 0.0] };
+                assert_eq!(force.len(), 2, "{what}: {force:?}");
+                for (f, e) in force.iter().zip(expected) {
+                    assert!(
+                        (f - e).abs() < 1e-9 * P,
+                        "{what}: unbalanced force {force:?}, expected {expected:?}"
+                    );
+                }
                 assert!(residual > 0.1 * load, "{what}: {residual} of {load}");
                 println!("{what}: rejected, unbalanced rigid load {residual:.3e} of {load:.3e}");
             }

@@ -357,6 +357,7 @@ times = [0.0, 1.0]
     let e = text(&r.stderr);
     assert_eq!(e.matches("are held only by contact").count(), 1, "{e}");
     assert!(e.contains("bodies `block` are held only by contact"), "{e}");
+    assert!(e.contains("an unbalanced net force of (") && e.contains(") N"), "the force in newtons: {e}");
     assert!(!e.contains("[\""), "{e}");
     // unloaded at t = 0, loaded at t = 1
     let file = dir.join("rest.toml");

@@ -78,10 +78,13 @@ pub enum ContactError {
     /// Bodies held only by contact (semi-coercive, docs/model.md §4) carry a load whose rigid part no
     /// admissible contact force balances: the load pulls them away from, or slides them off,
     /// their contact partners.
-    #[error("bodies {} are held only by contact, and contact forces cannot balance their load (unbalanced rigid-body load {residual:.3e} of {load:.3e}): the load pulls them away or slides them off; add Dirichlet or symmetry data, friction, or change the load", synovia_fem::error::fmt_names(bodies))]
+    #[error("bodies {} are held only by contact, and contact forces cannot balance their load: an unbalanced net force of {} N (rigid-body load norm {residual:.3e} of {load:.3e}) pulls them away or slides them off; add Dirichlet or symmetry data, friction, or change the load", synovia_fem::error::fmt_names(bodies), fmt_force(force))]
     Unbalanced {
         /// The floating bodies.
         bodies: Vec<String>,
+        /// The net force (Cartesian components, in the model's force unit — newtons for SI
+        /// models) of the part of the load that no contact force balances; empty if unknown.
+        force: Vec<f64>,
         /// Norm of the part of the rigid-body load that no contact force balances.
         residual: f64,
         /// Norm of the rigid-body load `Rᵀ F`.
@@ -90,4 +93,13 @@ pub enum ContactError {
     /// A parameter is out of range or vectors have inconsistent sizes.
     #[error("invalid contact parameter: {0}")]
     InvalidParameter(String),
+}
+
+/// `(1.000e0, -2.000e-3)` for a force vector, `unknown` for an empty one.
+fn fmt_force(force: &[f64]) -> String {
+    if force.is_empty() {
+        return "unknown".into();
+    }
+    let parts: Vec<String> = force.iter().map(|f| format!("{f:.4e}")).collect();
+    format!("({})", parts.join(", "))
 }

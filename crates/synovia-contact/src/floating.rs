@@ -34,12 +34,16 @@ use crate::problem::{FrictionConstraints, NormalConstraints};
 
 /// Checks Fichera's condition `Rᵀ F ∈ {Rᵀ Cᵀ ν : Λ_n ≥ 0}` (friction rows as free-sign
 /// columns) for the kernel `R` of `stabilisation`: `Ok(())` if the rigid part of `load` can be
-/// balanced by contact forces to `1e-8 ‖F‖`, [`ContactError::Unbalanced`] otherwise.
+/// balanced by contact forces to `1e-8 ‖F‖`, [`ContactError::Unbalanced`] otherwise, whose
+/// `force` is `net_force(δ_F)` of the unbalanced load `δ_F = Σ_m δ_m r_m`
+/// (`δ = Rᵀ F − Rᵀ Cᵀ ν*`, the residual of the non-negative least-squares fit), i.e. the net
+/// Cartesian force that nothing holds.
 pub fn check_balance(
     stabilisation: &Stabilisation,
     load: &[f64],
     normal: &NormalConstraints,
     friction: Option<&FrictionConstraints>,
+    net_force: &dyn Fn(&[f64]) -> Vec<f64>,
 ) -> Result<(), ContactError> {
     let modes: Vec<&Vec<f64>> = stabilisation.components.iter().flat_map(|c| c.modes.iter()).collect();
     let m = modes.len();
@@ -68,13 +72,25 @@ pub fn check_balance(
     if let Some(f) = friction {
         add_rows(&f.rows, None, true);
     }
-    let (_, residual) = nnls(&columns, &target);
+    let (x, residual) = nnls(&columns, &target);
     let target_norm = target.iter().map(|g| g * g).sum::<f64>().sqrt();
     if residual <= 1e-8 * load_norm.max(f64::MIN_POSITIVE) || target_norm == 0.0 {
         return Ok(());
     }
+    let mut delta = target;
+    for (xj, col) in x.iter().zip(&columns) {
+        for (d, c) in delta.iter_mut().zip(col) {
+            *d -= xj * c;
+        }
+    }
+    let mut unbalanced = vec![0.0; load.len()];
+    for (d, r) in delta.iter().zip(&modes) {
+        for (u, rv) in unbalanced.iter_mut().zip(r.iter()) {
+            *u += d * rv;
+        }
+    }
     let bodies = stabilisation.components.iter().flat_map(|c| c.bodies.iter().cloned()).collect();
-    Err(ContactError::Unbalanced { bodies, residual, load: target_norm })
+    Err(ContactError::Unbalanced { bodies, force: net_force(&unbalanced), residual, load: target_norm })
 }
 
 /// The load `F` with the part of its rigid-body load that no normal contact force can balance

@@ -378,7 +378,18 @@ impl<const D: usize> StaticContact<D> {
         let friction = active_friction(friction_op.as_ref());
         let stabilisation = self.elastic.stabilisation();
         if let Some(st) = stabilisation {
-            crate::floating::check_balance(st, &load, &normal, friction)?;
+            let dofs = self.elastic.dofs();
+            // Σ over node groups of N_g f̃_g: the net Cartesian force of a reduced load
+            let net_force = |reduced: &[f64]| -> Vec<f64> {
+                let mut total = Vector::<D>::zeros();
+                for g in dofs.groups() {
+                    for k in 0..g.n_dofs {
+                        total += g.basis[k] * reduced[g.first_dof + k];
+                    }
+                }
+                total.iter().copied().collect()
+            };
+            crate::floating::check_balance(st, &load, &normal, friction, &net_force)?;
         }
         let operator = self.operator()?;
         // A⁻¹ F: recycled when F is a combination of loads solved before (crate docs of
