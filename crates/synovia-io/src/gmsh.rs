@@ -209,7 +209,7 @@ pub struct GmshMesh {
 /// [`IoError::Parse`] (with the line number or byte offset) for malformed files.
 pub fn read_msh(path: impl AsRef<Path>) -> Result<GmshMesh, IoError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(path, e))?;
+    let bytes = crate::util::read_regular_file(path)?;
     parse_with_path(&bytes, path)
 }
 

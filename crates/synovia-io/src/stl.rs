@@ -22,7 +22,7 @@ use crate::error::IoError;
 /// [`IoError::Surface`] if its triangles are invalid (degenerate, non-finite).
 pub fn read_stl(path: impl AsRef<Path>) -> Result<TriangleSurface, IoError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(path, e))?;
+    let bytes = crate::util::read_regular_file(path)?;
     parse_stl_at(&bytes, path)
 }
 

@@ -10,6 +10,19 @@ use quick_xml::events::BytesStart;
 
 use crate::error::IoError;
 
+/// Reads the whole file at `path`, which must be a regular file: a device or pipe (`/dev/zero`,
+/// a FIFO) given as a mesh path would otherwise be read until memory runs out.
+pub(crate) fn read_regular_file(path: &Path) -> Result<Vec<u8>, IoError> {
+    let meta = std::fs::metadata(path).map_err(|e| IoError::io(path, e))?;
+    if !meta.is_file() {
+        return Err(IoError::io(
+            path,
+            io::Error::new(io::ErrorKind::InvalidInput, "not a regular file (a directory, device or pipe)"),
+        ));
+    }
+    std::fs::read(path).map_err(|e| IoError::io(path, e))
+}
+
 /// Escapes `& < > " '` for use inside a double-quoted attribute.
 pub(crate) fn escape_attr(s: &str) -> Cow<'_, str> {
     quick_xml::escape::escape(s)

@@ -95,3 +95,16 @@ fn implant_surfaces_of_the_grand_challenge_data() {
     let (lo, _) = insert.bounding_box().expect("box");
     assert!(lo.y.abs() < 1e-4, "the insert's tray side lies at y = 0 within 0.1 mm (got {})", lo.y);
 }
+
+/// A device given as a surface or mesh path is refused, not read until memory runs out.
+#[test]
+fn devices_are_not_read_as_files() {
+    for path in ["/dev/zero", "/"] {
+        if std::path::Path::new(path).exists() {
+            let err = read_stl(path).expect_err("device");
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+            let err = synovia_io::read_msh(path).expect_err("device");
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+        }
+    }
+}

@@ -229,7 +229,15 @@ impl Scenario {
     /// A [`ScenarioError`] if the file cannot be read or does not parse.
     pub fn from_file(path: impl AsRef<Path>) -> Result<Self, ScenarioError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError {
+        let regular = std::fs::metadata(path).map(|m| m.is_file());
+        let text = match regular {
+            Ok(false) => Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "not a regular file (a directory, device or pipe)",
+            )),
+            _ => std::fs::read_to_string(path),
+        }
+        .map_err(|e| ScenarioError {
             file: path.display().to_string(),
             key: String::new(),
             line: 0,
