@@ -418,7 +418,7 @@ fn run_dim<const D: usize>(
         .iter()
         .filter(|p| {
             let body = |id: synovia::fem::BodyId| {
-                built.joint.model().body(id).map_or(false, |b| floating.contains(&b.name))
+                built.joint.model().body(id).is_ok_and(|b| floating.contains(&b.name))
             };
             body(p.body) || p.partner_part().is_some_and(|(b, _)| body(b))
         })
