@@ -423,3 +423,33 @@ fn search_distance_drops_nodes_and_results_follow_the_slave_nodes() {
     let force = res.normal_force(&all, 0..all.len());
     assert!((total - force).abs() <= 1e-12 * force, "{total} vs {force}");
 }
+
+/// Issue 15: with a stiffness contrast the softer side must be the slave (docs/contact.md,
+/// "Which side is the slave"). A stiff (E = 100), finely meshed indenter on a soft (E = 1),
+/// coarse block (cells 2.5× larger): with the block as slave, node-to-segment and dual mortar
+/// pressures converge to Hertz as the meshes are refined; with the stiff indenter as slave the
+/// node-to-segment pressure error stays far above it at both sizes.
+#[test]
+fn softer_side_as_slave_converges_on_a_stiffness_contrast() {
+    let solver = by_name(synovia::solvers::DEFAULT_SOLVER).expect("solver");
+    let error = |mortar: bool, slave_indenter: bool, levels: usize, h: f64| {
+        let p = HertzBlock2d {
+            e1: 100.0,
+            e2: 1.0,
+            levels,
+            block_h: 2.5 * h,
+            slave_indenter,
+            mortar,
+            ..Default::default()
+        };
+        hertz2d_block(&p, solver.as_ref()).expect("solve").pressure_l2_err
+    };
+    for mortar in [false, true] {
+        let (coarse, fine) = (error(mortar, false, 10, 7.5e-3), error(mortar, false, 11, 3.77e-3));
+        println!("softer side as slave (mortar = {mortar}): L² error {coarse:.3e} → {fine:.3e}");
+        assert!(fine < 0.6 * coarse, "mortar = {mortar}: {coarse} → {fine}");
+        assert!(fine < 0.03, "mortar = {mortar}: {fine}");
+    }
+    let stiff_slave = error(false, true, 11, 3.77e-3);
+    assert!(stiff_slave > 0.3, "the stiff fine slave's known failure mode: L² error {stiff_slave}");
+}
