@@ -417,3 +417,50 @@ fn the_documented_example_is_the_example_file() {
     let example = std::fs::read_to_string(root.join("examples/scenarios/tibial_plateau2d.toml")).unwrap();
     assert!(doc.contains(&format!("```toml\n{example}```")), "docs/scenario.md is out of date");
 }
+
+/// Body-body pairs on non-matching meshes: the `discretisation` key and its errors.
+#[test]
+fn contact_discretisation_key() {
+    let two = |extra: &str| {
+        format!(
+            r#"dimension = 2
+[[body]]
+name = "upper"
+mesh = {{ generator = "rectangle", x = [0.0, 1.0], y = [0.0, 0.5], cells = [5, 2] }}
+material = {{ type = "isotropic", E = 1.0, nu = 0.3 }}
+[[body]]
+name = "lower"
+mesh = {{ generator = "rectangle", x = [0.0, 1.0], y = [-0.5, 0.0], cells = [3, 2] }}
+material = {{ type = "isotropic", E = 1.0, nu = 0.3 }}
+[[boundary]]
+body = "upper"
+part = "top"
+kind = "prescribed"
+value = [0.0, -0.01]
+[[boundary]]
+body = "lower"
+part = "bottom"
+kind = "clamped"
+[[contact]]
+body = "upper"
+part = "bottom"
+partner = {{ body = "lower", part = "top" }}
+{extra}
+[analysis]
+type = "static"
+"#
+        )
+    };
+    // non-matching meshes (5 vs 3 cells): both non-matching discretisations build
+    for kind in ["node_to_segment", "mortar"] {
+        checked(&two(&format!("discretisation = \"{kind}\""))).unwrap_or_else(|e| panic!("{kind}: {e}"));
+    }
+    let text = two("discretisation = \"node_to_surface\"");
+    assert_error(&text, "contact[0].discretisation", "\"node_to_surface\"", "unknown contact discretisation");
+    let text = two("discretisation = \"mortar\"\nnormal = [0.0, 1.0]");
+    assert_error(&text, "contact[0].normal", "[0.0, 1.0]\n", "node-to-node pairs only");
+    let text = two("search_distance = 0.1");
+    assert_error(&text, "contact[0].search_distance", "0.1\n", "`node_to_segment` and `mortar` pairs only");
+    let text = two("discretisation = \"mortar\"\nsearch_distance = -1.0");
+    assert!(error_of(&text).key.contains("search_distance"), "{}", error_of(&text));
+}

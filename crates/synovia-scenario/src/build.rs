@@ -1313,7 +1313,47 @@ fn contact<const D: usize>(
                 ));
             }
             let l = joint.model().body_id(&lb).map_err(|e| cx.err(&pk, p.span(), e.to_string()))?;
-            let mut pair = ContactPair::<D>::node_to_node(&name, id, &part, l, &lp);
+            let kind = s.discretisation.as_ref().map_or("node_to_node", |d| d.get_ref().as_str());
+            let matching_only = |f: &str, v: Option<std::ops::Range<usize>>| match v {
+                Some(sp) if kind != "node_to_node" => Err(cx.err(
+                    key(k, f),
+                    sp,
+                    format!("`{f}` applies to node-to-node pairs only (this pair is `{kind}`)"),
+                )),
+                _ => Ok(()),
+            };
+            matching_only("normal", s.normal.as_ref().map(|v| v.span()))?;
+            matching_only("tolerance", s.tolerance.as_ref().map(|v| v.span()))?;
+            let mut pair = match kind {
+                "node_to_node" => {
+                    if let Some(d) = &s.search_distance {
+                        return Err(cx.err(
+                            key(k, "search_distance"),
+                            d.span(),
+                            "`search_distance` applies to `node_to_segment` and `mortar` pairs only",
+                        ));
+                    }
+                    ContactPair::<D>::node_to_node(&name, id, &part, l, &lp)
+                }
+                "node_to_segment" | "node_to_facet" => {
+                    ContactPair::<D>::node_to_segment(&name, id, &part, l, &lp)
+                }
+                "mortar" => ContactPair::<D>::mortar(&name, id, &part, l, &lp),
+                other => {
+                    let span = s.discretisation.as_ref().map_or(span.clone(), |d| d.span());
+                    return Err(cx.err(
+                        key(k, "discretisation"),
+                        span,
+                        format!(
+                            "unknown contact discretisation `{other}`: use `node_to_node`, `node_to_segment` \
+                             (`node_to_facet` in 3D) or `mortar`"
+                        ),
+                    ));
+                }
+            };
+            if let Some(d) = &s.search_distance {
+                pair = pair.with_search_distance(cx.positive(d, &key(k, "search_distance"))?);
+            }
             if let Some(n) = &s.normal {
                 pair = pair.with_fixed_normal(cx.nonzero::<D>(n, &key(k, "normal"))?);
             }
@@ -1326,6 +1366,8 @@ fn contact<const D: usize>(
             for (f, v) in [
                 ("normal", s.normal.as_ref().map(|v| v.span())),
                 ("tolerance", s.tolerance.as_ref().map(|v| v.span())),
+                ("discretisation", s.discretisation.as_ref().map(|v| v.span())),
+                ("search_distance", s.search_distance.as_ref().map(|v| v.span())),
             ] {
                 if let Some(sp) = v {
                     return Err(cx.err(

@@ -502,6 +502,11 @@ pub struct ContactSpec {
     pub body: Sp<String>,
     pub part: Sp<String>,
     pub partner: Option<Sp<PartnerSpec>>,
+    /// Body-body pairs: `node_to_node` (default), `node_to_segment` (2D; `node_to_facet` in
+    /// 3D, either name works) or `mortar`.
+    pub discretisation: Option<Sp<String>>,
+    /// Body-body non-matching pairs: the largest slave-to-master distance searched.
+    pub search_distance: Option<Sp<f64>>,
     pub obstacle: Option<Sp<ObstacleSpec>>,
     pub friction: Option<Sp<f64>>,
     pub friction_law: Option<Sp<FrictionLawSpec>>,
