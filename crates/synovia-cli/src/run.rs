@@ -67,6 +67,13 @@ pub struct PairSummary {
     pub stick_area: f64,
     /// Slipping area.
     pub slip_area: f64,
+    /// Moment of the contact forces on body `k` about the origin, `[x, y, z]` (2D: `z` only).
+    pub moment: [f64; 3],
+    /// Centre of pressure (normal-force-weighted position of the contact nodes); `null`
+    /// without contact.
+    pub centre_of_pressure: Option<[f64; 3]>,
+    /// Mean contact pressure (normal force / contact area).
+    pub mean_pressure: f64,
 }
 
 /// The figures of one step.
@@ -366,6 +373,9 @@ fn step_summary(record: &StepRecord, vtu: Option<String>, kkt: f64, solver: Stri
                 peak_pressure: p.peak_pressure,
                 stick_area: p.stick_area,
                 slip_area: p.slip_area,
+                moment: p.moment,
+                centre_of_pressure: p.centre_of_pressure,
+                mean_pressure: p.mean_pressure,
             })
             .collect(),
         strain_energy: record.strain_energy,

@@ -867,21 +867,7 @@ impl<const D: usize> DynamicStepper<D> {
     /// `(U^i − U^{i−1})/Δt`, strain energy of `U^i`) and zero contact figures (one
     /// [`PairRecord`] per pair, so CSV columns line up): the row of step 0 of a results table.
     pub fn initial_record(&self) -> StepRecord {
-        let pairs = self
-            .geometry()
-            .pairs
-            .iter()
-            .map(|(name, _)| PairRecord {
-                name: name.clone(),
-                force: [0.0; 3],
-                normal_force: 0.0,
-                tangential_force: 0.0,
-                contact_area: 0.0,
-                peak_pressure: 0.0,
-                stick_area: 0.0,
-                slip_area: 0.0,
-            })
-            .collect();
+        let pairs = self.geometry().pairs.iter().map(|(name, _)| PairRecord::empty(name)).collect();
         StepRecord {
             step: self.step,
             time: self.time(),

@@ -28,6 +28,41 @@ pub struct PairRecord {
     pub stick_area: Real,
     /// Area of the slipping cells (`‖Λ_t‖ = 1`).
     pub slip_area: Real,
+    /// Moment of the contact forces on body `k` about the origin,
+    /// `Σ_r x_r × f_r` over the contact nodes (normal and friction forces at the node's
+    /// reference position `x_r`), 3 components (2D: only `z`).
+    pub moment: [Real; 3],
+    /// Centre of pressure: the contact nodes' reference positions weighted by their normal
+    /// forces, `Σ_r κ_r Λ_n,r x_r / Σ_r κ_r Λ_n,r`; `None` without contact.
+    pub centre_of_pressure: Option<[Real; 3]>,
+    /// Mean contact pressure `normal_force / contact_area` (0 without contact).
+    pub mean_pressure: Real,
+}
+
+impl PairRecord {
+    /// A record of a pair without contact (every figure zero).
+    pub fn empty(name: &str) -> Self {
+        Self {
+            name: name.to_string(),
+            force: [0.0; 3],
+            normal_force: 0.0,
+            tangential_force: 0.0,
+            contact_area: 0.0,
+            peak_pressure: 0.0,
+            stick_area: 0.0,
+            slip_area: 0.0,
+            moment: [0.0; 3],
+            centre_of_pressure: None,
+            mean_pressure: 0.0,
+        }
+    }
+}
+
+/// `x × f` of two vectors of dimension `D` embedded in 3D.
+fn moment_of<const D: usize>(x: &Vector<D>, f: &Vector<D>) -> [Real; 3] {
+    let e = |v: &Vector<D>| [v[0], v[1], if D > 2 { v[2] } else { 0.0 }];
+    let (a, b) = (e(x), e(f));
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 /// Figures of one time level.
@@ -74,26 +109,36 @@ pub fn pair_records<const D: usize>(
         .iter()
         .map(|(name, range)| {
             let mut force = Vector::<D>::zeros();
+            let mut centre = Vector::<D>::zeros();
+            let mut moment = [0.0; 3];
             let (mut nf, mut area, mut peak) = (0.0, 0.0, 0.0_f64);
             for r in range.clone() {
                 let node = &geometry.nodes[r];
                 let l = sol.lambda_n.get(r).copied().unwrap_or(0.0);
                 nf += node.weight * l;
-                force -= node.normal * (node.weight * l);
+                let f = -node.normal * (node.weight * l);
+                force += f;
+                centre += node.position * (node.weight * l);
+                for (m, v) in moment.iter_mut().zip(moment_of(&node.position, &f)) {
+                    *m += v;
+                }
                 if l > 0.0 {
                     area += node.weight;
                     peak = peak.max(l);
                 }
             }
+            let centre_of_pressure = (nf > 0.0).then(|| {
+                let c = centre / nf;
+                [c[0], c[1], if D > 2 { c[2] } else { 0.0 }]
+            });
             PairRecord {
-                name: name.clone(),
-                force: [0.0; 3],
                 normal_force: nf,
-                tangential_force: 0.0,
                 contact_area: area,
                 peak_pressure: peak,
-                stick_area: 0.0,
-                slip_area: 0.0,
+                moment,
+                centre_of_pressure,
+                mean_pressure: if area > 0.0 { nf / area } else { 0.0 },
+                ..PairRecord::empty(name)
             }
             .with_force(&force)
         })
@@ -109,6 +154,9 @@ pub fn pair_records<const D: usize>(
             f -= node.tangents[k] * (g * node.weight * lk);
         }
         friction[pair] += f;
+        for (m, v) in out[pair].moment.iter_mut().zip(moment_of(&node.position, &f)) {
+            *m += v;
+        }
         let ln = l.iter().map(|v| v * v).sum::<Real>().sqrt();
         if ln < 1.0 - 1e-6 {
             out[pair].stick_area += node.weight;
@@ -126,6 +174,7 @@ pub fn pair_records<const D: usize>(
 }
 
 impl PairRecord {
+    #[must_use]
     fn with_force<const D: usize>(mut self, f: &Vector<D>) -> Self {
         for i in 0..D {
             self.force[i] = f[i];
@@ -153,6 +202,13 @@ pub fn write_csv(path: &Path, records: &[StepRecord]) -> Result<(), IoError> {
                 "peak_pressure",
                 "stick_area",
                 "slip_area",
+                "moment_x",
+                "moment_y",
+                "moment_z",
+                "centre_of_pressure_x",
+                "centre_of_pressure_y",
+                "centre_of_pressure_z",
+                "mean_pressure",
             ] {
                 header.push_str(&format!(",{}_{col}", p.name));
             }
@@ -185,6 +241,13 @@ pub fn write_csv(path: &Path, records: &[StepRecord]) -> Result<(), IoError> {
                 p.stick_area,
                 p.slip_area
             ));
+            line.push_str(&format!(",{},{},{}", p.moment[0], p.moment[1], p.moment[2]));
+            match p.centre_of_pressure {
+                // no contact: empty cells (no made-up position)
+                None => line.push_str(",,,"),
+                Some(c) => line.push_str(&format!(",{},{},{}", c[0], c[1], c[2])),
+            }
+            line.push_str(&format!(",{}", p.mean_pressure));
         }
         writeln!(f, "{line}").map_err(io)?;
     }
