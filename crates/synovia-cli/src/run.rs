@@ -101,7 +101,8 @@ pub struct StepSummary {
     /// penetration, complementarity, friction; 0 without contact).
     pub kkt: f64,
     /// The contact solver that produced the step's solution (e.g. `dual-mprgp` when
-    /// `pdas-fallback` fell back; [`solver_that_ran`]).
+    /// `pdas-fallback` fell back; the step record's `solver`), the configured one for a step
+    /// without contact solve.
     pub solver: String,
     /// `true` when a body held only by contact carries no contact force at this step: its
     /// position is then not determined by the equations (any rigid motion of it is a
@@ -282,20 +283,6 @@ fn floating_note(bodies: &[String]) -> String {
         "bodies {} are held only by contact: at a step where no contact force acts on them their position is undetermined (summary.json: `position_undetermined`)",
         bodies.iter().map(|b| format!("`{b}`")).collect::<Vec<_>>().join(", ")
     )
-}
-
-/// The name of the contact solver that produced a step's solution: the one its report names,
-/// else the configured one (a step without contact solve).
-pub fn solver_that_ran<const D: usize>(
-    configured: &str,
-    result: &synovia::contact_ops::StaticContactResult<D>,
-) -> String {
-    let ran = &result.solution.report.solver;
-    if ran.is_empty() {
-        configured.to_string()
-    } else {
-        ran.clone()
-    }
 }
 
 /// An error and its causes as one line, each cause once: a cause whose text the message
@@ -486,8 +473,8 @@ fn run_dim<const D: usize>(
         };
         let has_contact = !view.geometry.is_empty();
         let kkt = if has_contact { view.result.kkt.max() } else { 0.0 };
-        let mut summary =
-            step_summary(view.record, vtu, kkt, solver_that_ran(&configured_solver, view.result));
+        let ran = if view.record.solver.is_empty() { &configured_solver } else { &view.record.solver };
+        let mut summary = step_summary(view.record, vtu, kkt, ran.clone());
         summary.position_undetermined = !floating.is_empty()
             && summary.pairs.iter().filter(|p| holding.contains(&p.name)).all(|p| p.normal_force == 0.0);
         if summary.position_undetermined {

@@ -54,41 +54,19 @@ pub fn check_balance(
     let load_norm = load.iter().map(|f| f * f).sum::<f64>().sqrt();
     // columns: normal rows (ν ≥ 0), friction rows with both signs
     let mut columns: Vec<Vec<f64>> = Vec::new();
-    let mut add_rows = |rows: &synovia_linalg::SparseRows, weights: Option<&[f64]>, both_signs: bool| {
-        let per_mode: Vec<Vec<f64>> = modes.iter().map(|r| rows.mul(r)).collect();
-        for row in 0..rows.nrows() {
-            let w = weights.map_or(1.0, |w| w[row]);
-            let col: Vec<f64> = per_mode.iter().map(|pm| w * pm[row]).collect();
-            if col.iter().any(|c| *c != 0.0) {
-                if both_signs {
-                    columns.push(col.iter().map(|c| -c).collect());
-                }
-                columns.push(col);
-            }
-        }
-    };
     // ν = κ Λ_n: the column of ν_r is (C R)_r·, the weights are already in ν.
-    add_rows(&normal.rows, None, false);
+    push_mode_columns(&mut columns, &modes, &normal.rows, false);
     if let Some(f) = friction {
-        add_rows(&f.rows, None, true);
+        push_mode_columns(&mut columns, &modes, &f.rows, true);
     }
     let (x, residual) = nnls(&columns, &target);
     let target_norm = target.iter().map(|g| g * g).sum::<f64>().sqrt();
     if residual <= 1e-8 * load_norm.max(f64::MIN_POSITIVE) || target_norm == 0.0 {
         return Ok(());
     }
-    let mut delta = target;
-    for (xj, col) in x.iter().zip(&columns) {
-        for (d, c) in delta.iter_mut().zip(col) {
-            *d -= xj * c;
-        }
-    }
+    let delta = fit_residual(target, &columns, &x);
     let mut unbalanced = vec![0.0; load.len()];
-    for (d, r) in delta.iter().zip(&modes) {
-        for (u, rv) in unbalanced.iter_mut().zip(r.iter()) {
-            *u += d * rv;
-        }
-    }
+    add_modes(&mut unbalanced, 1.0, &delta, &modes);
     let bodies = stabilisation.components.iter().flat_map(|c| c.bodies.iter().cloned()).collect();
     Err(ContactError::Unbalanced { bodies, force: net_force(&unbalanced), residual, load: target_norm })
 }
@@ -117,26 +95,54 @@ pub fn withhold_unbalanced(
         return (load.to_vec(), 0.0);
     }
     let target: Vec<f64> = modes.iter().map(|r| dot(r, load)).collect();
-    let per_mode: Vec<Vec<f64>> = modes.iter().map(|r| normal.rows.mul(r)).collect();
-    let columns: Vec<Vec<f64>> = (0..normal.rows.nrows())
-        .map(|row| per_mode.iter().map(|pm| pm[row]).collect::<Vec<f64>>())
-        .filter(|col| col.iter().any(|c| *c != 0.0))
-        .collect();
+    let mut columns = Vec::new();
+    push_mode_columns(&mut columns, &modes, &normal.rows, false);
     let (x, _) = nnls(&columns, &target);
-    let mut delta = target;
-    for (xj, col) in x.iter().zip(&columns) {
-        for (d, c) in delta.iter_mut().zip(col) {
+    let delta = fit_residual(target, &columns, &x);
+    let mut out = load.to_vec();
+    add_modes(&mut out, -1.0, &delta, &modes);
+    let norm = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
+    (out, norm)
+}
+
+/// Appends the non-zero columns `(Rᵀ C_rᵀ)` of the rows `C_r` in the rigid modes `R` (row by
+/// row; with `both_signs` each column's negative first, for the free-sign friction rows).
+fn push_mode_columns(
+    columns: &mut Vec<Vec<f64>>,
+    modes: &[&Vec<f64>],
+    rows: &synovia_linalg::SparseRows,
+    both_signs: bool,
+) {
+    let per_mode: Vec<Vec<f64>> = modes.iter().map(|r| rows.mul(r)).collect();
+    for row in 0..rows.nrows() {
+        let col: Vec<f64> = per_mode.iter().map(|pm| pm[row]).collect();
+        if col.iter().any(|c| *c != 0.0) {
+            if both_signs {
+                columns.push(col.iter().map(|c| -c).collect());
+            }
+            columns.push(col);
+        }
+    }
+}
+
+/// `δ = t − Σ_j x_j a_j`: the part of the rigid-body load `t` that the fitted contact
+/// columns `a_j` with the coefficients `x_j` do not balance.
+fn fit_residual(mut target: Vec<f64>, columns: &[Vec<f64>], x: &[f64]) -> Vec<f64> {
+    for (xj, col) in x.iter().zip(columns) {
+        for (d, c) in target.iter_mut().zip(col) {
             *d -= xj * c;
         }
     }
-    let mut out = load.to_vec();
-    for (d, r) in delta.iter().zip(&modes) {
-        for (o, rv) in out.iter_mut().zip(r.iter()) {
-            *o -= d * rv;
+    target
+}
+
+/// `y += s Σ_m δ_m r_m`: a load in the rigid modes `r_m` with the coefficients `δ`.
+fn add_modes(y: &mut [f64], s: f64, delta: &[f64], modes: &[&Vec<f64>]) {
+    for (d, r) in delta.iter().zip(modes) {
+        for (yi, rv) in y.iter_mut().zip(r.iter()) {
+            *yi += s * d * rv;
         }
     }
-    let norm = delta.iter().map(|d| d * d).sum::<f64>().sqrt();
-    (out, norm)
 }
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {

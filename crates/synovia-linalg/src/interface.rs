@@ -37,6 +37,13 @@ struct StoredSolve {
     solve: Vec<f64>,
 }
 
+impl StoredSolve {
+    /// Bytes it holds (the solve and the direction's index–value pairs).
+    fn bytes(&self) -> usize {
+        (self.solve.len() + 2 * self.direction.len()) * std::mem::size_of::<f64>()
+    }
+}
+
 /// A row in trailing positions as `s · d`: `s` its entry of largest magnitude (the first of
 /// equal ones; 1 for an empty or zero row) and `d = row / s`.
 #[derive(Debug)]
@@ -122,17 +129,18 @@ impl BlockSolveStore {
     }
     /// Keeps the solve `x` of `row` as `x_d = x / s`.
     fn put(&self, block: usize, row: &RowDirection, x: &[f64]) {
-        let bytes = (x.len() + 2 * row.direction.len()) * std::mem::size_of::<f64>();
-        let solve: Vec<f64> = x.iter().map(|v| v / row.scale).collect();
+        let stored = StoredSolve {
+            direction: row.direction.clone(),
+            solve: x.iter().map(|v| v / row.scale).collect(),
+        };
+        let bytes = stored.bytes();
         let mut store = self.lock();
         if store.block != block || store.bytes + bytes > self.budget_bytes {
             *store = BlockSolves { block, ..Default::default() };
         }
         if bytes <= self.budget_bytes {
-            let stored = StoredSolve { direction: row.direction.clone(), solve };
             if let Some(old) = store.solves.insert(row.key, stored) {
-                let old_bytes = (old.solve.len() + 2 * old.direction.len()) * std::mem::size_of::<f64>();
-                store.bytes -= old_bytes.min(store.bytes);
+                store.bytes -= old.bytes().min(store.bytes);
             }
             store.bytes += bytes;
         }
