@@ -60,6 +60,7 @@ use synovia_time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
 use synovia_time::results::StepRecord;
 use synovia_time::TimeError;
 
+use crate::rigid::{ForceControlParams, LevelMode, RigidBody, RigidDriver};
 use crate::session::JointSession;
 
 mod setup;
@@ -268,6 +269,10 @@ pub struct JointModel<const D: usize> {
     analysis: Option<Analysis>,
     refuse_penetration: bool,
     refuse_penetration_pairs: Vec<String>,
+    rigid_bodies: Vec<RigidBody<D>>,
+    rigid_pairs: Vec<(String, usize)>,
+    rigid_ties: Vec<(BodyId, String, usize)>,
+    force_control: ForceControlParams,
 }
 
 impl<const D: usize> fmt::Debug for JointModel<D> {
@@ -334,6 +339,132 @@ impl<const D: usize> JointModel<D> {
             analysis: None,
             refuse_penetration: false,
             refuse_penetration_pairs: Vec::new(),
+            rigid_bodies: Vec::new(),
+            rigid_pairs: Vec::new(),
+            rigid_ties: Vec::new(),
+            force_control: ForceControlParams::default(),
+        }
+    }
+
+    // ----- rigid bodies -----
+
+    /// Adds a rigid body with mixed control ([`crate::rigid`]); returns its index.
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for a duplicate name.
+    pub fn add_rigid_body(&mut self, body: RigidBody<D>) -> Result<usize, JointError> {
+        if self.rigid_bodies.iter().any(|b| b.name == body.name) {
+            return Err(JointError::Invalid(format!("two rigid bodies are called `{}`", body.name)));
+        }
+        self.rigid_bodies.push(body);
+        Ok(self.rigid_bodies.len() - 1)
+    }
+
+    fn rigid_index(&self, rigid: &str) -> Result<usize, JointError> {
+        self.rigid_bodies.iter().position(|b| b.name == rigid).ok_or_else(|| {
+            let names: Vec<&str> = self.rigid_bodies.iter().map(|b| b.name.as_str()).collect();
+            JointError::Invalid(format!("unknown rigid body `{rigid}` (rigid bodies: {})", names.join(", ")))
+        })
+    }
+
+    /// Adds a contact pair between `part` of `body` and the shape of rigid body `rigid`
+    /// (`shape`: a signed distance in the rigid body's own frame, e.g. a
+    /// [`SurfaceObstacle`](synovia_contact::SurfaceObstacle)), placed by the rigid body's
+    /// pose at every level ([`crate::rigid::PosedObstacle`]); Coulomb coefficient `friction`.
+    /// The contact forces of the pair load the rigid body.
+    ///
+    /// # Errors
+    /// Unknown rigid body; see [`JointModel::add_contact`].
+    pub fn contact_rigid_body(
+        &mut self,
+        name: &str,
+        body: impl BodyRef,
+        part: &str,
+        rigid: &str,
+        shape: Arc<dyn SignedDistance<D>>,
+        friction: Real,
+    ) -> Result<&mut Self, JointError> {
+        let r = self.rigid_index(rigid)?;
+        let id = body.resolve(&self.model)?;
+        let posed = crate::rigid::PosedObstacle::new(shape, self.rigid_bodies[r].pose.clone());
+        self.add_contact(ContactPair::rigid(name, id, part, Arc::new(posed)).with_friction(friction))?;
+        self.rigid_pairs.push((name.to_string(), r));
+        Ok(self)
+    }
+
+    /// Ties `part` of `body` to rigid body `rigid` (a rigid plate): the part moves with the
+    /// rigid body's pose, `u(X) = c + t + R (X − c) − X` (all components), and its reactions
+    /// load the rigid body.
+    ///
+    /// # Errors
+    /// Unknown rigid body, body or part; [`JointError::PartKind`].
+    pub fn tie_to_rigid_body(
+        &mut self,
+        body: impl BodyRef,
+        part: &str,
+        rigid: &str,
+    ) -> Result<&mut Self, JointError> {
+        let r = self.rigid_index(rigid)?;
+        let id = body.resolve(&self.model)?;
+        let pose = self.rigid_bodies[r].pose.clone();
+        self.prescribe_field(id, part, ComponentMask::ALL, move |x, _t| pose.get().position(x) - x)?;
+        self.rigid_ties.push((id, part.to_string(), r));
+        Ok(self)
+    }
+
+    /// Sets the parameters of the force-control iteration ([`ForceControlParams`]).
+    pub fn force_control(&mut self, params: ForceControlParams) -> &mut Self {
+        self.force_control = params;
+        self
+    }
+
+    /// The parameters of the force-control iteration.
+    pub fn force_control_params(&self) -> ForceControlParams {
+        self.force_control
+    }
+
+    /// The rigid bodies.
+    pub fn rigid_bodies(&self) -> &[RigidBody<D>] {
+        &self.rigid_bodies
+    }
+
+    /// The parts tied to rigid bodies: `(body, part, rigid body index)`.
+    pub fn rigid_ties(&self) -> &[(BodyId, String, usize)] {
+        &self.rigid_ties
+    }
+
+    /// The contact pairs with a rigid body's shape: `(pair name, rigid body index)`.
+    pub fn rigid_pair_bodies(&self) -> &[(String, usize)] {
+        &self.rigid_pairs
+    }
+
+    /// For each pair of `geometry` (in its order), the rigid body whose shape it touches.
+    pub(crate) fn pair_rigid_owner(&self, geometry: &ContactGeometry<D>) -> Vec<Option<usize>> {
+        geometry
+            .pairs
+            .iter()
+            .map(|(name, _)| self.rigid_pairs.iter().find(|(p, _)| p == name).map(|(_, r)| *r))
+            .collect()
+    }
+
+    /// The diagonal of the bounding box of all bodies' nodes (the model's size, for relative
+    /// tolerances); 1 for an empty model.
+    pub fn model_size(&self) -> Real {
+        let mut lo = [Real::INFINITY; 3];
+        let mut hi = [Real::NEG_INFINITY; 3];
+        for b in self.model.bodies() {
+            for x in b.mesh.nodes() {
+                for i in 0..D {
+                    lo[i] = lo[i].min(x[i]);
+                    hi[i] = hi[i].max(x[i]);
+                }
+            }
+        }
+        let d = (0..D).map(|i| (hi[i] - lo[i]).powi(2)).sum::<Real>().sqrt();
+        if d.is_finite() && d > 0.0 {
+            d
+        } else {
+            1.0
         }
     }
 
@@ -957,6 +1088,9 @@ impl<const D: usize> JointModel<D> {
         }
         let geometry = stepper.geometry().clone();
         let setup_s = start.elapsed().as_secs_f64();
+        if !self.rigid_bodies.is_empty() {
+            return self.run_rigid_levels(times, stepper, solver.as_ref(), n_dofs, start, setup_s, observer);
+        }
         let mut failure: Option<JointError> = None;
         let run = stepper.run(&self.model, times, solver.as_ref(), |record, result| {
             let view = StepView { model: &self.model, geometry: &geometry, record, result, n_steps };
@@ -977,6 +1111,49 @@ impl<const D: usize> JointModel<D> {
             contact: last,
             n_dofs,
             contact_nodes: geometry.len(),
+            solver: solver.name().to_string(),
+            setup_s,
+            total_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The levels of a model with rigid bodies: each level poses them and finds their
+    /// force-controlled coordinates ([`crate::rigid`]).
+    #[allow(clippy::too_many_arguments)]
+    fn run_rigid_levels(
+        &self,
+        times: &[Real],
+        mut stepper: QuasiStaticStepper<D>,
+        solver: &dyn ContactSolver,
+        n_dofs: usize,
+        start: Instant,
+        setup_s: f64,
+        mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
+    ) -> Result<RunResult<D>, JointError> {
+        check_levels(times)?;
+        let mut driver = RigidDriver::new(self);
+        let mut records = Vec::with_capacity(times.len());
+        let mut last = None;
+        for (i, &t) in times.iter().enumerate() {
+            let mode = if i == 0 { LevelMode::Restart { warm: false } } else { LevelMode::Step };
+            let (record, result) = driver.level(self, &mut stepper, t, solver, mode)?;
+            let view = StepView {
+                model: &self.model,
+                geometry: stepper.geometry(),
+                record: &record,
+                result: &result,
+                n_steps: times.len(),
+            };
+            observer(&view)?;
+            records.push(record);
+            last = Some(result);
+        }
+        Ok(RunResult {
+            records,
+            displacement: last.as_ref().map(|r| r.displacement.clone()).unwrap_or_default(),
+            contact: last,
+            n_dofs,
+            contact_nodes: stepper.geometry().len(),
             solver: solver.name().to_string(),
             setup_s,
             total_s: start.elapsed().as_secs_f64(),
@@ -1123,6 +1300,21 @@ impl<const D: usize> JointModel<D> {
             total_s: start.elapsed().as_secs_f64(),
         })
     }
+}
+
+/// Time levels must be finite, strictly increasing, at least one.
+fn check_levels(times: &[Real]) -> Result<(), JointError> {
+    if times.is_empty() {
+        return Err(JointError::Invalid("no time levels".into()));
+    }
+    for (i, &t) in times.iter().enumerate() {
+        if !t.is_finite() || (i > 0 && t <= times[i - 1]) {
+            return Err(JointError::Invalid(format!(
+                "time levels must be finite and increase strictly (level {i}: {t})"
+            )));
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -77,6 +77,7 @@ pub mod contact {
 }
 pub mod builder;
 pub mod output;
+pub mod rigid;
 pub mod session;
 pub mod solvers;
 

@@ -46,6 +46,7 @@ use synovia_time::quasistatic::QuasiStaticStepper;
 use synovia_time::results::StepRecord;
 
 use crate::builder::{JointError, JointModel};
+use crate::rigid::{LevelMode, RigidDriver};
 
 /// Figures of one solve of a [`JointSession`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,6 +79,7 @@ pub struct JointSession<'a, const D: usize> {
     record: Option<StepRecord>,
     report: Option<SolveReport>,
     setup_s: f64,
+    rigid: RigidDriver,
 }
 
 // one per session, so the size difference of the variants does not matter
@@ -131,6 +133,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
             record: None,
             report: None,
             setup_s: start.elapsed().as_secs_f64(),
+            rigid: RigidDriver::new(joint),
         })
     }
 
@@ -151,6 +154,19 @@ impl<'a, const D: usize> JointSession<'a, D> {
     pub fn solve_static(&mut self, t: Real) -> Result<SolveReport, JointError> {
         let model = self.joint.model();
         match &mut self.engine {
+            Engine::Contact(stepper) if !self.joint.rigid_bodies().is_empty() => {
+                let warm = stepper.has_warm_start();
+                let (record, result) = self.rigid.level(
+                    self.joint,
+                    stepper,
+                    t,
+                    self.solver.as_ref(),
+                    LevelMode::Restart { warm: true },
+                )?;
+                let report = contact_report(&record, &result, warm);
+                self.geometry = stepper.geometry().clone();
+                Ok(self.commit(record, report))
+            }
             Engine::Contact(stepper) => {
                 let warm = stepper.has_warm_start();
                 let (record, result) = stepper.restart(model, t, self.solver.as_ref(), true)?;
@@ -173,6 +189,20 @@ impl<'a, const D: usize> JointSession<'a, D> {
     pub fn step(&mut self, t: Real) -> Result<SolveReport, JointError> {
         let model = self.joint.model();
         match &mut self.engine {
+            Engine::Contact(stepper) if !self.joint.rigid_bodies().is_empty() => {
+                if let Some(last) = stepper.last_time().filter(|&l| t <= l) {
+                    return Err(JointError::Invalid(format!(
+                        "time {t} must be later than the last solve's time {last}"
+                    )));
+                }
+                let warm = stepper.last_result().is_some();
+                let mode = if warm { LevelMode::Step } else { LevelMode::Restart { warm: false } };
+                let (record, result) =
+                    self.rigid.level(self.joint, stepper, t, self.solver.as_ref(), mode)?;
+                let report = contact_report(&record, &result, warm);
+                self.geometry = stepper.geometry().clone();
+                Ok(self.commit(record, report))
+            }
             Engine::Contact(stepper) => {
                 let warm = stepper.last_result().is_some();
                 let (record, result) = stepper.step(model, t, self.solver.as_ref())?;
@@ -194,6 +224,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
     /// Forgets the last solution and the friction state (the next solve is cold-started); the
     /// factorisation is kept.
     pub fn reset(&mut self) {
+        self.rigid.reset(self.joint);
         match &mut self.engine {
             Engine::Contact(stepper) => stepper.reset(),
             Engine::Elastic { result, step, .. } => {

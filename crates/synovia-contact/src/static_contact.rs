@@ -250,6 +250,44 @@ impl<const D: usize> StaticContact<D> {
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
+    /// Rebuilds the contact geometry of `pairs` on the reference meshes
+    /// ([`ContactGeometry::new`]), keeping the factorisation of `A`: for contact partners that
+    /// moved (a posed rigid body's shape reads its pose when the geometry is built). Returns
+    /// the previous geometry. The kept Schur columns are dropped (the rows changed).
+    ///
+    /// # Errors
+    /// From [`ContactGeometry::new`].
+    pub fn rebuild_geometry(
+        &mut self,
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+    ) -> Result<ContactGeometry<D>, ContactError> {
+        let geometry = ContactGeometry::new(model, pairs)?;
+        self.context.clear_rows();
+        Ok(std::mem::replace(&mut self.geometry, geometry))
+    }
+
+    /// Replaces the gaps `d_r` of the contact nodes (one per node), keeping the rows and the
+    /// kept Schur columns: a partner that moves by a small rigid motion changes the gaps to
+    /// first order and not the normals (`synovia::rigid`, the force-control iteration).
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] for a wrong length or a gap that is not finite.
+    pub fn set_gaps(&mut self, gaps: &[Real]) -> Result<(), ContactError> {
+        if gaps.len() != self.geometry.nodes.len() || gaps.iter().any(|g| !g.is_finite()) {
+            return Err(ContactError::InvalidParameter(format!(
+                "{} gaps (all finite) needed for {} contact nodes, {} given",
+                self.geometry.nodes.len(),
+                self.geometry.nodes.len(),
+                gaps.len()
+            )));
+        }
+        for (node, &g) in self.geometry.nodes.iter_mut().zip(gaps) {
+            node.gap = g;
+        }
+        Ok(())
+    }
+
     /// Nested iteration for cold starts ([`crate::nested`]): coarsen the contact rows
     /// down to `min_rows` and use the coarse solutions as the warm start (default `Some(32)`);
     /// `None` starts every solve from `Λ = 0`.

@@ -137,3 +137,90 @@ pub fn body_fields<const D: usize>(
     }
     Ok(out)
 }
+
+/// Reaction forces at the nodes of a part held by prescribed displacements (a clamped face, a
+/// face tied to a rigid plate): the force the support exerts on the body at node `i`,
+///
+/// ```text
+/// R_i = Σ_{T ∋ i} (K_T u_T)_i − Σ_{T ∋ i} ∫_T f φ_i dx,
+/// ```
+///
+/// the internal (elastic) force at the node minus the body-force load it carries (a prescribed
+/// part carries no traction and, being a Dirichlet part, no contact force of its own). With the
+/// solution `displacement[body][node]` of an equilibrium problem, `Σ_i R_i` balances the
+/// other loads on the body. Returns `(node, R_i)` for the part's nodes in ascending order.
+///
+/// # Errors
+/// Unknown body or part, a nonlinear material ([`FemError::NonlinearMaterial`]), a degenerate
+/// cell, a non-finite body force, or a displacement that does not fit the body.
+pub fn part_reactions<const D: usize>(
+    model: &Model<D>,
+    body: crate::BodyId,
+    part: &str,
+    displacement: &[Vector<D>],
+    t: Real,
+) -> Result<Vec<(usize, Vector<D>)>, FemError> {
+    use crate::element::{body_force_into, stiffness_into};
+    let b = model.body(body)?;
+    let mesh = &b.mesh;
+    if displacement.len() != mesh.nodes().len() {
+        return Err(FemError::InvalidParameter(format!(
+            "body `{}`: {} displacements for {} nodes",
+            b.name,
+            displacement.len(),
+            mesh.nodes().len()
+        )));
+    }
+    let nodes =
+        mesh.boundary_part(part).map_err(|source| FemError::Mesh { body: b.name.clone(), source })?.nodes();
+    let mut slot = vec![usize::MAX; mesh.nodes().len()];
+    for (k, &i) in nodes.iter().enumerate() {
+        slot[i] = k;
+    }
+    let c = b
+        .material
+        .linear_stiffness()
+        .ok_or_else(|| FemError::NonlinearMaterial { body: b.name.clone(), material: b.material.name() })?;
+    let rule = crate::QuadratureRule::simplex(D, 2)?;
+    let n = D * (D + 1);
+    let mut ke = vec![0.0; n * n];
+    let mut fe = vec![0.0; n];
+    let mut out = vec![Vector::<D>::zeros(); nodes.len()];
+    for (ci, cell) in mesh.cells().enumerate() {
+        if cell.iter().all(|&i| slot[i] == usize::MAX) {
+            continue;
+        }
+        let pts = mesh.cell_points(ci);
+        let geo = SimplexGeometry::new(&pts).filter(|g| g.measure > 0.0).ok_or_else(|| FemError::Mesh {
+            body: b.name.clone(),
+            source: synovia_mesh::MeshError::DegenerateCell { cell: ci, det: 0.0 },
+        })?;
+        stiffness_into(&geo, &c, &mut ke);
+        match &b.body_force {
+            Some(f) => {
+                let f = |x: &synovia_mesh::math::Point<D>| f(x, t);
+                body_force_into(&pts, geo.measure, &rule, &f, &mut fe).map_err(|x| {
+                    FemError::InvalidParameter(format!("body `{}`: body force not finite at {x:?}", b.name))
+                })?;
+            }
+            None => fe.iter_mut().for_each(|v| *v = 0.0),
+        }
+        for (a, &i) in cell.iter().enumerate() {
+            let k = slot[i];
+            if k == usize::MAX {
+                continue;
+            }
+            for p in 0..D {
+                let row = &ke[(D * a + p) * n..(D * a + p + 1) * n];
+                let mut s = -fe[D * a + p];
+                for (bb, &j) in cell.iter().enumerate() {
+                    for q in 0..D {
+                        s += row[D * bb + q] * displacement[j][q];
+                    }
+                }
+                out[k][p] += s;
+            }
+        }
+    }
+    Ok(nodes.into_iter().zip(out).collect())
+}

@@ -187,6 +187,16 @@ impl QuasiStaticParams {
     }
 }
 
+/// A saved state of a [`QuasiStaticStepper`] sequence ([`QuasiStaticStepper::checkpoint`]).
+#[derive(Debug, Clone)]
+pub struct StepperCheckpoint<const D: usize> {
+    last: Option<StaticContactResult<D>>,
+    slip_rate: Vec<Real>,
+    next_step: usize,
+    last_time: Option<Real>,
+    cumulative: Real,
+}
+
 /// The quasi-static stepper of docs/model.md §7: owns a [`StaticContact`] (one factorisation of `A`,
 /// reused at every level) and solves one Tresca contact problem per time level with `g_c`
 /// frozen from the previous level (see the [module documentation](self)).
@@ -398,6 +408,29 @@ impl<const D: usize> QuasiStaticStepper<D> {
         self.level(model, t, solver, Some(warm))
     }
 
+    /// The state of the sequence (last level's solution, slip rates, step counter, time,
+    /// dissipation), to try a level and go back ([`QuasiStaticStepper::rollback`]): e.g. the
+    /// trial solves of a force-controlled rigid body, each from the same previous level.
+    pub fn checkpoint(&self) -> StepperCheckpoint<D> {
+        StepperCheckpoint {
+            last: self.last.clone(),
+            slip_rate: self.slip_rate.clone(),
+            next_step: self.next_step,
+            last_time: self.last_time,
+            cumulative: self.cumulative,
+        }
+    }
+
+    /// Returns to a [`QuasiStaticStepper::checkpoint`] (the factorisation and the contact
+    /// geometry are not part of it).
+    pub fn rollback(&mut self, checkpoint: StepperCheckpoint<D>) {
+        self.last = checkpoint.last;
+        self.slip_rate = checkpoint.slip_rate;
+        self.next_step = checkpoint.next_step;
+        self.last_time = checkpoint.last_time;
+        self.cumulative = checkpoint.cumulative;
+    }
+
     /// Runs the levels `times` (finite, strictly increasing, at least one): step 0 is the
     /// initial state at `times[0]`, step `i` the Tresca problem at `times[i]` with `g_c` and
     /// the slip origin from step `i − 1` (see the [module documentation](self)). Starts a new
@@ -524,6 +557,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
             step_s: start.elapsed().as_secs_f64(),
             solver: result.solution.report.solver.clone(),
             fallback: result.solution.report.fallback.clone(),
+            rigid: Vec::new(),
         };
         self.cumulative = cumulative;
         self.slip_rate = slip_rate;

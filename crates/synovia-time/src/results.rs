@@ -95,6 +95,33 @@ pub struct StepRecord {
     /// Why the configured solver handed over to another one, if it did
     /// ([`SolverReport::fallback`](synovia_contact::SolverReport)).
     pub fallback: Option<String>,
+    /// Per rigid body with mixed control (none without rigid bodies).
+    pub rigid: Vec<RigidRecord>,
+}
+
+/// The state of a rigid body with mixed control at one level (`synovia::rigid`).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct RigidRecord {
+    /// Rigid body name.
+    pub name: String,
+    /// Generalised coordinates `q` (translations in the length unit, angles in radians;
+    /// 2D: `t_x, t_y, θ`, 3D: `t_x, t_y, t_z, θ_x, θ_y, θ_z`).
+    pub dofs: Vec<Real>,
+    /// Generalised forces `Q_k` the elastic bodies exert on the rigid body (forces, and
+    /// moments about the axes of the angles through the moved reference point).
+    pub reaction: Vec<Real>,
+    /// The applied generalised force `F_k` of each force-controlled degree of freedom
+    /// (`None`: prescribed).
+    pub applied: Vec<Option<Real>>,
+    /// Resultant force the elastic bodies exert on the rigid body (3 components, `z = 0` in 2D).
+    pub force: [Real; 3],
+    /// Its moment about the moved reference point `c + t` (3 components; 2D: only `z`).
+    pub moment: [Real; 3],
+    /// Largest `|Q_k + F_k| / scale_k` over the force-controlled degrees of freedom (0 if
+    /// there are none).
+    pub balance_error: Real,
+    /// Contact solves spent on this level.
+    pub solves: usize,
 }
 
 /// Computes the pair records of a contact solution.

@@ -1,0 +1,1049 @@
+//! Rigid bodies with mixed control (docs/model.md §8, docs/scenario.md `[[rigid_body]]`).
+//!
+//! A [`RigidBody`] has `3` (2D) or `6` (3D) degrees of freedom `q`: the translation `t` of its
+//! reference point `c` and its rotation angles. Its pose maps a point `X` of the body to
+//!
+//! ```text
+//! x = c + t + R(q) (X − c),       2D: R = R(θ);   3D: R = R_{a₁}(q_{a₁}) R_{a₂}(q_{a₂}) R_{a₃}(q_{a₃})
+//! ```
+//!
+//! with the rotation order `a₁ a₂ a₃` (default `z x y`: body-fixed z–x–y angles, the order of
+//! the OpenSim knee joint; `q = [t_x, t_y, t_z, θ_x, θ_y, θ_z]`). Each degree of freedom is
+//! either **prescribed** by a history (`q_k = h_k(t)`) or **force-controlled**: loaded by a
+//! generalised force history `F_k(t)` (a force along `e_k` for a translation, a moment about
+//! the angle's axis for a rotation) and found so that the rigid body is in equilibrium,
+//!
+//! ```text
+//! Q_k(q) + F_k(t) = 0,     Q_k = Σ_i f_i · v_k(x_i),
+//! ```
+//!
+//! where `f_i` are the forces the elastic bodies exert on the rigid body at the points `x_i`
+//! (contact forces of its pairs, reactions of the parts tied to it) and `v_k = ∂x/∂q_k` the
+//! velocity field of degree of freedom `k`: `e_k` for a translation, `a_k × (x − c − t)` for a
+//! rotation about the current axis `a_k` of angle `k` (`a_{a₁} = e_{a₁}`,
+//! `a_{a₂} = R_{a₁} e_{a₂}`, `a_{a₃} = R_{a₁} R_{a₂} e_{a₃}`). So `Q` is the resultant
+//! force and the moment about `c + t` projected on those axes.
+//!
+//! A rigid body acts on the elastic bodies in two ways:
+//!
+//! * as a contact partner: [`JointModel::contact_rigid_body`] pairs a part with the body's
+//!   shape (any [`SignedDistance`] in the body's own frame, e.g. a [`SurfaceObstacle`] read
+//!   from STL), posed by [`PosedObstacle`];
+//! * as a rigid plate: [`JointModel::tie_to_rigid_body`] prescribes the exact rigid
+//!   displacement `x(X) − X` of its pose on a part of an elastic body.
+//!
+//! The stiffness is factorised once: a pose changes only the contact rows and gaps (rigid
+//! contact partners) and the prescribed displacements (tied parts). The force-controlled
+//! degrees of freedom are found by a Newton iteration on `r(q) = Q(q) + F` around the contact
+//! solve (Broyden updates of a finite-difference Jacobian, bracketed bisection for a single
+//! degree of freedom), in which the contact geometry is built at a pose and the gaps follow the
+//! motion to first order (`d_r(q) = d_r(q₀) + n_r · v_k(x_r) (q_k − q₀_k)`, the rows and the
+//! Schur columns kept); once the motion from that pose exceeds the geometry tolerance, the
+//! geometry is rebuilt at the new pose and the iteration continues. The level is accepted
+//! when `|r_k| ≤ tolerance × scale` for every force-controlled degree of freedom
+//! ([`ForceControlParams`]).
+//!
+//! [`JointModel::contact_rigid_body`]: crate::builder::JointModel::contact_rigid_body
+//! [`JointModel::tie_to_rigid_body`]: crate::builder::JointModel::tie_to_rigid_body
+//! [`SurfaceObstacle`]: synovia_contact::SurfaceObstacle
+
+use std::fmt;
+use std::sync::{Arc, RwLock};
+
+use synovia_contact::operators::SignedDistance;
+use synovia_mesh::math::{Point, Real, Tensor, Vector};
+use synovia_time::history::LoadHistory;
+
+use synovia_contact::operators::ContactGeometry;
+use synovia_contact::{ContactSolver, StaticContactResult};
+use synovia_time::quasistatic::{QuasiStaticStepper, StepperCheckpoint};
+use synovia_time::results::StepRecord;
+
+use crate::builder::{JointError, JointModel};
+
+/// Number of degrees of freedom of a rigid body in dimension `D` (3 in 2D, 6 in 3D).
+pub const fn rigid_dofs(dim: usize) -> usize {
+    if dim == 2 {
+        3
+    } else {
+        6
+    }
+}
+
+/// How one degree of freedom of a [`RigidBody`] is driven.
+#[derive(Clone)]
+pub enum DofControl {
+    /// `q_k = h(t)` (length unit for translations, radians for rotations).
+    Prescribed(Arc<dyn LoadHistory>),
+    /// Loaded by the generalised force `F_k(t)` (force unit for translations, force × length
+    /// for rotations); `q_k` is found from the equilibrium of the rigid body.
+    Force(Arc<dyn LoadHistory>),
+}
+
+impl fmt::Debug for DofControl {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Prescribed(_) => f.write_str("Prescribed"),
+            Self::Force(_) => f.write_str("Force"),
+        }
+    }
+}
+
+/// The pose of a rigid body: `x = c + t + R (X − c)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RigidPose<const D: usize> {
+    /// The reference point `c` (in the reference configuration).
+    pub centre: Point<D>,
+    /// The rotation `R`.
+    pub rotation: Tensor<D>,
+    /// The translation `t` of `c`.
+    pub translation: Vector<D>,
+}
+
+impl<const D: usize> RigidPose<D> {
+    /// The identity pose about `centre`.
+    pub fn identity(centre: Point<D>) -> Self {
+        Self { centre, rotation: Tensor::<D>::identity(), translation: Vector::<D>::zeros() }
+    }
+    /// `x = c + t + R (X − c)`.
+    pub fn position(&self, x: &Point<D>) -> Point<D> {
+        self.centre + self.translation + self.rotation * (x - self.centre)
+    }
+    /// `X = c + Rᵀ (x − c − t)`: the body point at the place `x`.
+    pub fn to_body(&self, x: &Point<D>) -> Point<D> {
+        self.centre + self.rotation.transpose() * (x - self.centre - self.translation)
+    }
+}
+
+/// A pose shared between a [`RigidBody`], its posed contact shapes and its tied parts: the
+/// driver sets it, the shapes and the prescribed displacements read it.
+#[derive(Debug, Clone)]
+pub struct SharedPose<const D: usize>(Arc<RwLock<RigidPose<D>>>);
+
+impl<const D: usize> SharedPose<D> {
+    /// A shared pose starting at `pose`.
+    pub fn new(pose: RigidPose<D>) -> Self {
+        Self(Arc::new(RwLock::new(pose)))
+    }
+    /// The current pose.
+    pub fn get(&self) -> RigidPose<D> {
+        // a poisoned lock still holds a valid pose (plain data, written in one assignment)
+        match self.0.read() {
+            Ok(p) => *p,
+            Err(e) => *e.into_inner(),
+        }
+    }
+    /// Sets the pose.
+    pub fn set(&self, pose: RigidPose<D>) {
+        match self.0.write() {
+            Ok(mut p) => *p = pose,
+            Err(e) => *e.into_inner() = pose,
+        }
+    }
+}
+
+/// A contact shape given in a rigid body's own frame, placed by the body's current pose:
+/// `φ(x) = φ_body(X)`, `∇φ(x) = R ∇φ_body(X)` with `X` the body point at `x`.
+#[derive(Debug, Clone)]
+pub struct PosedObstacle<const D: usize> {
+    shape: Arc<dyn SignedDistance<D>>,
+    pose: SharedPose<D>,
+}
+
+impl<const D: usize> PosedObstacle<D> {
+    /// `shape` (body frame) placed by `pose`.
+    pub fn new(shape: Arc<dyn SignedDistance<D>>, pose: SharedPose<D>) -> Self {
+        Self { shape, pose }
+    }
+}
+
+impl<const D: usize> SignedDistance<D> for PosedObstacle<D> {
+    fn distance(&self, x: &Point<D>) -> Real {
+        self.shape.distance(&self.pose.get().to_body(x))
+    }
+    fn gradient(&self, x: &Point<D>) -> Vector<D> {
+        let pose = self.pose.get();
+        pose.rotation * self.shape.gradient(&pose.to_body(x))
+    }
+    fn validate(&self) -> Result<(), String> {
+        let p = self.pose.get();
+        if !(p.rotation.iter().chain(p.translation.iter()).all(|v| v.is_finite())) {
+            return Err("rigid body pose is not finite".into());
+        }
+        self.shape.validate()
+    }
+}
+
+/// A rigid body with one [`DofControl`] per degree of freedom (see the
+/// [module documentation](self)).
+#[derive(Debug, Clone)]
+pub struct RigidBody<const D: usize> {
+    pub(crate) name: String,
+    pub(crate) centre: Point<D>,
+    pub(crate) controls: Vec<DofControl>,
+    pub(crate) order: [usize; 3],
+    pub(crate) pose: SharedPose<D>,
+}
+
+/// Names of the degrees of freedom (2D and 3D).
+pub fn dof_names(dim: usize) -> &'static [&'static str] {
+    if dim == 2 {
+        &["tx", "ty", "rz"]
+    } else {
+        &["tx", "ty", "tz", "rx", "ry", "rz"]
+    }
+}
+
+fn axis_rotation(axis: usize, angle: Real) -> Tensor<3> {
+    let (s, c) = angle.sin_cos();
+    match axis {
+        0 => Tensor::<3>::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c),
+        1 => Tensor::<3>::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c),
+        _ => Tensor::<3>::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0),
+    }
+}
+
+impl<const D: usize> RigidBody<D> {
+    /// A rigid body `name` with reference point `centre`, every degree of freedom prescribed to
+    /// zero (it stays where it is until its controls are set).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for an empty name, a non-finite centre or a dimension other
+    /// than 2 or 3.
+    pub fn new(name: &str, centre: Point<D>) -> Result<Self, JointError> {
+        if D != 2 && D != 3 {
+            return Err(JointError::Invalid(format!("rigid body `{name}`: dimension {D} is not 2 or 3")));
+        }
+        if name.is_empty() {
+            return Err(JointError::Invalid("a rigid body needs a name".into()));
+        }
+        if !centre.iter().all(|v| v.is_finite()) {
+            return Err(JointError::Invalid(format!("rigid body `{name}`: centre {centre:?} is not finite")));
+        }
+        let zero: Arc<dyn LoadHistory> = Arc::new(synovia_time::history::Constant(0.0));
+        Ok(Self {
+            name: name.to_string(),
+            centre,
+            controls: vec![DofControl::Prescribed(zero); rigid_dofs(D)],
+            order: [2, 0, 1],
+            pose: SharedPose::new(RigidPose::identity(centre)),
+        })
+    }
+
+    /// The body's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// The reference point `c`.
+    pub fn centre(&self) -> &Point<D> {
+        &self.centre
+    }
+    /// The controls, one per degree of freedom ([`dof_names`] order).
+    pub fn controls(&self) -> &[DofControl] {
+        &self.controls
+    }
+    /// The shared pose (the current one while a model runs).
+    pub fn shared_pose(&self) -> &SharedPose<D> {
+        &self.pose
+    }
+
+    fn check_dof(&self, dof: usize) -> Result<(), JointError> {
+        if dof >= rigid_dofs(D) {
+            return Err(JointError::Invalid(format!(
+                "rigid body `{}`: degree of freedom {dof} does not exist (0…{}: {})",
+                self.name,
+                rigid_dofs(D) - 1,
+                dof_names(D).join(", ")
+            )));
+        }
+        Ok(())
+    }
+
+    /// Index of the degree of freedom called `name` (`"tx"`, `"ty"`, `"tz"`, `"rx"`, `"ry"`,
+    /// `"rz"`; 2D: `"tx"`, `"ty"`, `"rz"`).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] naming the valid names.
+    pub fn dof_index(name: &str) -> Result<usize, JointError> {
+        dof_names(D).iter().position(|n| *n == name).ok_or_else(|| {
+            JointError::Invalid(format!(
+                "unknown rigid degree of freedom `{name}` (in {D}D: {})",
+                dof_names(D).join(", ")
+            ))
+        })
+    }
+
+    /// Prescribes degree of freedom `dof` by `history` (length or radians).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for a degree of freedom that does not exist.
+    pub fn prescribe(mut self, dof: usize, history: impl LoadHistory + 'static) -> Result<Self, JointError> {
+        self.check_dof(dof)?;
+        self.controls[dof] = DofControl::Prescribed(Arc::new(history));
+        Ok(self)
+    }
+
+    /// Loads degree of freedom `dof` by the generalised force `history` (force, or moment
+    /// about the angle's axis); the degree of freedom is found from equilibrium.
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for a degree of freedom that does not exist.
+    pub fn force(mut self, dof: usize, history: impl LoadHistory + 'static) -> Result<Self, JointError> {
+        self.check_dof(dof)?;
+        self.controls[dof] = DofControl::Force(Arc::new(history));
+        Ok(self)
+    }
+
+    /// Sets the rotation order (3D): e.g. `"zxy"` for `R = R_z R_x R_y` (the default).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] unless `order` is a permutation of `x`, `y`, `z`.
+    pub fn with_rotation_order(mut self, order: &str) -> Result<Self, JointError> {
+        let axes: Vec<usize> = order
+            .chars()
+            .map(|c| match c {
+                'x' | 'X' => Ok(0),
+                'y' | 'Y' => Ok(1),
+                'z' | 'Z' => Ok(2),
+                _ => Err(()),
+            })
+            .collect::<Result<_, _>>()
+            .map_err(|()| self.bad_order(order))?;
+        if axes.len() != 3 || (0..3).any(|a| !axes.contains(&a)) {
+            return Err(self.bad_order(order));
+        }
+        self.order = [axes[0], axes[1], axes[2]];
+        Ok(self)
+    }
+
+    fn bad_order(&self, order: &str) -> JointError {
+        JointError::Invalid(format!(
+            "rigid body `{}`: rotation order `{order}` must be a permutation of x, y, z (e.g. \"zxy\")",
+            self.name
+        ))
+    }
+
+    /// Indices of the force-controlled degrees of freedom.
+    pub fn force_dofs(&self) -> Vec<usize> {
+        (0..self.controls.len()).filter(|&k| matches!(self.controls[k], DofControl::Force(_))).collect()
+    }
+
+    /// `q_k(t)` of the prescribed degrees of freedom, `F_k(t)` of the force-controlled ones.
+    pub(crate) fn control_values(&self, t: Real) -> Vec<Real> {
+        self.controls
+            .iter()
+            .map(|c| match c {
+                DofControl::Prescribed(h) | DofControl::Force(h) => h.value(t),
+            })
+            .collect()
+    }
+
+    /// The pose of the generalised coordinates `q` (see the [module documentation](self)).
+    pub fn pose_of(&self, q: &[Real]) -> RigidPose<D> {
+        let mut pose = RigidPose::identity(self.centre);
+        for i in 0..D {
+            pose.translation[i] = q.get(i).copied().unwrap_or(0.0);
+        }
+        if D == 2 {
+            let (s, c) = q.get(2).copied().unwrap_or(0.0).sin_cos();
+            pose.rotation[(0, 0)] = c;
+            pose.rotation[(0, 1)] = -s;
+            pose.rotation[(1, 0)] = s;
+            pose.rotation[(1, 1)] = c;
+        } else {
+            let mut r = Tensor::<3>::identity();
+            for &a in &self.order {
+                r *= axis_rotation(a, q.get(3 + a).copied().unwrap_or(0.0));
+            }
+            for i in 0..3 {
+                for j in 0..3 {
+                    pose.rotation[(i, j)] = r[(i, j)];
+                }
+            }
+        }
+        pose
+    }
+
+    /// The axes `a_k` (world frame) of the rotation angles at `q`, indexed by axis
+    /// (`x`, `y`, `z`); 2D: the `z` axis only.
+    pub(crate) fn rotation_axes(&self, q: &[Real]) -> [[Real; 3]; 3] {
+        let mut axes = [[0.0; 3]; 3];
+        if D == 2 {
+            axes[2] = [0.0, 0.0, 1.0];
+            return axes;
+        }
+        let mut r = Tensor::<3>::identity();
+        for &a in &self.order {
+            let mut e = Vector::<3>::zeros();
+            e[a] = 1.0;
+            let w = r * e;
+            axes[a] = [w[0], w[1], w[2]];
+            r *= axis_rotation(a, q.get(3 + a).copied().unwrap_or(0.0));
+        }
+        axes
+    }
+
+    /// The generalised forces `Q_k = Σ f · v_k` of a force system with resultant `force` and
+    /// moment `moment` about the origin (3 components each; 2D: `z` of the moment), at `q`.
+    pub(crate) fn generalised(&self, q: &[Real], force: [Real; 3], moment: [Real; 3]) -> Vec<Real> {
+        let mp = self.moment_about_centre(q, force, moment);
+        let axes = self.rotation_axes(q);
+        let mut out = Vec::with_capacity(rigid_dofs(D));
+        out.extend(force.iter().take(D).copied());
+        if D == 2 {
+            out.push(mp[2]);
+        } else {
+            for a in axes {
+                out.push(a[0] * mp[0] + a[1] * mp[1] + a[2] * mp[2]);
+            }
+        }
+        out
+    }
+
+    /// The moment about the moved reference point `p = c + t`, `M_O − p × F`, of a force
+    /// system with resultant `force` and moment `moment` about the origin.
+    pub(crate) fn moment_about_centre(&self, q: &[Real], force: [Real; 3], moment: [Real; 3]) -> [Real; 3] {
+        let pose = self.pose_of(q);
+        let pxf = cross(embed(&(pose.centre + pose.translation)), force);
+        [moment[0] - pxf[0], moment[1] - pxf[1], moment[2] - pxf[2]]
+    }
+
+    /// `v_k(x)`: the velocity of the body point at the place `x` for a unit rate of degree of
+    /// freedom `k` at `q`.
+    pub(crate) fn velocity(&self, q: &[Real], k: usize, x: &Point<D>) -> Vector<D> {
+        let mut v = Vector::<D>::zeros();
+        if k < D {
+            v[k] = 1.0;
+            return v;
+        }
+        let pose = self.pose_of(q);
+        let r = x - pose.centre - pose.translation;
+        let a = if D == 2 { [0.0, 0.0, 1.0] } else { self.rotation_axes(q)[k - 3] };
+        let w = cross(a, embed(&r));
+        for (vi, wi) in v.iter_mut().zip(w) {
+            *vi = wi;
+        }
+        v
+    }
+}
+
+/// Parameters of the force-control iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ForceControlParams {
+    /// Relative tolerance of the equilibrium `|Q_k + F_k| ≤ tolerance × scale_k`
+    /// (`scale` = the largest applied force of the body, × the model size for moments).
+    pub tolerance: Real,
+    /// Largest number of contact solves per level.
+    pub max_solves: usize,
+    /// Largest motion from the pose the contact geometry was built at (relative to the model
+    /// size) before the geometry is rebuilt.
+    pub geometry_tolerance: Real,
+}
+
+impl Default for ForceControlParams {
+    fn default() -> Self {
+        Self { tolerance: 1e-10, max_solves: 60, geometry_tolerance: 1e-6 }
+    }
+}
+
+/// The state of a rigid body at one level, reported in [`StepRecord::rigid`](synovia_time::results::StepRecord).
+pub use synovia_time::results::RigidRecord;
+
+/// How a level is solved: step 0 of a new sequence (warm-started from the last solution or
+/// not), or the next quasi-static level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum LevelMode {
+    Restart { warm: bool },
+    Step,
+}
+
+/// The force-control driver of a model's rigid bodies: their current coordinates and the
+/// Jacobian of the last level (the predictor of the next one).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct RigidDriver {
+    q: Vec<Vec<Real>>,
+    jacobian: Option<nalgebra::DMatrix<Real>>,
+}
+
+type Level<const D: usize> = (StepRecord, StaticContactResult<D>);
+
+/// A force system: its resultant and its moment about the origin (3 components each).
+type ForceSystem = ([Real; 3], [Real; 3]);
+
+/// A vector of dimension `D` embedded in 3D.
+fn embed<const D: usize>(v: &Vector<D>) -> [Real; 3] {
+    let mut out = [0.0; 3];
+    for (o, x) in out.iter_mut().zip(v.iter()) {
+        *o = *x;
+    }
+    out
+}
+
+fn cross(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+impl RigidDriver {
+    pub(crate) fn new<const D: usize>(joint: &JointModel<D>) -> Self {
+        Self { q: joint.rigid_bodies().iter().map(|_| vec![0.0; rigid_dofs(D)]).collect(), jacobian: None }
+    }
+
+    /// Forgets the force-controlled coordinates and the Jacobian.
+    pub(crate) fn reset<const D: usize>(&mut self, joint: &JointModel<D>) {
+        *self = Self::new(joint);
+    }
+
+    fn set_poses<const D: usize>(&self, joint: &JointModel<D>) {
+        for (body, q) in joint.rigid_bodies().iter().zip(&self.q) {
+            body.pose.set(body.pose_of(q));
+        }
+    }
+
+    /// Solves one level at `t` with the rigid bodies posed by their prescribed coordinates and
+    /// their force-controlled coordinates found from equilibrium (see the
+    /// [module documentation](self)).
+    pub(crate) fn level<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        stepper: &mut QuasiStaticStepper<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        mode: LevelMode,
+    ) -> Result<Level<D>, JointError> {
+        let model = joint.model();
+        let bodies = joint.rigid_bodies();
+        let values: Vec<Vec<Real>> = bodies.iter().map(|b| b.control_values(t)).collect();
+        for (bi, body) in bodies.iter().enumerate() {
+            for (k, c) in body.controls.iter().enumerate() {
+                if matches!(c, DofControl::Prescribed(_)) {
+                    self.q[bi][k] = values[bi][k];
+                }
+            }
+            if self.q[bi].iter().chain(&values[bi]).any(|v| !v.is_finite()) {
+                return Err(JointError::Invalid(format!(
+                    "rigid body `{}` at t = {t}: a control value is not finite ({:?})",
+                    body.name, values[bi]
+                )));
+            }
+        }
+        let unknowns: Vec<(usize, usize)> = bodies
+            .iter()
+            .enumerate()
+            .flat_map(|(bi, b)| b.force_dofs().into_iter().map(move |k| (bi, k)))
+            .collect();
+        let posed_pairs = !joint.rigid_pair_bodies().is_empty();
+        let checkpoint = (mode == LevelMode::Step).then(|| stepper.checkpoint());
+        let mut solves = 0usize;
+        let length = joint.model_size();
+        // the level without force control: pose, rebuild, solve
+        if unknowns.is_empty() {
+            self.set_poses(joint);
+            if posed_pairs {
+                stepper.contact_mut().rebuild_geometry(model, joint.pairs())?;
+            }
+            let (record, result) = self.solve_once(joint, stepper, t, solver, mode, &mut solves)?;
+            let record = self.finish(joint, stepper.geometry(), record, &result, &values, t, solves)?;
+            return Ok((record, result));
+        }
+        let params = joint.force_control_params();
+        let target: Vec<Real> = unknowns.iter().map(|&(b, k)| values[b][k]).collect();
+        let scales = force_scales(bodies, &values, &unknowns, length);
+        let mut best: Option<(Real, Level<D>)> = None;
+        let mut jac = self.jacobian.clone().filter(|j| j.nrows() == unknowns.len());
+        for _pass in 0..8 {
+            // the geometry at the current pose
+            self.set_poses(joint);
+            if posed_pairs {
+                stepper.contact_mut().rebuild_geometry(model, joint.pairs())?;
+            }
+            let base: Vec<Real> = unknowns.iter().map(|&(b, k)| self.q[b][k]).collect();
+            let geometry = stepper.geometry().clone();
+            let gaps0: Vec<Real> = geometry.nodes.iter().map(|n| n.gap).collect();
+            let sens = self.gap_sensitivities(joint, &geometry, &unknowns);
+            let mut z = base.clone();
+            let mut history: Vec<(Vec<Real>, Vec<Real>)> = Vec::new();
+            let mut bracket = Bracket::default();
+            loop {
+                if solves >= params.max_solves {
+                    return Err(self.no_convergence(joint, &unknowns, &best, solves, t));
+                }
+                for (&(b, k), &zj) in unknowns.iter().zip(&z) {
+                    self.q[b][k] = zj;
+                }
+                self.set_poses(joint);
+                if posed_pairs {
+                    let gaps: Vec<Real> = gaps0
+                        .iter()
+                        .zip(&sens)
+                        .map(|(g, s)| {
+                            g + s
+                                .iter()
+                                .zip(z.iter().zip(&base))
+                                .map(|(sj, (zj, bj))| sj * (zj - bj))
+                                .sum::<Real>()
+                        })
+                        .collect();
+                    stepper.contact_mut().set_gaps(&gaps)?;
+                }
+                if let Some(c) = &checkpoint {
+                    stepper.rollback(c.clone());
+                }
+                let (record, result) = self.solve_once(joint, stepper, t, solver, mode, &mut solves)?;
+                let reactions = self.reactions(joint, &geometry, &record, &result, t)?;
+                let r: Vec<Real> =
+                    unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
+                let error = r.iter().zip(&scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
+                if best.as_ref().is_none_or(|(e, _)| error < *e) {
+                    best = Some((error, (record, result)));
+                }
+                if error <= params.tolerance {
+                    break;
+                }
+                // not touching: move to first contact along the applied forces
+                let touching = reactions.iter().flatten().any(|v| *v != 0.0)
+                    || unknowns.iter().any(|&(b, _)| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b));
+                if !touching {
+                    z = self.approach(joint, &unknowns, &target, &z, &gaps0, &sens, &base, length)?;
+                    history.clear();
+                    continue;
+                }
+                if unknowns.len() == 1 {
+                    bracket.update(z[0], r[0]);
+                }
+                let dz = match (&mut jac, history.last()) {
+                    (Some(j), Some((zp, rp))) => {
+                        broyden(j, &z, &r, zp, rp);
+                        newton_step(j, &r)
+                    }
+                    (Some(j), None) => newton_step(j, &r),
+                    (None, _) => None,
+                };
+                history.push((z.clone(), r.clone()));
+                let mut next = match dz {
+                    Some(dz) => z.iter().zip(&dz).map(|(a, d)| a + d).collect::<Vec<_>>(),
+                    None => {
+                        // a finite-difference column per unknown, then Newton
+                        let j = self.fd_jacobian(
+                            joint,
+                            stepper,
+                            t,
+                            solver,
+                            mode,
+                            &checkpoint,
+                            &unknowns,
+                            &z,
+                            &r,
+                            &target,
+                            &gaps0,
+                            &sens,
+                            &base,
+                            length,
+                            &mut solves,
+                        )?;
+                        let step = newton_step(&j, &r);
+                        jac = Some(j);
+                        match step {
+                            Some(dz) => z.iter().zip(&dz).map(|(a, d)| a + d).collect(),
+                            None => return Err(self.unresisted(joint, &unknowns)),
+                        }
+                    }
+                };
+                limit_step::<D>(&mut next, &z, &unknowns, length);
+                if let (Some((lo, hi)), 1) = (bracket.interval(), unknowns.len()) {
+                    if !(next[0] > lo && next[0] < hi) {
+                        next[0] = 0.5 * (lo + hi);
+                    }
+                }
+                z = next;
+            }
+            // converged on this geometry: done if the motion from its pose is small
+            let moved = unknowns
+                .iter()
+                .zip(z.iter().zip(&base))
+                .map(|(&(_, k), (a, b))| (a - b).abs() * if k < D { 1.0 } else { length })
+                .fold(0.0, Real::max);
+            if !posed_pairs || moved <= params.geometry_tolerance * length {
+                self.jacobian = jac;
+                let Some((_, (record, result))) = best.take() else {
+                    return Err(JointError::Invalid("internal: no solve".into()));
+                };
+                let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
+                return Ok((record, result));
+            }
+            best = None;
+        }
+        Err(self.no_convergence(joint, &unknowns, &best, solves, t))
+    }
+
+    /// One contact solve of the level.
+    fn solve_once<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        stepper: &mut QuasiStaticStepper<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        mode: LevelMode,
+        solves: &mut usize,
+    ) -> Result<Level<D>, JointError> {
+        let model = joint.model();
+        *solves += 1;
+        let (record, result) = match mode {
+            LevelMode::Restart { warm } => stepper.restart(model, t, solver, warm || *solves > 1)?,
+            LevelMode::Step => stepper.step(model, t, solver)?,
+        };
+        Ok((record, result.clone()))
+    }
+
+    /// `∂d_r/∂q_k = n_r · v_k(x_r)` for the nodes of the pairs of the rigid body owning
+    /// unknown `j` (zero elsewhere).
+    fn gap_sensitivities<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        geometry: &ContactGeometry<D>,
+        unknowns: &[(usize, usize)],
+    ) -> Vec<Vec<Real>> {
+        let owner = joint.pair_rigid_owner(geometry);
+        geometry
+            .nodes
+            .iter()
+            .map(|node| {
+                unknowns
+                    .iter()
+                    .map(|&(b, k)| match owner.get(node.pair).copied().flatten() {
+                        Some(ob) if ob == b => {
+                            let body = &joint.rigid_bodies()[b];
+                            node.normal.dot(&body.velocity(&self.q[b], k, &node.position))
+                        }
+                        _ => 0.0,
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Generalised forces `Q` on every rigid body from its contact pairs and tied parts,
+    /// with the resultant and moment (about the origin).
+    fn loads<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        geometry: &ContactGeometry<D>,
+        record: &StepRecord,
+        result: &StaticContactResult<D>,
+        t: Real,
+    ) -> Result<Vec<ForceSystem>, JointError> {
+        let mut out = vec![([0.0; 3], [0.0; 3]); joint.rigid_bodies().len()];
+        let owner = joint.pair_rigid_owner(geometry);
+        for (pi, rec) in record.pairs.iter().enumerate() {
+            if let Some(b) = owner.get(pi).copied().flatten() {
+                for i in 0..3 {
+                    out[b].0[i] -= rec.force[i];
+                    out[b].1[i] -= rec.moment[i];
+                }
+            }
+        }
+        for (body, part, b) in joint.rigid_ties() {
+            let pose = joint.rigid_bodies()[*b].pose_of(&self.q[*b]);
+            let u = result
+                .displacement
+                .get(body.0)
+                .ok_or_else(|| JointError::Invalid("internal: no displacement".into()))?;
+            let mesh = &joint.model().body(*body)?.mesh;
+            for (i, r) in synovia_fem::post::part_reactions(joint.model(), *body, part, u, t)? {
+                let x = pose.position(&mesh.nodes()[i]);
+                let f = embed(&-r);
+                let m = cross(embed(&x), f);
+                for c in 0..3 {
+                    out[*b].0[c] += f[c];
+                    out[*b].1[c] += m[c];
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    fn reactions<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        geometry: &ContactGeometry<D>,
+        record: &StepRecord,
+        result: &StaticContactResult<D>,
+        t: Real,
+    ) -> Result<Vec<Vec<Real>>, JointError> {
+        Ok(self
+            .loads(joint, geometry, record, result, t)?
+            .into_iter()
+            .zip(joint.rigid_bodies())
+            .zip(&self.q)
+            .map(|(((f, m), body), q)| body.generalised(q, f, m))
+            .collect())
+    }
+
+    /// The record with the rigid bodies' figures.
+    #[allow(clippy::too_many_arguments)]
+    fn finish<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        geometry: &ContactGeometry<D>,
+        mut record: StepRecord,
+        result: &StaticContactResult<D>,
+        values: &[Vec<Real>],
+        t: Real,
+        solves: usize,
+    ) -> Result<StepRecord, JointError> {
+        let loads = self.loads(joint, geometry, &record, result, t)?;
+        let length = joint.model_size();
+        let bodies = joint.rigid_bodies();
+        let all: Vec<(usize, usize)> = bodies
+            .iter()
+            .enumerate()
+            .flat_map(|(bi, b)| b.force_dofs().into_iter().map(move |k| (bi, k)))
+            .collect();
+        let scales = force_scales(bodies, values, &all, length);
+        record.rigid = bodies
+            .iter()
+            .enumerate()
+            .map(|(b, body)| {
+                let q = &self.q[b];
+                let (f, m) = loads[b];
+                let reaction = body.generalised(q, f, m);
+                let applied: Vec<Option<Real>> = body
+                    .controls
+                    .iter()
+                    .enumerate()
+                    .map(|(k, c)| matches!(c, DofControl::Force(_)).then_some(values[b][k]))
+                    .collect();
+                let balance_error = all
+                    .iter()
+                    .zip(&scales)
+                    .filter(|((bb, _), _)| *bb == b)
+                    .map(|(&(_, k), s)| (reaction[k] + values[b][k]).abs() / s)
+                    .fold(0.0, Real::max);
+                RigidRecord {
+                    name: body.name.clone(),
+                    dofs: q.clone(),
+                    reaction,
+                    applied,
+                    force: f,
+                    moment: body.moment_about_centre(q, f, m),
+                    balance_error,
+                    solves,
+                }
+            })
+            .collect();
+        Ok(record)
+    }
+
+    /// Moves the force-controlled coordinates to first contact along their applied forces:
+    /// the smallest motion that closes a gap, with a little overlap.
+    #[allow(clippy::too_many_arguments)]
+    fn approach<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        unknowns: &[(usize, usize)],
+        target: &[Real],
+        z: &[Real],
+        gaps0: &[Real],
+        sens: &[Vec<Real>],
+        base: &[Real],
+        length: Real,
+    ) -> Result<Vec<Real>, JointError> {
+        let mut next = z.to_vec();
+        let mut moved = false;
+        for (j, (&f, zj)) in target.iter().zip(z).enumerate() {
+            if f == 0.0 {
+                continue;
+            }
+            let s = f.signum();
+            // gap at z of every node, and its rate along s
+            let mut best = Real::INFINITY;
+            for (g0, sr) in gaps0.iter().zip(sens) {
+                let g =
+                    g0 + sr.iter().zip(z.iter().zip(base)).map(|(a, (zi, bi))| a * (zi - bi)).sum::<Real>();
+                let rate = sr[j] * s;
+                if rate < 0.0 {
+                    best = best.min(g.max(0.0) / -rate);
+                }
+            }
+            if best.is_finite() {
+                next[j] = zj + s * (best + 1e-4 * length);
+                moved = true;
+            }
+        }
+        if !moved {
+            return Err(self.unresisted(joint, unknowns));
+        }
+        Ok(next)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn fd_jacobian<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        stepper: &mut QuasiStaticStepper<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        mode: LevelMode,
+        checkpoint: &Option<StepperCheckpoint<D>>,
+        unknowns: &[(usize, usize)],
+        z: &[Real],
+        r: &[Real],
+        target: &[Real],
+        gaps0: &[Real],
+        sens: &[Vec<Real>],
+        base: &[Real],
+        length: Real,
+        solves: &mut usize,
+    ) -> Result<nalgebra::DMatrix<Real>, JointError> {
+        let m = unknowns.len();
+        let mut j = nalgebra::DMatrix::<Real>::zeros(m, m);
+        let geometry = stepper.geometry().clone();
+        for col in 0..m {
+            let (_, k) = unknowns[col];
+            // along the applied force: into the contact
+            let h = if k < D { 1e-4 * length } else { 1e-4 } * if target[col] < 0.0 { -1.0 } else { 1.0 };
+            let mut zp = z.to_vec();
+            zp[col] += h;
+            for (&(b, kk), &zj) in unknowns.iter().zip(&zp) {
+                self.q[b][kk] = zj;
+            }
+            self.set_poses(joint);
+            if !joint.rigid_pair_bodies().is_empty() {
+                let gaps: Vec<Real> = gaps0
+                    .iter()
+                    .zip(sens)
+                    .map(|(g, s)| {
+                        g + s
+                            .iter()
+                            .zip(zp.iter().zip(base))
+                            .map(|(sj, (zj, bj))| sj * (zj - bj))
+                            .sum::<Real>()
+                    })
+                    .collect();
+                stepper.contact_mut().set_gaps(&gaps)?;
+            }
+            if let Some(c) = checkpoint {
+                stepper.rollback(c.clone());
+            }
+            let (record, result) = self.solve_once(joint, stepper, t, solver, mode, solves)?;
+            let reactions = self.reactions(joint, &geometry, &record, &result, t)?;
+            for (row, &(b, kk)) in unknowns.iter().enumerate() {
+                j[(row, col)] = (reactions[b][kk] + target[row] - r[row]) / h;
+            }
+        }
+        for (&(b, k), &zj) in unknowns.iter().zip(z) {
+            self.q[b][k] = zj;
+        }
+        Ok(j)
+    }
+
+    fn unresisted<const D: usize>(&self, joint: &JointModel<D>, unknowns: &[(usize, usize)]) -> JointError {
+        let names: Vec<String> = unknowns
+            .iter()
+            .map(|&(b, k)| format!("`{}`.{}", joint.rigid_bodies()[b].name, dof_names(D)[k]))
+            .collect();
+        JointError::Invalid(format!(
+            "force-controlled degree(s) of freedom {} are not resisted: no contact pair of the rigid body closes a gap when it moves along the applied force, and no tied part holds it (add a contact pair or a tie, or prescribe the degree of freedom)",
+            names.join(", ")
+        ))
+    }
+
+    fn no_convergence<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        unknowns: &[(usize, usize)],
+        best: &Option<(Real, Level<D>)>,
+        solves: usize,
+        t: Real,
+    ) -> JointError {
+        let names: Vec<String> = unknowns
+            .iter()
+            .map(|&(b, k)| format!("`{}`.{}", joint.rigid_bodies()[b].name, dof_names(D)[k]))
+            .collect();
+        JointError::Invalid(format!(
+            "t = {t}: the force-controlled degrees of freedom {} did not reach equilibrium in {solves} contact solves (best relative balance error {:.3e}, tolerance {:.1e})",
+            names.join(", "),
+            best.as_ref().map_or(Real::INFINITY, |(e, _)| *e),
+            joint.force_control_params().tolerance
+        ))
+    }
+}
+
+/// `scale_j`: the largest applied force of the owning body (translations), times the model
+/// size for moments, or the largest applied moment, whichever is larger.
+fn force_scales<const D: usize>(
+    bodies: &[RigidBody<D>],
+    values: &[Vec<Real>],
+    unknowns: &[(usize, usize)],
+    length: Real,
+) -> Vec<Real> {
+    unknowns
+        .iter()
+        .map(|&(b, k)| {
+            let applied = |pred: &dyn Fn(usize) -> bool| {
+                bodies[b]
+                    .force_dofs()
+                    .into_iter()
+                    .filter(|&kk| pred(kk))
+                    .map(|kk| values[b][kk].abs())
+                    .fold(0.0, Real::max)
+            };
+            let force = applied(&|kk| kk < D);
+            let moment = applied(&|kk| kk >= D);
+            let s = if k < D { force.max(moment / length) } else { moment.max(force * length) };
+            if s > 0.0 {
+                s
+            } else {
+                Real::MIN_POSITIVE.sqrt()
+            }
+        })
+        .collect()
+}
+
+fn newton_step(j: &nalgebra::DMatrix<Real>, r: &[Real]) -> Option<Vec<Real>> {
+    let rhs = nalgebra::DVector::from_iterator(r.len(), r.iter().map(|v| -v));
+    let lu = j.clone().lu();
+    let dz = lu.solve(&rhs)?;
+    dz.iter().all(|v| v.is_finite()).then(|| dz.iter().copied().collect())
+}
+
+/// Broyden's update `J += (Δr − J Δz) Δzᵀ / (Δzᵀ Δz)`.
+fn broyden(j: &mut nalgebra::DMatrix<Real>, z: &[Real], r: &[Real], zp: &[Real], rp: &[Real]) {
+    let dz = nalgebra::DVector::from_iterator(z.len(), z.iter().zip(zp).map(|(a, b)| a - b));
+    let dr = nalgebra::DVector::from_iterator(r.len(), r.iter().zip(rp).map(|(a, b)| a - b));
+    let n2 = dz.norm_squared();
+    if n2 > 0.0 {
+        let u = (dr - &*j * &dz) / n2;
+        *j += u * dz.transpose();
+    }
+}
+
+/// The latest iterates of a single unknown with a positive and with a negative residual:
+/// a sign-change bracket once both exist.
+#[derive(Debug, Clone, Copy, Default)]
+struct Bracket {
+    positive: Option<Real>,
+    negative: Option<Real>,
+}
+
+impl Bracket {
+    fn update(&mut self, z: Real, r: Real) {
+        if r > 0.0 {
+            self.positive = Some(z);
+        } else if r < 0.0 {
+            self.negative = Some(z);
+        }
+    }
+    /// `(lo, hi)` if the residual changes sign between two iterates.
+    fn interval(&self) -> Option<(Real, Real)> {
+        let (a, b) = (self.positive?, self.negative?);
+        Some((a.min(b), a.max(b)))
+    }
+}
+
+/// Limits a step to a tenth of the model size (translations) or 0.1 rad (rotations).
+fn limit_step<const D: usize>(next: &mut [Real], z: &[Real], unknowns: &[(usize, usize)], length: Real) {
+    for ((n, zj), &(_, k)) in next.iter_mut().zip(z).zip(unknowns) {
+        let cap = if k < D { 0.1 * length } else { 0.1 };
+        *n = zj + (*n - zj).clamp(-cap, cap);
+    }
+}

@@ -1,0 +1,110 @@
+//! Rigid bodies with mixed control (`synovia::rigid`): force-controlled degrees of freedom
+//! reach equilibrium with the contact forces and the reactions of tied parts; prescribed ones
+//! pose the body; a force nothing resists is refused.
+
+use std::sync::Arc;
+
+use synovia::prelude::*;
+use synovia::rigid::RigidBody;
+
+fn block2d() -> Result<JointModel<2>, Box<dyn std::error::Error>> {
+    let mesh = rectangle(-1.0, 1.0, 0.0, 1.0, 16, 8, Grading::Uniform, Grading::Uniform)?;
+    let mut joint = JointModel::<2>::new();
+    joint.add_body("block", mesh, plane_strain(1.0e3, 0.3)?)?;
+    Ok(joint)
+}
+
+/// A plate tied to the top of a block pushes it onto a rigid floor with a given force: the
+/// floor carries exactly that force, and the same pose prescribed gives the same reactions.
+#[test]
+fn tied_plate_under_force_control_balances_the_floor() -> Result<(), Box<dyn std::error::Error>> {
+    let mut joint = block2d()?;
+    let plate = RigidBody::<2>::new("plate", Point::<2>::new(0.0, 1.0))?.force(1, Constant(-25.0))?;
+    joint.add_rigid_body(plate)?;
+    joint.tie_to_rigid_body("block", "top", "plate")?;
+    let floor = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0))?;
+    joint.contact_rigid("floor", "block", "bottom", floor, 0.0)?;
+    let run = joint.run_static(0.0)?;
+    let rec = &run.records[0];
+    let floor_force = rec.pairs[0].force;
+    assert!((floor_force[1] - 25.0).abs() < 1e-9 * 25.0, "floor force on the block {floor_force:?}");
+    let rigid = &rec.rigid[0];
+    assert!(rigid.balance_error < 1e-9, "{rigid:?}");
+    assert!((rigid.reaction[1] - 25.0).abs() < 1e-9 * 25.0, "{rigid:?}");
+    // the plate went down; compression of a block with a frictionless floor and a bonded
+    // top lies between the uniaxial-strain and uniaxial-stress values of F / (E* w)
+    let dy = rigid.dofs[1];
+    let e = 1.0e3;
+    let nu: f64 = 0.3;
+    let stress_free = 25.0 / 2.0 / (e / (1.0 - nu * nu)); // plane strain, free sides
+    let constrained = 25.0 / 2.0 * (1.0 + nu) * (1.0 - 2.0 * nu) / (e * (1.0 - nu));
+    assert!(-dy < stress_free * 1.001 && -dy > constrained * 0.999, "dy = {dy}");
+
+    // the same plate position prescribed: the same reaction
+    let mut fixed = block2d()?;
+    let plate = RigidBody::<2>::new("plate", Point::<2>::new(0.0, 1.0))?.prescribe(1, Constant(dy))?;
+    fixed.add_rigid_body(plate)?;
+    fixed.tie_to_rigid_body("block", "top", "plate")?;
+    let floor = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::new(0.0, 1.0))?;
+    fixed.contact_rigid("floor", "block", "bottom", floor, 0.0)?;
+    let again = fixed.run_static(0.0)?;
+    let r2 = &again.records[0].rigid[0];
+    assert!((r2.reaction[1] - 25.0).abs() < 1e-8 * 25.0, "{r2:?}");
+    assert!(r2.applied.iter().all(Option::is_none));
+    Ok(())
+}
+
+/// A rigid cylinder, posed by a force along −y and a prescribed tilt, on a clamped block: the
+/// contact carries the force, the moment about the rigid body's axis is that of the contact
+/// forces, and a free rotation under zero moment centres the contact under the body.
+#[test]
+fn rigid_indenter_under_force_control() -> Result<(), Box<dyn std::error::Error>> {
+    let mut joint = block2d()?;
+    joint.clamp("block", "bottom")?;
+    let centre = Point::<2>::new(0.1, 1.5);
+    let indenter = RigidBody::<2>::new("indenter", centre)?.force(1, Constant(-4.0))?;
+    joint.add_rigid_body(indenter)?;
+    // the shape in the indenter's frame: a circle of radius 0.5 about its centre (touching y = 1)
+    let shape = Arc::new(SphereObstacle::new(centre, 0.5, false)?);
+    // starts 0.05 above the block: the driver moves it to first contact
+    let lift = RigidBody::<2>::dof_index("ty")?;
+    assert_eq!(lift, 1);
+    joint.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+    let mut session = joint.prepare()?;
+    for force_time in [0.0, 1.0] {
+        let report = session.solve_static(force_time)?;
+        assert!(report.kkt < 1e-8);
+        let rec = session.record().ok_or("no record")?;
+        let pair = &rec.pairs[0];
+        assert!((pair.normal_force - 4.0).abs() < 5e-2, "{pair:?}"); // curved normals
+        assert!((pair.force[1] + 4.0).abs() < 1e-9 * 4.0, "{pair:?}");
+        let rigid = &rec.rigid[0];
+        assert!(rigid.balance_error < 1e-9, "{rigid:?}");
+        assert!(rigid.dofs[1] < 0.0);
+        // the circle's normals pass through its centre: no moment about it (to the geometry
+        // tolerance, 1e-6 of the model size, of the last rebuild)
+        assert!(rigid.reaction[2].abs() < 1e-5 * 4.0, "{rigid:?}");
+        let cop = pair.centre_of_pressure.ok_or("no contact")?;
+        assert!((cop[0] - 0.1).abs() < 0.07, "centre of pressure {cop:?} (element size 0.125)");
+    }
+    assert_eq!(session.factorizations(), 1);
+    Ok(())
+}
+
+/// A force-controlled degree of freedom that no pair or tie resists is refused with a message
+/// that names it.
+#[test]
+fn unresisted_force_is_refused() -> Result<(), Box<dyn std::error::Error>> {
+    let mut joint = block2d()?;
+    joint.clamp("block", "bottom")?;
+    let centre = Point::<2>::new(0.0, 1.5);
+    // pushes sideways (+x): the circle never closes a gap on the top in that direction
+    let indenter = RigidBody::<2>::new("indenter", centre)?.force(0, Constant(3.0))?;
+    joint.add_rigid_body(indenter)?;
+    let shape = Arc::new(SphereObstacle::new(centre, 0.4, false)?);
+    joint.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+    let err = joint.run_static(0.0).err().ok_or("an unresisted force was accepted")?;
+    let msg = err.to_string();
+    assert!(msg.contains("`indenter`.tx") && msg.contains("not resisted"), "{msg}");
+    Ok(())
+}
