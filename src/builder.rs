@@ -412,6 +412,24 @@ impl<const D: usize> JointModel<D> {
         Ok(self)
     }
 
+    /// Sets the search distance of contact pair `pair`
+    /// ([`ContactPair::with_search_distance`]: node-to-segment, mortar and rigid pairs).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for an unknown pair or a distance that is not positive.
+    pub fn search_distance(&mut self, pair: &str, distance: Real) -> Result<&mut Self, JointError> {
+        if !(distance.is_finite() && distance > 0.0) {
+            return Err(JointError::Invalid(format!("search distance {distance} must be finite and > 0")));
+        }
+        let p = self
+            .pairs
+            .iter_mut()
+            .find(|p| p.name == pair)
+            .ok_or_else(|| JointError::Invalid(format!("no contact pair `{pair}`")))?;
+        *p = p.clone().with_search_distance(distance);
+        Ok(self)
+    }
+
     /// Sets the parameters of the force-control iteration ([`ForceControlParams`]).
     pub fn force_control(&mut self, params: ForceControlParams) -> &mut Self {
         self.force_control = params;

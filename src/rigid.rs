@@ -76,15 +76,22 @@ pub enum DofControl {
     /// `q_k = h(t)` (length unit for translations, radians for rotations).
     Prescribed(Arc<dyn LoadHistory>),
     /// Loaded by the generalised force `F_k(t)` (force unit for translations, force × length
-    /// for rotations); `q_k` is found from the equilibrium of the rigid body.
-    Force(Arc<dyn LoadHistory>),
+    /// for rotations); `q_k` is found from the equilibrium of the rigid body, starting from
+    /// the `guess` history if there is one (e.g. a measured coordinate, corrected by the
+    /// offset found at the previous level), else from the previous level's value.
+    Force {
+        /// `F_k(t)`.
+        load: Arc<dyn LoadHistory>,
+        /// A predictor of `q_k(t)`.
+        guess: Option<Arc<dyn LoadHistory>>,
+    },
 }
 
 impl fmt::Debug for DofControl {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Prescribed(_) => f.write_str("Prescribed"),
-            Self::Force(_) => f.write_str("Force"),
+            Self::Force { guess, .. } => write!(f, "Force {{ guess: {} }}", guess.is_some()),
         }
     }
 }
@@ -290,7 +297,24 @@ impl<const D: usize> RigidBody<D> {
     /// [`JointError::Invalid`] for a degree of freedom that does not exist.
     pub fn force(mut self, dof: usize, history: impl LoadHistory + 'static) -> Result<Self, JointError> {
         self.check_dof(dof)?;
-        self.controls[dof] = DofControl::Force(Arc::new(history));
+        self.controls[dof] = DofControl::Force { load: Arc::new(history), guess: None };
+        Ok(self)
+    }
+
+    /// [`RigidBody::force`] with a predictor `guess` of the coordinate (e.g. the measured
+    /// superior–inferior translation of a force-controlled knee): each level starts from
+    /// `guess(t)` plus the correction found at the previous level.
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for a degree of freedom that does not exist.
+    pub fn force_with_guess(
+        mut self,
+        dof: usize,
+        history: impl LoadHistory + 'static,
+        guess: impl LoadHistory + 'static,
+    ) -> Result<Self, JointError> {
+        self.check_dof(dof)?;
+        self.controls[dof] = DofControl::Force { load: Arc::new(history), guess: Some(Arc::new(guess)) };
         Ok(self)
     }
 
@@ -325,7 +349,7 @@ impl<const D: usize> RigidBody<D> {
 
     /// Indices of the force-controlled degrees of freedom.
     pub fn force_dofs(&self) -> Vec<usize> {
-        (0..self.controls.len()).filter(|&k| matches!(self.controls[k], DofControl::Force(_))).collect()
+        (0..self.controls.len()).filter(|&k| matches!(self.controls[k], DofControl::Force { .. })).collect()
     }
 
     /// `q_k(t)` of the prescribed degrees of freedom, `F_k(t)` of the force-controlled ones.
@@ -333,7 +357,7 @@ impl<const D: usize> RigidBody<D> {
         self.controls
             .iter()
             .map(|c| match c {
-                DofControl::Prescribed(h) | DofControl::Force(h) => h.value(t),
+                DofControl::Prescribed(h) | DofControl::Force { load: h, .. } => h.value(t),
             })
             .collect()
     }
@@ -462,6 +486,8 @@ pub(crate) enum LevelMode {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct RigidDriver {
     q: Vec<Vec<Real>>,
+    /// `q_k − guess_k(t)` of the last level, per force-controlled coordinate with a guess.
+    offset: Vec<Vec<Real>>,
     jacobian: Option<nalgebra::DMatrix<Real>>,
 }
 
@@ -485,7 +511,8 @@ fn cross(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
 
 impl RigidDriver {
     pub(crate) fn new<const D: usize>(joint: &JointModel<D>) -> Self {
-        Self { q: joint.rigid_bodies().iter().map(|_| vec![0.0; rigid_dofs(D)]).collect(), jacobian: None }
+        let zeros = || joint.rigid_bodies().iter().map(|_| vec![0.0; rigid_dofs(D)]).collect();
+        Self { q: zeros(), offset: zeros(), jacobian: None }
     }
 
     /// Forgets the force-controlled coordinates and the Jacobian.
@@ -515,8 +542,10 @@ impl RigidDriver {
         let values: Vec<Vec<Real>> = bodies.iter().map(|b| b.control_values(t)).collect();
         for (bi, body) in bodies.iter().enumerate() {
             for (k, c) in body.controls.iter().enumerate() {
-                if matches!(c, DofControl::Prescribed(_)) {
-                    self.q[bi][k] = values[bi][k];
+                match c {
+                    DofControl::Prescribed(_) => self.q[bi][k] = values[bi][k],
+                    DofControl::Force { guess: Some(g), .. } => self.q[bi][k] = g.value(t) + self.offset[bi][k],
+                    DofControl::Force { guess: None, .. } => {}
                 }
             }
             if self.q[bi].iter().chain(&values[bi]).any(|v| !v.is_finite()) {
@@ -664,6 +693,13 @@ impl RigidDriver {
                 .fold(0.0, Real::max);
             if !posed_pairs || moved <= params.geometry_tolerance * length {
                 self.jacobian = jac;
+                for (bi, body) in bodies.iter().enumerate() {
+                    for (k, c) in body.controls.iter().enumerate() {
+                        if let DofControl::Force { guess: Some(g), .. } = c {
+                            self.offset[bi][k] = self.q[bi][k] - g.value(t);
+                        }
+                    }
+                }
                 let Some((_, (record, result))) = best.take() else {
                     return Err(JointError::Invalid("internal: no solve".into()));
                 };
@@ -810,7 +846,7 @@ impl RigidDriver {
                     .controls
                     .iter()
                     .enumerate()
-                    .map(|(k, c)| matches!(c, DofControl::Force(_)).then_some(values[b][k]))
+                    .map(|(k, c)| matches!(c, DofControl::Force { .. }).then_some(values[b][k]))
                     .collect();
                 let balance_error = all
                     .iter()

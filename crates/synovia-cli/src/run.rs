@@ -76,6 +76,29 @@ pub struct PairSummary {
     pub mean_pressure: f64,
 }
 
+/// The state of one rigid body with mixed control at one step.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RigidSummary {
+    /// Rigid body name.
+    pub name: String,
+    /// Coordinates `[t_x, t_y, t_z, θ_x, θ_y, θ_z]` (2D: `[t_x, t_y, θ]`): length unit, radians.
+    pub dofs: Vec<f64>,
+    /// Generalised forces the elastic bodies exert on it, per coordinate (force; moment about
+    /// the angle's axis through the moved reference point).
+    pub reaction: Vec<f64>,
+    /// Applied generalised force per coordinate, `null` for a prescribed one.
+    pub applied: Vec<Option<f64>>,
+    /// Resultant force on it from the elastic bodies, `[x, y, z]`.
+    pub force: [f64; 3],
+    /// Moment of those forces about the moved reference point, `[x, y, z]`.
+    pub moment: [f64; 3],
+    /// Largest relative equilibrium error `|Q_k + F_k| / scale` of the force-controlled
+    /// coordinates (0 if none).
+    pub balance_error: f64,
+    /// Contact solves spent on the step.
+    pub solves: usize,
+}
+
 /// The figures of one step.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StepSummary {
@@ -91,6 +114,8 @@ pub struct StepSummary {
     pub contact_force: f64,
     /// Per contact pair.
     pub pairs: Vec<PairSummary>,
+    /// Per rigid body (empty without rigid bodies).
+    pub rigid_bodies: Vec<RigidSummary>,
     /// Strain energy.
     pub strain_energy: f64,
     /// Kinetic energy (dynamic runs).
@@ -363,6 +388,20 @@ fn step_summary(record: &StepRecord, vtu: Option<String>, kkt: f64, solver: Stri
                 moment: p.moment,
                 centre_of_pressure: p.centre_of_pressure,
                 mean_pressure: p.mean_pressure,
+            })
+            .collect(),
+        rigid_bodies: record
+            .rigid
+            .iter()
+            .map(|r| RigidSummary {
+                name: r.name.clone(),
+                dofs: r.dofs.clone(),
+                reaction: r.reaction.clone(),
+                applied: r.applied.clone(),
+                force: r.force,
+                moment: r.moment,
+                balance_error: r.balance_error,
+                solves: r.solves,
             })
             .collect(),
         strain_energy: record.strain_energy,

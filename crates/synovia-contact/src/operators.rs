@@ -127,13 +127,17 @@ impl<const D: usize> ContactPair<D> {
         let any: &dyn std::any::Any = &*self.discretisation;
         any.downcast_ref::<T>().cloned()
     }
-    /// Sets the search distance of a node-to-segment or mortar pair (no effect on other pairs).
+    /// Sets the search distance of a node-to-segment, mortar or rigid-obstacle pair (no effect
+    /// on other pairs; see [`RigidObstacle::search_distance`] for the rigid case).
     #[must_use]
     pub fn with_search_distance(mut self, distance: Real) -> Self {
         if let Some(mut d) = self.built_in::<NodeToSegment>() {
             d.search_distance = Some(distance);
             self.discretisation = Arc::new(d);
         } else if let Some(mut d) = self.built_in::<DualMortar>() {
+            d.search_distance = Some(distance);
+            self.discretisation = Arc::new(d);
+        } else if let Some(mut d) = self.built_in::<RigidObstacle<D>>() {
             d.search_distance = Some(distance);
             self.discretisation = Arc::new(d);
         }

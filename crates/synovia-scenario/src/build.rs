@@ -331,6 +331,11 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
         add_body(&cx, &mut joint, b.get_ref(), &format!("body[{i}]"), &mut gmsh, doc.bodies[..i].iter())?;
     }
     let names: Vec<String> = doc.bodies.iter().map(|b| b.get_ref().name.get_ref().clone()).collect();
+    let tables = tables(&cx, &doc.tables)?;
+    let mut shapes: HashMap<String, Shape<D>> = HashMap::new();
+    for (i, r) in doc.rigid_bodies.iter().enumerate() {
+        rigid_body(&cx, &mut joint, r, &format!("rigid_body[{i}]"), &tables, &mut shapes)?;
+    }
     let mut used = HashSet::new();
     for (i, bc) in doc.boundary.iter().enumerate() {
         boundary(&cx, &mut joint, bc, &format!("boundary[{i}]"), &names, &mut used)?;
@@ -348,7 +353,7 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
     }
     let dynamic = matches!(analysis, Analysis::Dynamic { .. });
     for (i, c) in doc.contact.iter().enumerate() {
-        contact(&cx, &mut joint, c, &format!("contact[{i}]"), &names, dynamic)?;
+        contact(&cx, &mut joint, c, &format!("contact[{i}]"), &names, dynamic, &shapes)?;
     }
     if let Some(s) = &doc.solver {
         solver(&cx, &mut joint, s)?;
@@ -1119,7 +1124,7 @@ fn boundary<const D: usize>(
     let present = present!(s;
         "value" => value, "components" => components, "history" => history,
         "translation" => translation, "rotation_deg" => rotation_deg, "center" => center, "axis" => axis,
-        "rotation_history" => rotation_history,
+        "rotation_history" => rotation_history, "rigid_body" => rigid_body,
     );
     let vector_value = || -> R<Vector<D>> {
         let v = cx.req(&s.value, k, "value", &span, &format!("a `{kind}` part needs its vector"))?;
@@ -1155,6 +1160,13 @@ fn boundary<const D: usize>(
                 }
             }
             .map_err(built_err)?;
+        }
+        "rigid_body" => {
+            cx.only(k, &present, &["rigid_body"], why)?;
+            let r = cx.req(&s.rigid_body, k, "rigid_body", &span, why)?;
+            joint
+                .tie_to_rigid_body(body.as_str(), &part, r.get_ref())
+                .map_err(|e| cx.err(key(k, "rigid_body"), r.span(), e.to_string()))?;
         }
         "prescribed" => {
             cx.only(k, &present, &["value", "components", "history"], why)?;
@@ -1276,6 +1288,7 @@ fn contact<const D: usize>(
     k: &str,
     names: &[String],
     dynamic: bool,
+    shapes: &HashMap<String, Shape<D>>,
 ) -> R<()> {
     let s = c.get_ref();
     let span = c.span();
@@ -1293,6 +1306,31 @@ fn contact<const D: usize>(
         None => 0.0,
     };
     let id = joint.model().body_id(&body).map_err(|e| cx.err(k, span.clone(), e.to_string()))?;
+    if let Some(r) = &s.rigid_body {
+        let rk = key(k, "rigid_body");
+        if s.partner.is_some() || s.obstacle.is_some() {
+            return Err(cx.err(rk, r.span(), "give one of `partner`, `obstacle` and `rigid_body`"));
+        }
+        let shape = shapes.get(r.get_ref()).ok_or_else(|| {
+            let known: Vec<&String> = shapes.keys().collect();
+            cx.err(
+                &rk,
+                r.span(),
+                format!(
+                    "no rigid body `{}` with a `shape` (rigid bodies with shapes: {known:?})",
+                    r.get_ref()
+                ),
+            )
+        })?;
+        joint
+            .contact_rigid_body(&name, id, &part, r.get_ref(), shape.clone(), friction)
+            .map_err(|e| cx.err(key(k, "part"), s.part.span(), e.to_string()))?;
+        if let Some(d) = &s.search_distance {
+            let dk = key(k, "search_distance");
+            joint.search_distance(&name, cx.positive(d, &dk)?).map_err(|e| cx.err(dk, d.span(), e.to_string()))?;
+        }
+        return contact_options(cx, joint, s, k, &name, dynamic);
+    }
     let mut pair = match (&s.partner, &s.obstacle) {
         (Some(p), None) => {
             let pk = key(k, "partner");
@@ -1388,6 +1426,19 @@ fn contact<const D: usize>(
     };
     pair.friction = friction;
     joint.add_contact(pair).map_err(|e| cx.err(key(k, "part"), s.part.span(), e.to_string()))?;
+    contact_options(cx, joint, s, k, &name, dynamic)
+}
+
+/// The options of a contact pair once it is added: initial penetration policy, friction law.
+fn contact_options<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &mut JointModel<D>,
+    s: &ContactSpec,
+    k: &str,
+    name: &str,
+    dynamic: bool,
+) -> R<()> {
+    let name = name.to_string();
     if let Some(r) = &s.refuse_initial_penetration {
         joint
             .refuse_initial_penetration_in(&name, *r.get_ref())
@@ -1424,7 +1475,7 @@ fn obstacle<const D: usize>(
     let why = format!("obstacle `{kind}`");
     let why = why.as_str();
     let present = present!(s; "point" => point, "normal" => normal, "center" => center, "radius" => radius,
-        "axis" => axis, "cavity" => cavity);
+        "axis" => axis, "cavity" => cavity, "file" => file, "scale" => scale, "solid" => solid);
     let cavity = s.cavity.as_ref().is_some_and(|c| *c.get_ref());
     let any: Box<dyn Any> = match kind {
         "plane" => {
@@ -1461,11 +1512,45 @@ fn obstacle<const D: usize>(
             );
             Box::new(d)
         }
+        "stl" => {
+            if D != 3 {
+                return Err(cx.err(key(k, "type"), s.kind.span(), "an `stl` surface is 3D"));
+            }
+            cx.only(k, &present, &["file", "scale", "solid"], why)?;
+            let f = cx.req(&s.file, k, "file", &span, why)?;
+            let fk = key(k, "file");
+            let path = cx.src.resolve(f.get_ref());
+            let mut surface =
+                synovia::io::read_stl(&path).map_err(|e| cx.err(&fk, f.span(), e.to_string()))?;
+            if let Some(sc) = &s.scale {
+                let factor = cx.positive(sc, &key(k, "scale"))?;
+                surface = surface.scaled(factor).map_err(|e| cx.err(key(k, "scale"), sc.span(), e.to_string()))?;
+            }
+            let solid = s.solid.as_ref().is_none_or(|v| *v.get_ref());
+            let obstacle = if solid {
+                synovia::contact_ops::SurfaceObstacle::solid(surface)
+            } else {
+                synovia::contact_ops::SurfaceObstacle::new(surface)
+            }
+            .map_err(|e| {
+                cx.err(
+                    &fk,
+                    f.span(),
+                    format!(
+                        "{}: {e}{}",
+                        f.get_ref(),
+                        if solid { " (a `solid` surface must be closed; `solid = false` accepts an open patch)" } else { "" }
+                    ),
+                )
+            })?;
+            let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<3>> = Arc::new(obstacle);
+            Box::new(d)
+        }
         other => {
             return Err(cx.err(
                 key(k, "type"),
                 s.kind.span(),
-                format!("unknown obstacle `{other}` (plane, sphere, cylinder)"),
+                format!("unknown obstacle `{other}` (plane, sphere, cylinder, stl)"),
             ))
         }
     };
@@ -1687,4 +1772,182 @@ fn output(cx: &Cx<'_>, o: Option<&Sp<OutputSpec>>) -> R<OutputPlan> {
         };
     }
     Ok(plan)
+}
+
+/// A rigid body's contact shape.
+type Shape<const D: usize> = Arc<dyn synovia::contact_ops::operators::SignedDistance<D>>;
+
+/// The `[[table]]` files, read, by name.
+fn tables(cx: &Cx<'_>, specs: &[Sp<TableSpec>]) -> R<HashMap<String, (synovia::time::table::Table, f64)>> {
+    let mut out = HashMap::new();
+    for (i, t) in specs.iter().enumerate() {
+        let k = format!("table[{i}]");
+        let s = t.get_ref();
+        let name = s.name.get_ref().clone();
+        if out.contains_key(&name) {
+            return Err(cx.err(key(&k, "name"), s.name.span(), format!("two tables are called `{name}`")));
+        }
+        let path = cx.src.resolve(s.file.get_ref());
+        let table = synovia::time::table::Table::read(&path)
+            .map_err(|e| cx.err(key(&k, "file"), s.file.span(), e.to_string()))?;
+        let time_scale = match &s.time_scale {
+            Some(v) => {
+                let f = cx.finite(v, &key(&k, "time_scale"))?;
+                if f == 0.0 {
+                    return Err(cx.err(key(&k, "time_scale"), v.span(), "must not be 0"));
+                }
+                f
+            }
+            None => 1.0,
+        };
+        out.insert(name, (table, time_scale));
+    }
+    Ok(out)
+}
+
+/// A `[[rigid_body]]`: its controls, rotation order and shape.
+fn rigid_body<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &mut JointModel<D>,
+    spec: &Sp<RigidBodySpec>,
+    k: &str,
+    tables: &HashMap<String, (synovia::time::table::Table, f64)>,
+    shapes: &mut HashMap<String, Shape<D>>,
+) -> R<()> {
+    use synovia::rigid::RigidBody;
+    let s = spec.get_ref();
+    let name = s.name.get_ref().clone();
+    let centre = match &s.center {
+        Some(c) => cx.point::<D>(c, &key(k, "center"))?,
+        None => Point::<D>::zeros(),
+    };
+    let mut body = RigidBody::<D>::new(&name, centre).map_err(|e| cx.err(key(k, "name"), s.name.span(), e.to_string()))?;
+    if let Some(o) = &s.rotation_order {
+        if D != 3 {
+            return Err(cx.err(key(k, "rotation_order"), o.span(), "a rotation order is 3D only"));
+        }
+        body = body
+            .with_rotation_order(o.get_ref())
+            .map_err(|e| cx.err(key(k, "rotation_order"), o.span(), e.to_string()))?;
+    }
+    let dofs = [("tx", &s.tx), ("ty", &s.ty), ("tz", &s.tz), ("rx", &s.rx), ("ry", &s.ry), ("rz", &s.rz)];
+    for (dof_name, dof) in dofs {
+        let Some(d) = dof else { continue };
+        let dk = key(k, dof_name);
+        let index = RigidBody::<D>::dof_index(dof_name).map_err(|e| cx.err(&dk, d.span(), e.to_string()))?;
+        let rotation = index >= D;
+        let ds = d.get_ref();
+        let present = present!(ds; "value" => value, "force" => force, "history" => history,
+            "table" => table, "column" => column, "scale" => scale, "unit" => unit,
+            "guess_column" => guess_column, "guess_scale" => guess_scale);
+        let find_table = |t: &Sp<String>| {
+            tables.get(t.get_ref()).ok_or_else(|| {
+                let known: Vec<&String> = tables.keys().collect();
+                cx.err(key(&dk, "table"), t.span(), format!("no [[table]] called `{}` (tables: {known:?})", t.get_ref()))
+            })
+        };
+        let guess: Option<Arc<dyn LoadHistory>> = match &ds.guess_column {
+            None => {
+                if let Some(g) = &ds.guess_scale {
+                    return Err(cx.err(key(&dk, "guess_scale"), g.span(), "`guess_scale` needs `guess_column`"));
+                }
+                None
+            }
+            Some(gc) => {
+                let t = ds.table.as_ref().ok_or_else(|| {
+                    cx.err(key(&dk, "guess_column"), gc.span(), "`guess_column` needs the `table` it is in")
+                })?;
+                if ds.force.is_none() {
+                    return Err(cx.err(key(&dk, "guess_column"), gc.span(), "`guess_column` applies to a force-controlled coordinate (`force`)"));
+                }
+                let (table, time_scale) = find_table(t)?;
+                let factor = match &ds.guess_scale {
+                    Some(sc) => cx.finite(sc, &key(&dk, "guess_scale"))?,
+                    None => 1.0,
+                };
+                let h = table
+                    .history(gc.get_ref(), factor, *time_scale)
+                    .map_err(|e| cx.err(key(&dk, "guess_column"), gc.span(), e.to_string()))?;
+                Some(Arc::new(h))
+            }
+        };
+        let (amount, is_force) = match (&ds.value, &ds.force) {
+            (Some(v), None) => (Some(cx.finite(v, &key(&dk, "value"))?), false),
+            (None, Some(f)) => (Some(cx.finite(f, &key(&dk, "force"))?), true),
+            (None, None) => (None, false),
+            (Some(_), Some(f)) => {
+                return Err(cx.err(key(&dk, "force"), f.span(), "give either `value` (prescribed) or `force`, not both"))
+            }
+        };
+        let history: Arc<dyn LoadHistory> = match (&ds.table, &ds.column) {
+            (Some(t), Some(c)) => {
+                if ds.history.is_some() {
+                    return Err(cx.err(&dk, d.span(), "give either `history` or `table` with `column`, not both"));
+                }
+                let (table, time_scale) = find_table(t)?;
+                let mut factor = match &ds.scale {
+                    Some(sc) => cx.finite(sc, &key(&dk, "scale"))?,
+                    None => 1.0,
+                };
+                match ds.unit.as_ref().map(|u| (u.get_ref().as_str(), u.span())) {
+                    None | Some(("rad", _)) => {}
+                    Some(("deg", _)) if rotation => factor *= std::f64::consts::PI / 180.0,
+                    Some((other, span)) => {
+                        return Err(cx.err(
+                            key(&dk, "unit"),
+                            span,
+                            format!("unit `{other}`: only angles take a unit, `rad` or `deg` (lengths: use `scale`)"),
+                        ))
+                    }
+                }
+                factor *= amount.unwrap_or(1.0);
+                let h = table
+                    .history(c.get_ref(), factor, *time_scale)
+                    .map_err(|e| cx.err(key(&dk, "column"), c.span(), e.to_string()))?;
+                Arc::new(h)
+            }
+            (Some(t), None) if guess.is_none() => {
+                return Err(cx.err(key(&dk, "table"), t.span(), "a `table` needs its `column`"))
+            }
+            (None, Some(c)) => return Err(cx.err(key(&dk, "column"), c.span(), "a `column` needs its `table`")),
+            (_, None) => {
+                for (n, sp) in present.iter() {
+                    if let (true, Some(sp)) = (matches!(*n, "scale" | "unit"), sp) {
+                        return Err(cx.err(key(&dk, n), sp.clone(), format!("`{n}` applies to a table column")));
+                    }
+                }
+                let Some(a) = amount else {
+                    return Err(cx.err(&dk, d.span(), "give `value` (prescribed), `force`, or `table` with `column`"));
+                };
+                // prescribed angles are given in degrees
+                let a = if rotation && !is_force { a.to_radians() } else { a };
+                let h = cx.history(ds.history.as_ref(), &key(&dk, "history"))?;
+                Arc::new(synovia::time::history::FnHistory::new(move |t| a * h.value(t)))
+            }
+        };
+        body = if is_force {
+            match guess {
+                Some(g) => body.force_with_guess(index, ArcHistory(history), ArcHistory(g)),
+                None => body.force(index, ArcHistory(history)),
+            }
+        } else {
+            body.prescribe(index, ArcHistory(history))
+        }
+        .map_err(|e| cx.err(&dk, d.span(), e.to_string()))?;
+    }
+    if let Some(shape) = &s.shape {
+        shapes.insert(name.clone(), obstacle::<D>(cx, shape, &key(k, "shape"))?);
+    }
+    joint.add_rigid_body(body).map_err(|e| cx.err(key(k, "name"), s.name.span(), e.to_string()))?;
+    Ok(())
+}
+
+/// A shared history as a history.
+#[derive(Debug, Clone)]
+struct ArcHistory(Arc<dyn LoadHistory>);
+
+impl LoadHistory for ArcHistory {
+    fn value(&self, t: f64) -> f64 {
+        self.0.value(t)
+    }
 }

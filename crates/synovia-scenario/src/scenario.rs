@@ -302,6 +302,12 @@ pub struct ScenarioDoc {
     /// Contact pairs (`[[contact]]`).
     #[serde(default)]
     pub contact: Vec<Sp<ContactSpec>>,
+    /// Data tables (`[[table]]`: kinematics or load histories from CSV / OpenSim `.sto` files).
+    #[serde(default, rename = "table")]
+    pub tables: Vec<Sp<TableSpec>>,
+    /// Rigid bodies with mixed control (`[[rigid_body]]`).
+    #[serde(default, rename = "rigid_body")]
+    pub rigid_bodies: Vec<Sp<RigidBodySpec>>,
     /// The contact solver.
     pub solver: Option<Sp<SolverSpec>>,
     /// The analysis.
@@ -480,6 +486,8 @@ pub struct BoundarySpec {
     pub center: Option<Sp<Vec<f64>>>,
     pub axis: Option<Sp<Vec<f64>>>,
     pub rotation_history: Option<Sp<HistorySpec>>,
+    /// `kind = "rigid_body"`: the rigid body the part is tied to.
+    pub rigid_body: Option<Sp<String>>,
 }
 
 /// A bonded interface.
@@ -508,6 +516,8 @@ pub struct ContactSpec {
     /// Body-body non-matching pairs: the largest slave-to-master distance searched.
     pub search_distance: Option<Sp<f64>>,
     pub obstacle: Option<Sp<ObstacleSpec>>,
+    /// The shape of this rigid body (`[[rigid_body]]`) is the partner.
+    pub rigid_body: Option<Sp<String>>,
     pub friction: Option<Sp<f64>>,
     pub friction_law: Option<Sp<FrictionLawSpec>>,
     pub normal: Option<Sp<Vec<f64>>>,
@@ -529,9 +539,16 @@ pub struct PartnerSpec {
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct ObstacleSpec {
-    /// `plane`, `sphere` (circle in 2D), `cylinder` (3D).
+    /// `plane`, `sphere` (circle in 2D), `cylinder` (3D), `stl` (3D, a triangle surface).
     #[serde(rename = "type")]
     pub kind: Sp<String>,
+    /// `stl`: the file (relative to the scenario).
+    pub file: Option<Sp<String>>,
+    /// `stl`: factor from the file's length unit to the model's (e.g. 1000 for metres → mm).
+    pub scale: Option<Sp<f64>>,
+    /// `stl`: `true` (default) requires a closed, manifold surface (inside = negative
+    /// distance); `false` accepts an open patch (distance signed by the facet normals).
+    pub solid: Option<Sp<bool>>,
     pub point: Option<Sp<Vec<f64>>>,
     pub normal: Option<Sp<Vec<f64>>>,
     pub center: Option<Sp<Vec<f64>>>,
@@ -746,4 +763,69 @@ impl<'de> Deserialize<'de> for TimesSpec {
         }
         d.deserialize_any(V)
     }
+}
+
+/// A data table (`[[table]]`): columns of a CSV or OpenSim `.sto`/`.mot` file, used by rigid
+/// body degrees of freedom.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableSpec {
+    /// The name the degrees of freedom refer to.
+    pub name: Sp<String>,
+    /// The file (relative to the scenario).
+    pub file: Sp<String>,
+    /// Factor from the table's time to the scenario's (e.g. 0.01: percent of a cycle → cycles).
+    pub time_scale: Option<Sp<f64>>,
+}
+
+/// A rigid body with mixed control (`[[rigid_body]]`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidBodySpec {
+    /// Name.
+    pub name: Sp<String>,
+    /// Reference point `c` (default the origin).
+    pub center: Option<Sp<Vec<f64>>>,
+    /// 3D rotation order, a permutation of `xyz` (default `"zxy"`: `R = R_z R_x R_y`).
+    pub rotation_order: Option<Sp<String>>,
+    /// Its contact shape in its own frame (same keys as a contact `obstacle`, plus `stl`).
+    pub shape: Option<Sp<ObstacleSpec>>,
+    /// Degrees of freedom (absent: prescribed zero).
+    pub tx: Option<Sp<DofSpec>>,
+    #[allow(missing_docs)]
+    pub ty: Option<Sp<DofSpec>>,
+    #[allow(missing_docs)]
+    pub tz: Option<Sp<DofSpec>>,
+    #[allow(missing_docs)]
+    pub rx: Option<Sp<DofSpec>>,
+    #[allow(missing_docs)]
+    pub ry: Option<Sp<DofSpec>>,
+    #[allow(missing_docs)]
+    pub rz: Option<Sp<DofSpec>>,
+}
+
+/// The control of one rigid degree of freedom: prescribed (`value`, or a table column) or
+/// force-controlled (`force`), each times `history` or a table column.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DofSpec {
+    /// Prescribed coordinate (length unit; angles in degrees for `rx`, `ry`, `rz`).
+    pub value: Option<Sp<f64>>,
+    /// Applied generalised force (force unit; moment for rotations).
+    pub force: Option<Sp<f64>>,
+    /// History multiplying `value` / `force` (default 1).
+    pub history: Option<Sp<HistorySpec>>,
+    /// A `[[table]]` name: the coordinate (or the force) is a column of it.
+    pub table: Option<Sp<String>>,
+    /// The column of `table`.
+    pub column: Option<Sp<String>>,
+    /// Factor applied to the column (unit conversion; e.g. 1000 for metres → mm).
+    pub scale: Option<Sp<f64>>,
+    /// Unit of an angle column: `"rad"` (default) or `"deg"`.
+    pub unit: Option<Sp<String>>,
+    /// Force control: a column of `table` that predicts the coordinate (e.g. the measured
+    /// translation), times `guess_scale`.
+    pub guess_column: Option<Sp<String>>,
+    /// Factor of `guess_column` (default 1).
+    pub guess_scale: Option<Sp<f64>>,
 }

@@ -8,6 +8,7 @@
 use std::sync::Arc;
 
 use synovia_fem::BodyId;
+use synovia_mesh::math::Real;
 
 use super::{ContactDiscretisation, ContactRow, PairContext};
 use crate::error::ContactError;
@@ -18,12 +19,19 @@ use crate::operators::SignedDistance;
 pub struct RigidObstacle<const D: usize> {
     /// The obstacle's signed distance (positive in the free space).
     pub obstacle: Arc<dyn SignedDistance<D>>,
+    /// Nodes farther than this from the obstacle (`φ > search_distance`), and nodes outside it
+    /// that the obstacle faces away from, keep their row with the body's own outward normal
+    /// and their gap `φ`: constraints that cannot become active near this configuration (a
+    /// femoral component above the far side of an insert), kept so that the pair's nodes do
+    /// not change from pose to pose. `None` (default): every node uses the obstacle's normal,
+    /// and an obstacle facing away from a node is an error.
+    pub search_distance: Option<Real>,
 }
 
 impl<const D: usize> RigidObstacle<D> {
     /// Against `obstacle`.
     pub fn new(obstacle: Arc<dyn SignedDistance<D>>) -> Self {
-        Self { obstacle }
+        Self { obstacle, search_distance: None }
     }
 }
 
@@ -49,6 +57,19 @@ impl<const D: usize> ContactDiscretisation<D> for RigidObstacle<D> {
                 return Err(cx.invalid(format!("obstacle distance or gradient not finite/zero at node {i}")));
             }
             let n = -grad / gl;
+            if let Some(reach) = self.search_distance {
+                if phi > reach || (phi > 0.0 && n.dot(&nk) <= 0.0) {
+                    rows.push(ContactRow {
+                        node: i,
+                        partner: None,
+                        master: Vec::new(),
+                        normal: nk,
+                        weight: cx.weight(i),
+                        gap: phi,
+                    });
+                    continue;
+                }
+            }
             if n.dot(&nk) <= 0.0 {
                 return Err(cx.invalid(format!(
                     "at node {i} the obstacle faces away from the body (outward normal · obstacle normal = {:.3} ≤ 0)",
