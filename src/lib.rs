@@ -79,6 +79,7 @@ pub mod builder;
 pub mod output;
 pub mod session;
 pub mod solvers;
+pub mod units;
 
 /// The types most programs need.
 pub mod prelude {
