@@ -151,7 +151,11 @@ pub fn characteristic_strain<const D: usize>(model: &Model<D>, times: &[Real]) -
                 let Ok(part) = body.mesh.boundary_part(&pd.part) else { continue };
                 for i in part.nodes() {
                     let u = (pd.value)(&x[i], t);
-                    let m = (0..D).filter(|&k| pd.components.contains(k)).map(|k| u[k] * u[k]).sum::<Real>().sqrt();
+                    let m = (0..D)
+                        .filter(|&k| pd.components.contains(k))
+                        .map(|k| u[k] * u[k])
+                        .sum::<Real>()
+                        .sqrt();
                     disp = disp.max(m);
                 }
             }
@@ -198,6 +202,10 @@ mod tests {
         // the same numbers on a mesh in metres: a million times more
         let m = characteristic_strain(block(1.0).model(), &[0.0]).expect("estimate");
         assert!((m.strain / mm.strain - 1e6).abs() < 1e-3 * 1e6, "{m:?}");
-        assert!(m.describe("mm", "N", "MPa").contains("strain body `insert`"), "{}", m.describe("mm", "N", "MPa"));
+        assert!(
+            m.describe("mm", "N", "MPa").contains("strain body `insert`"),
+            "{}",
+            m.describe("mm", "N", "MPa")
+        );
     }
 }
