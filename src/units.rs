@@ -126,7 +126,7 @@ pub fn characteristic_strain<const D: usize>(model: &Model<D>, times: &[Real]) -
             }
         }
         let size = (hi - lo).norm();
-        if !(size > 0.0) {
+        if size.is_nan() || size <= 0.0 {
             continue;
         }
         let volume: Real = (0..D).map(|k| hi[k] - lo[k]).product();
