@@ -33,7 +33,7 @@ use synovia::mesh::generators::disc;
 use synovia::pdas::Pdas;
 use synovia::prelude::*;
 use synovia::time::dynamic::{DynamicBody, DynamicParams, DynamicStepper};
-use synovia::time::results::{write_csv, StepRecord};
+use synovia::time::results::{write_csv_with_units, StepRecord, Units};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let out = std::env::args().nth(1).unwrap_or_else(|| "out/dynamic_drop".to_string());
@@ -154,7 +154,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let mismatch = (stepper.momentum() - p0 - impulse).norm() / (total_mass * v0.norm());
     let csv = Path::new(&out).join("dynamic_drop.csv");
-    write_csv(&csv, &records)?;
+    // SI units, 2D: forces per metre of thickness
+    let si = Units { length: "m".into(), force: "N".into(), time: "s".into() };
+    write_csv_with_units(&csv, &records, &si, 2)?;
     println!("ParaView series: {}", series.pvd_path().display());
 
     // ## Step 4: cost of a step vs. a plain elastic factorisation + solve of the same mesh

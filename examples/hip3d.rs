@@ -74,7 +74,7 @@ fn main() -> Result<(), KneeError> {
     })?;
 
     let mut csv = String::from(
-        "time,load_n,contact_force_n,contact_shear_n,balance_error,peak_pressure_mpa,mean_pressure_mpa,contact_area_mm2,active_nodes,approach_mm,solves,kkt,seconds\n",
+        "time [cycle],load [N],contact_force [N],contact_shear [N],balance_error [-],peak_pressure [MPa],mean_pressure [MPa],contact_area [mm^2],active_nodes [-],approach [mm],solves [-],kkt [-],seconds [s]\n",
     );
     for s in &steps {
         let _ = writeln!(

@@ -1318,6 +1318,30 @@ impl<const D: usize> JointModel<D> {
             total_s: start.elapsed().as_secs_f64(),
         })
     }
+
+    // ----- reporting (issue 16 item 5) -----
+
+    /// Reports the figures of contact pair `pair` also split by a plane into two sides (e.g.
+    /// medial and lateral, [`PairSplit`](synovia_contact::operators::PairSplit)): every step
+    /// record's [`PairRecord::sides`](synovia_time::results::PairRecord::sides) then holds
+    /// the force, moment, areas, peak and mean pressure and centre of pressure of each side.
+    /// Reporting only: the solution does not change. A second call replaces the split.
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for an unknown pair.
+    pub fn split_pair_report(
+        &mut self,
+        pair: &str,
+        split: synovia_contact::operators::PairSplit,
+    ) -> Result<&mut Self, JointError> {
+        let p = self
+            .pairs
+            .iter_mut()
+            .find(|p| p.name == pair)
+            .ok_or_else(|| JointError::Invalid(format!("no contact pair `{pair}`")))?;
+        p.report_split = Some(split);
+        Ok(self)
+    }
 }
 
 /// Time levels must be finite, strictly increasing, at least one.

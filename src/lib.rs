@@ -80,12 +80,15 @@ pub mod output;
 pub mod rigid;
 pub mod session;
 pub mod solvers;
+pub mod units;
 
 /// The types most programs need.
 pub mod prelude {
     pub use crate::builder::{Analysis, BodyMaterial, BodyRef, JointError, JointModel, RunResult, StepView};
     pub use crate::session::{JointSession, SolveReport};
-    pub use synovia_contact::operators::{CylinderObstacle, FnObstacle, PlaneObstacle, SphereObstacle};
+    pub use synovia_contact::operators::{
+        CylinderObstacle, FnObstacle, PairSplit, PlaneObstacle, SphereObstacle,
+    };
     pub use synovia_contact::SurfaceObstacle;
     pub use synovia_contact::{ConstantFriction, ContactParams, ExponentialFriction, FrictionLaw};
     pub use synovia_fem::{

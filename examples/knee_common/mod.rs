@@ -61,7 +61,7 @@ pub fn run_cycle(
 /// The per-pose CSV table.
 pub fn csv_text(steps: &[KneeStep]) -> String {
     let mut s = String::from(
-        "time,flexion_deg,load_n,load_n_per_mm,contact_force_n_per_mm,contact_shear_n_per_mm,balance_error,peak_pressure_mpa,peak_x_mm,contact_length_mm,approach_mm,solves,solver_iterations,kkt,seconds\n",
+        "time [cycle],flexion [deg],load [N],load [N/mm],contact_force [N/mm],contact_shear [N/mm],balance_error [-],peak_pressure [MPa],peak_x [mm],contact_length [mm],approach [mm],solves [-],solver_iterations [-],kkt [-],seconds [s]\n",
     );
     for r in steps {
         let _ = writeln!(

@@ -9,7 +9,7 @@ use std::time::Instant;
 use serde::Serialize;
 use synovia::builder::JointError;
 use synovia::time::quasistatic::QuasiStaticOutput;
-use synovia::time::results::{write_csv, StepRecord};
+use synovia::time::results::{write_csv_with_units, PairRecord, StepRecord, Units};
 
 use crate::build::{build, Built};
 use crate::outdir::{OutDir, MANIFEST, SUMMARY};
@@ -74,6 +74,61 @@ pub struct PairSummary {
     pub centre_of_pressure: Option<[f64; 3]>,
     /// Mean contact pressure (normal force / contact area).
     pub mean_pressure: f64,
+    /// The two sides of a pair split by a plane (`split` in `[[contact]]`), positive side
+    /// first, each with the figures above (`name` = the side's name, `sides` empty); empty
+    /// for a pair without a split.
+    pub sides: Vec<PairSummary>,
+}
+
+impl PairSummary {
+    fn of(p: &PairRecord) -> Self {
+        Self {
+            name: p.name.clone(),
+            force: p.force,
+            normal_force: p.normal_force,
+            tangential_force: p.tangential_force,
+            contact_area: p.contact_area,
+            peak_pressure: p.peak_pressure,
+            stick_area: p.stick_area,
+            slip_area: p.slip_area,
+            moment: p.moment,
+            centre_of_pressure: p.centre_of_pressure,
+            mean_pressure: p.mean_pressure,
+            sides: p.sides.iter().map(Self::of).collect(),
+        }
+    }
+}
+
+/// The unit labels of the outputs (`[units]` of the scenario; synovia computes in any
+/// consistent units, these only name them).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct UnitsSummary {
+    /// Length unit of the meshes (positions, displacements, centres of pressure).
+    pub length: String,
+    /// Force unit (forces; in 2D forces are per unit thickness, `force/length`).
+    pub force: String,
+    /// Time unit of the time levels.
+    pub time: String,
+    /// Pressure and modulus unit, `force/length²` (`MPa` for N and mm).
+    pub pressure: String,
+    /// Area unit (3D `length^2`; 2D: contact length per unit thickness, `length^2/length`).
+    pub area: String,
+    /// Moment and energy unit (`force*length`; 2D per unit thickness).
+    pub moment: String,
+}
+
+impl UnitsSummary {
+    fn of(u: &Units, dimension: usize) -> Self {
+        use synovia::time::results::Quantity;
+        Self {
+            length: u.length.clone(),
+            force: u.label(Quantity::Force, dimension),
+            time: u.time.clone(),
+            pressure: u.pressure(),
+            area: u.label(Quantity::Area, dimension),
+            moment: u.label(Quantity::Moment, dimension),
+        }
+    }
 }
 
 /// The state of one rigid body with mixed control at one step.
@@ -201,8 +256,10 @@ pub struct Summary {
     /// The KKT residual of the last step (`steps.last().kkt`; 0 without steps).
     pub final_kkt: f64,
     /// Warnings of the build and the run (initial penetration, unused duplicate nodes,
-    /// undetermined positions), also printed by the CLI.
+    /// undetermined positions, large strains of the unit check), also printed by the CLI.
     pub warnings: Vec<String>,
+    /// The unit labels of every figure (`[units]` of the scenario; default mm, N, s).
+    pub units: UnitsSummary,
 }
 
 /// Options of [`run_with_options`].
@@ -373,23 +430,7 @@ fn step_summary(record: &StepRecord, vtu: Option<String>, kkt: f64, solver: Stri
         iterations: record.iterations,
         step_s: record.step_s,
         contact_force: record.pairs.iter().map(|p| p.normal_force).sum(),
-        pairs: record
-            .pairs
-            .iter()
-            .map(|p| PairSummary {
-                name: p.name.clone(),
-                force: p.force,
-                normal_force: p.normal_force,
-                tangential_force: p.tangential_force,
-                contact_area: p.contact_area,
-                peak_pressure: p.peak_pressure,
-                stick_area: p.stick_area,
-                slip_area: p.slip_area,
-                moment: p.moment,
-                centre_of_pressure: p.centre_of_pressure,
-                mean_pressure: p.mean_pressure,
-            })
-            .collect(),
+        pairs: record.pairs.iter().map(PairSummary::of).collect(),
         rigid_bodies: record
             .rigid
             .iter()
@@ -557,7 +598,7 @@ fn run_dim<const D: usize>(
     let final_kkt = steps.last().map_or(0.0, |s| s.kkt);
     let csv = format!("{name}.csv");
     let csv_tmp = out_dir.join(format!("{csv}.tmp"));
-    write_csv(&csv_tmp, &records).map_err(anyhow::Error::new)?;
+    write_csv_with_units(&csv_tmp, &records, &built.units, D).map_err(anyhow::Error::new)?;
     std::fs::rename(&csv_tmp, out_dir.join(&csv)).map_err(|e| {
         let _ = std::fs::remove_file(&csv_tmp);
         anyhow::anyhow!("cannot write `{}`: {e}", out_dir.join(&csv).display())
@@ -593,6 +634,7 @@ fn run_dim<const D: usize>(
         steps_planned: n_steps,
         final_kkt,
         warnings,
+        units: UnitsSummary::of(&built.units, D),
     };
     let json = serde_json::to_string_pretty(&summary).map_err(anyhow::Error::new)?;
     folder.write(SUMMARY, (json + "\n").as_bytes())?;

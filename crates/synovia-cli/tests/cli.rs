@@ -90,7 +90,7 @@ fn every_example_scenario_runs() {
         assert!(peak > 0.0, "{stem}: no contact at any step");
         let csv = std::fs::read_to_string(out.join(format!("{stem}.csv"))).unwrap();
         assert_eq!(csv.lines().count(), n + 1, "{stem}: CSV rows");
-        assert!(csv.starts_with("step,time,iterations"));
+        assert!(csv.starts_with("step [-],time [s],iterations [-]"), "{stem}: CSV header with units");
         let pvd = out.join(format!("{stem}.pvd"));
         let series = synovia::io::read_pvd(&pvd).unwrap();
         assert_eq!(series.len(), summary["files"]["vtu"].as_u64().unwrap() as usize);

@@ -78,6 +78,58 @@ pub struct ContactPair<const D: usize> {
     pub discretisation: Arc<dyn ContactDiscretisation<D>>,
     /// Coulomb coefficient `F_c ≥ 0` (0: frictionless).
     pub friction: Real,
+    /// Reporting only: the plane that splits the pair's figures into two sides
+    /// ([`PairSplit`]; `None`: the pair is reported as a whole only).
+    pub report_split: Option<PairSplit>,
+}
+
+/// A plane that splits a pair's reported figures into two sides (e.g. `medial` and
+/// `lateral`): a contact node belongs to the positive side when `(x − point)·normal ≥ 0` for
+/// its position `x` (the position the centre of pressure is computed from), else to the
+/// negative side. Reporting only: the contact problem is not changed. In 2D the third
+/// components of `point` and `normal` are ignored.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PairSplit {
+    /// Name of the side `(x − point)·normal ≥ 0`.
+    pub positive: String,
+    /// Name of the side `(x − point)·normal < 0`.
+    pub negative: String,
+    /// A point of the plane.
+    pub point: [Real; 3],
+    /// Its normal (pointing into the positive side; any length > 0).
+    pub normal: [Real; 3],
+}
+
+impl PairSplit {
+    /// A split plane through `point` with `normal` towards the side named `positive`.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] for a point or normal that is not finite, a zero
+    /// normal, empty or equal side names.
+    pub fn new(
+        positive: &str,
+        negative: &str,
+        point: [Real; 3],
+        normal: [Real; 3],
+    ) -> Result<Self, ContactError> {
+        let bad = |m: String| Err(ContactError::InvalidParameter(m));
+        if point.iter().chain(&normal).any(|x| !x.is_finite()) {
+            return bad(format!("split plane: point {point:?} and normal {normal:?} must be finite"));
+        }
+        if normal.iter().all(|&x| x == 0.0) {
+            return bad("split plane: the normal is zero".into());
+        }
+        if positive.is_empty() || negative.is_empty() || positive == negative {
+            return bad(format!(
+                "split plane: the sides need two different non-empty names, got `{positive}` and `{negative}`"
+            ));
+        }
+        Ok(Self { positive: positive.into(), negative: negative.into(), point, normal })
+    }
+    /// Whether position `x` (dimension 2 or 3) lies on the positive side.
+    pub fn is_positive(&self, x: &[Real]) -> bool {
+        x.iter().zip(self.point.iter().zip(&self.normal)).map(|(x, (p, n))| (x - p) * n).sum::<Real>() >= 0.0
+    }
 }
 
 impl<const D: usize> ContactPair<D> {
@@ -89,7 +141,20 @@ impl<const D: usize> ContactPair<D> {
         part: &str,
         discretisation: Arc<dyn ContactDiscretisation<D>>,
     ) -> Self {
-        Self { name: name.to_string(), body, part: part.to_string(), discretisation, friction: 0.0 }
+        Self {
+            name: name.to_string(),
+            body,
+            part: part.to_string(),
+            discretisation,
+            friction: 0.0,
+            report_split: None,
+        }
+    }
+    /// The pair with its reported figures split by a plane into two sides ([`PairSplit`]).
+    #[must_use]
+    pub fn with_report_split(mut self, split: PairSplit) -> Self {
+        self.report_split = Some(split);
+        self
     }
     /// Body–body node-to-node pair ([`NodeToNode`]) with default pairing direction, tolerance
     /// and normal.
@@ -301,6 +366,9 @@ impl BodyPlacement<2> {
 pub struct ContactGeometry<const D: usize> {
     /// Pair names, with the range of their nodes in `nodes`.
     pub pairs: Vec<(String, std::ops::Range<usize>)>,
+    /// The reporting split of each pair ([`ContactPair::report_split`]), in the order of
+    /// `pairs` (may be shorter: missing entries have none).
+    pub report_splits: Vec<Option<PairSplit>>,
     /// All contact nodes, pair by pair.
     pub nodes: Vec<ContactNode<D>>,
     /// Neighbours of each contact node (nodes sharing a contact facet of body `k`), for nested
@@ -601,7 +669,13 @@ impl<const D: usize> ContactGeometry<D> {
             a.sort_unstable();
             a.dedup();
         }
-        Ok(Self { pairs: ranges, nodes, adjacency, placements: Vec::new() })
+        Ok(Self {
+            pairs: ranges,
+            nodes,
+            adjacency,
+            placements: Vec::new(),
+            report_splits: pairs.iter().map(|p| p.report_split.clone()).collect(),
+        })
     }
 
     /// The contact nodes of the pair called `name`, if any.

@@ -16,6 +16,7 @@
 
 pub mod error;
 pub mod generators;
+pub mod intersect;
 pub mod matching;
 pub mod math;
 pub mod mesh;

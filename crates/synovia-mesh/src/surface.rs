@@ -102,7 +102,7 @@ pub enum SurfaceError {
     SelfIntersection {
         /// The two triangles.
         triangles: [usize; 2],
-        /// A point near the crossing (the first triangle's centroid).
+        /// A point where they cross.
         at: [Real; 3],
     },
     /// A parameter (tolerance, subdivision, radius) is invalid.

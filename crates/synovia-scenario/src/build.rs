@@ -28,6 +28,7 @@ use synovia::mesh::{BoundaryKind, Mesh};
 use synovia::time::dynamic::{DynamicParams, MassKind};
 use synovia::time::history::{Constant, LoadHistory, Periodic, PiecewiseLinear, RigidMotion};
 use synovia::time::quasistatic::QuasiStaticParams;
+use synovia::time::results::Units;
 
 use crate::scenario::*;
 
@@ -45,6 +46,8 @@ pub struct Built<const D: usize> {
     /// Warnings found while building (e.g. unused duplicate nodes of a mesh); the model is
     /// usable.
     pub warnings: Vec<String>,
+    /// The unit labels of the outputs (`[units]`; default mm, N, s).
+    pub units: Units,
 }
 
 /// Where and how often to write results.
@@ -388,7 +391,8 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
     }
     joint.set_analysis(analysis.clone());
     let output = output(&cx, doc.output.as_ref())?;
-    Ok(Built { joint, analysis, output, name: sc.name(), warnings: cx.warnings.into_inner() })
+    let units = units(&cx, doc, &joint, &analysis)?;
+    Ok(Built { joint, analysis, output, name: sc.name(), warnings: cx.warnings.into_inner(), units })
 }
 
 /// Resolves a body name and one of its part names (errors list what exists).
@@ -1444,6 +1448,22 @@ fn contact_options<const D: usize>(
             .refuse_initial_penetration_in(&name, *r.get_ref())
             .map_err(|e| cx.err(key(k, "refuse_initial_penetration"), r.span(), e.to_string()))?;
     }
+    if let Some(sp) = &s.split {
+        let sk = key(k, "split");
+        let v = sp.get_ref();
+        let three = |a: &Sp<Vec<f64>>, what: &str| -> R<[f64; 3]> {
+            let x = cx.array(a, &key(&sk, what), D, &format!("a {D}D {what}"))?;
+            Ok([x[0], x[1], if D > 2 { x[2] } else { 0.0 }])
+        };
+        let split = synovia::contact_ops::operators::PairSplit::new(
+            v.positive.get_ref(),
+            v.negative.get_ref(),
+            three(&v.point, "point")?,
+            three(&v.normal, "normal")?,
+        )
+        .map_err(|e| cx.err(sk.clone(), sp.span(), e.to_string()))?;
+        joint.split_pair_report(&name, split).map_err(|e| cx.err(sk, sp.span(), e.to_string()))?;
+    }
     if let Some(l) = &s.friction_law {
         let lk = key(k, "friction_law");
         if !dynamic {
@@ -1950,4 +1970,74 @@ impl LoadHistory for ArcHistory {
     fn value(&self, t: f64) -> f64 {
         self.0.value(t)
     }
+}
+
+/// Strain above which the unit check refuses a model (100 %).
+pub const UNIT_CHECK_REFUSE: f64 = 1.0;
+/// Strain above which the unit check warns (10 %: beyond linear elasticity).
+pub const UNIT_CHECK_WARN: f64 = 0.1;
+
+/// The unit labels of `[units]`, and the unit-mistake check
+/// ([`synovia::units::characteristic_strain`]): a strain above 100 % is refused (at the key
+/// `units`, or the file) unless `units.check = false`, one above 10 % is a warning.
+fn units<const D: usize>(
+    cx: &Cx<'_>,
+    doc: &ScenarioDoc,
+    joint: &JointModel<D>,
+    analysis: &Analysis,
+) -> R<Units> {
+    let mut units = Units::default();
+    let mut check = true;
+    if let Some(u) = &doc.units {
+        let s = u.get_ref();
+        for (field, value, k) in [
+            (&mut units.length, &s.length, "length"),
+            (&mut units.force, &s.force, "force"),
+            (&mut units.time, &s.time, "time"),
+        ] {
+            if let Some(v) = value {
+                let t = v.get_ref().trim();
+                if t.is_empty() || t.contains(',') || t.contains('[') || t.contains(']') {
+                    return Err(cx.err(
+                        format!("units.{k}"),
+                        v.span(),
+                        format!("a unit label must be non-empty without `,`, `[` or `]`, got `{t}`"),
+                    ));
+                }
+                *field = t.to_string();
+            }
+        }
+        if let Some(c) = &s.check {
+            check = *c.get_ref();
+        }
+    }
+    let times: Vec<f64> = match analysis {
+        Analysis::Static { time } => vec![*time],
+        Analysis::QuasiStatic { times } => times.clone(),
+        Analysis::Dynamic { dt, steps } => (0..=*steps).map(|k| k as f64 * dt).collect(),
+    };
+    if let Some(e) = synovia::units::characteristic_strain(joint.model(), &times) {
+        let what = e.describe(&units.length, &units.force, &units.pressure());
+        let labels =
+            format!("the outputs are labelled in {}, {} and {}", units.length, units.force, units.pressure());
+        if e.strain > UNIT_CHECK_REFUSE && check {
+            let (k, span) = match &doc.units {
+                Some(u) => ("units".to_string(), u.span()),
+                None => ("analysis".to_string(), doc.analysis.span()),
+            };
+            return Err(cx.err(
+                k,
+                span,
+                format!(
+                    "{what}, more than 100 %: are the meshes in metres and the loads and moduli in N and MPa (or the reverse)? Use one consistent set of units (mm, N, MPa or m, N, Pa; {labels}); to run anyway, set `check = false` in `[units]`"
+                ),
+            ));
+        }
+        if e.strain > UNIT_CHECK_WARN {
+            cx.warnings.borrow_mut().push(format!(
+                "{what}: beyond the small strains of linear elasticity; check the units ({labels})"
+            ));
+        }
+    }
+    Ok(units)
 }

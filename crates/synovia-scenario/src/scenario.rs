@@ -314,6 +314,24 @@ pub struct ScenarioDoc {
     pub analysis: Sp<AnalysisSpec>,
     /// Output options.
     pub output: Option<Sp<OutputSpec>>,
+    /// The model's units (`[units]`): labels of the outputs and the unit-mistake check.
+    pub units: Option<Sp<UnitsSpec>>,
+}
+
+/// `[units]`: the units the model's numbers are in. They only label the outputs (synovia
+/// computes in any consistent units) — except `check`, the unit-mistake check.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UnitsSpec {
+    /// Length unit of the meshes (default `mm`).
+    pub length: Option<Sp<String>>,
+    /// Force unit of the loads (default `N`).
+    pub force: Option<Sp<String>>,
+    /// Time unit (default `s`).
+    pub time: Option<Sp<String>>,
+    /// Refuse a model whose loads or prescribed displacements would strain a body by more
+    /// than 100 % (a unit mistake; default `true`).
+    pub check: Option<Sp<bool>>,
 }
 
 /// One body: mesh, material, optional dynamic data, body force and extra boundary parts.
@@ -523,6 +541,19 @@ pub struct ContactSpec {
     pub normal: Option<Sp<Vec<f64>>>,
     pub tolerance: Option<Sp<f64>>,
     pub refuse_initial_penetration: Option<Sp<bool>>,
+    /// Reporting only: split the pair's figures by a plane into two sides.
+    pub split: Option<Sp<SplitSpec>>,
+}
+
+/// `split = { point = [..], normal = [..], positive = "lateral", negative = "medial" }`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+#[allow(missing_docs)]
+pub struct SplitSpec {
+    pub point: Sp<Vec<f64>>,
+    pub normal: Sp<Vec<f64>>,
+    pub positive: Sp<String>,
+    pub negative: Sp<String>,
 }
 
 /// The other body of a node-to-node pair.

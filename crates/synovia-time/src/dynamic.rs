@@ -98,7 +98,7 @@ use synovia_mesh::math::{Point, Real, Vector};
 
 use crate::error::TimeError;
 use crate::quasistatic::{friction_dissipation, warm_start};
-use crate::results::{pair_records, PairRecord, StepRecord};
+use crate::results::{empty_pair_records, pair_records, StepRecord};
 
 /// Largest element matrix size `(D(D+1))²` for `D ≤ 3`.
 const KE_MAX: usize = 144;
@@ -865,9 +865,9 @@ impl<const D: usize> DynamicStepper<D> {
 
     /// A record of the current level with its energies (kinetic energy of
     /// `(U^i − U^{i−1})/Δt`, strain energy of `U^i`) and zero contact figures (one
-    /// [`PairRecord`] per pair, so CSV columns line up): the row of step 0 of a results table.
+    /// [`PairRecord`](crate::results::PairRecord) per pair, so CSV columns line up): the row of step 0 of a results table.
     pub fn initial_record(&self) -> StepRecord {
-        let pairs = self.geometry().pairs.iter().map(|(name, _)| PairRecord::empty(name)).collect();
+        let pairs = empty_pair_records(self.geometry());
         StepRecord {
             step: self.step,
             time: self.time(),

@@ -106,7 +106,7 @@ use synovia_io::{Encoding, Field, TimeSeriesWriter, VtuWriter};
 use synovia_mesh::math::{Real, Vector};
 
 use crate::error::TimeError;
-use crate::results::{pair_records, write_csv, StepRecord};
+use crate::results::{pair_records, write_csv_with_units, StepRecord, Units};
 
 /// Parameters of the quasi-static stepper.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -1118,13 +1118,14 @@ impl<const D: usize> QuasiStaticOutput<D> {
         Ok(self.series.write_step(record.time, &vtu)?)
     }
 
-    /// Writes `records` to `DIR/NAME.csv` ([`crate::results::write_csv`]); returns the path.
+    /// Writes `records` to `DIR/NAME.csv` ([`crate::results::write_csv_with_units`] with the
+    /// default unit labels, mm, N, s); returns the path.
     ///
     /// # Errors
     /// [`TimeError::Io`] on write failures.
     pub fn write_csv(&self, records: &[StepRecord]) -> Result<PathBuf, TimeError> {
         let path = self.csv_path();
-        write_csv(&path, records)?;
+        write_csv_with_units(&path, records, &Units::default(), D)?;
         Ok(path)
     }
 

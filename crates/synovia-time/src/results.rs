@@ -37,6 +37,12 @@ pub struct PairRecord {
     pub centre_of_pressure: Option<[Real; 3]>,
     /// Mean contact pressure `normal_force / contact_area` (0 without contact).
     pub mean_pressure: Real,
+    /// The two sides of a pair split by a plane
+    /// ([`PairSplit`](synovia_contact::operators::PairSplit)): positive side first, each
+    /// with the figures above over its own contact nodes and friction cells (`name` = the
+    /// side's name, `sides` empty); their forces, moments, areas add up to the pair's. Empty
+    /// for a pair without a split.
+    pub sides: Vec<PairRecord>,
 }
 
 impl PairRecord {
@@ -54,8 +60,26 @@ impl PairRecord {
             moment: [0.0; 3],
             centre_of_pressure: None,
             mean_pressure: 0.0,
+            sides: Vec::new(),
         }
     }
+}
+
+/// Records without contact (every figure zero) of every pair of `geometry`, with the empty
+/// sides of split pairs (so that CSV columns line up with later steps).
+pub fn empty_pair_records<const D: usize>(geometry: &ContactGeometry<D>) -> Vec<PairRecord> {
+    geometry
+        .pairs
+        .iter()
+        .enumerate()
+        .map(|(p, (name, _))| {
+            let mut rec = PairRecord::empty(name);
+            if let Some(Some(split)) = geometry.report_splits.get(p) {
+                rec.sides = vec![PairRecord::empty(&split.positive), PairRecord::empty(&split.negative)];
+            }
+            rec
+        })
+        .collect()
 }
 
 /// `x × f` of two vectors of dimension `D` embedded in 3D.
@@ -124,10 +148,33 @@ pub struct RigidRecord {
     pub solves: usize,
 }
 
-/// Computes the pair records of a contact solution.
+/// Computes the pair records of a contact solution, with the sides of the pairs that have a
+/// reporting split ([`ContactGeometry::report_splits`]).
 pub fn pair_records<const D: usize>(
     geometry: &ContactGeometry<D>,
     result: &StaticContactResult<D>,
+) -> Vec<PairRecord> {
+    let mut out = records_where(geometry, result, |_| true);
+    for (p, split) in geometry.report_splits.iter().enumerate() {
+        let (Some(split), Some(rec)) = (split, out.get_mut(p)) else { continue };
+        for (name, positive) in [(&split.positive, true), (&split.negative, false)] {
+            let side = records_where(geometry, result, |r| {
+                let node = &geometry.nodes[r];
+                node.pair == p && split.is_positive(node.position.as_slice()) == positive
+            });
+            let mut side = side.into_iter().nth(p).unwrap_or_else(|| PairRecord::empty(name));
+            side.name.clone_from(name);
+            rec.sides.push(side);
+        }
+    }
+    out
+}
+
+/// The pair records over the contact nodes `r` with `keep(r)` (and their friction cells).
+fn records_where<const D: usize>(
+    geometry: &ContactGeometry<D>,
+    result: &StaticContactResult<D>,
+    keep: impl Fn(usize) -> bool,
 ) -> Vec<PairRecord> {
     let sol = &result.solution;
     let comps = D - 1;
@@ -139,7 +186,7 @@ pub fn pair_records<const D: usize>(
             let mut centre = Vector::<D>::zeros();
             let mut moment = [0.0; 3];
             let (mut nf, mut area, mut peak) = (0.0, 0.0, 0.0_f64);
-            for r in range.clone() {
+            for r in range.clone().filter(|&r| keep(r)) {
                 let node = &geometry.nodes[r];
                 let l = sol.lambda_n.get(r).copied().unwrap_or(0.0);
                 nf += node.weight * l;
@@ -173,6 +220,9 @@ pub fn pair_records<const D: usize>(
     // friction cells
     let mut friction = vec![Vector::<D>::zeros(); geometry.pairs.len()];
     for (c, (&r, &g)) in result.cell_node.iter().zip(&result.slip_bound).enumerate() {
+        if !keep(r) {
+            continue;
+        }
         let node = &geometry.nodes[r];
         let pair = node.pair;
         let l = &sol.lambda_t[c * comps..(c + 1) * comps];
@@ -210,38 +260,173 @@ impl PairRecord {
     }
 }
 
-/// Writes the records as CSV: one row per step; pair columns are prefixed by the pair name.
+/// Labels of the model's units for the outputs. synovia computes in any consistent units (the
+/// user's length unit `L` and force unit `F`; pressures and moduli in `F/L²`, energies in
+/// `F·L`); these labels only name them in CSV headers and `summary.json`. Default: `mm`, `N`,
+/// `s` (pressures in `MPa`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Units {
+    /// Length unit of the meshes.
+    pub length: String,
+    /// Force unit of the loads.
+    pub force: String,
+    /// Time unit of the histories and time levels.
+    pub time: String,
+}
+
+impl Default for Units {
+    fn default() -> Self {
+        Self { length: "mm".into(), force: "N".into(), time: "s".into() }
+    }
+}
+
+/// The physical quantity of an output figure ([`Units::label`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Quantity {
+    /// A count or ratio: `-`.
+    Count,
+    /// Model time.
+    Time,
+    /// Wall-clock time: always `s`.
+    WallTime,
+    /// A position or length.
+    Length,
+    /// An area (in 2D: a length per unit thickness).
+    Area,
+    /// A force (in 2D: per unit thickness).
+    Force,
+    /// A moment (in 2D: per unit thickness).
+    Moment,
+    /// A pressure or stress (also in 2D).
+    Pressure,
+    /// An energy or work (in 2D: per unit thickness).
+    Energy,
+}
+
+impl Units {
+    /// The pressure unit: `MPa` for `N` and `mm`, `Pa` for `N` and `m`, `kPa` for `kN` and `m`,
+    /// `GPa` for `kN` and `mm`, else `F/L^2`.
+    pub fn pressure(&self) -> String {
+        match (self.force.as_str(), self.length.as_str()) {
+            ("N", "mm") | ("MN", "m") => "MPa".into(),
+            ("N", "m") => "Pa".into(),
+            ("kN", "m") => "kPa".into(),
+            ("kN", "mm") => "GPa".into(),
+            (f, l) => format!("{f}/{l}^2"),
+        }
+    }
+    /// The unit label of a quantity in dimension `dimension` (2D: per unit thickness, written
+    /// `…/L`).
+    pub fn label(&self, q: Quantity, dimension: usize) -> String {
+        let (l, f) = (&self.length, &self.force);
+        let per = if dimension == 2 { format!("/{l}") } else { String::new() };
+        match q {
+            Quantity::Count => "-".into(),
+            Quantity::Time => self.time.clone(),
+            Quantity::WallTime => "s".into(),
+            Quantity::Length => l.clone(),
+            Quantity::Area => format!("{l}^2{per}"),
+            Quantity::Force => format!("{f}{per}"),
+            Quantity::Moment | Quantity::Energy => format!("{f}*{l}{per}"),
+            Quantity::Pressure => self.pressure(),
+        }
+    }
+}
+
+/// The step columns of the CSV and their quantities.
+const STEP_COLUMNS: [(&str, Quantity); 9] = [
+    ("step", Quantity::Count),
+    ("time", Quantity::Time),
+    ("iterations", Quantity::Count),
+    ("step_s", Quantity::WallTime),
+    ("kinetic_energy", Quantity::Energy),
+    ("strain_energy", Quantity::Energy),
+    ("viscous_dissipation", Quantity::Energy),
+    ("friction_dissipation", Quantity::Energy),
+    ("cumulative_friction_dissipation", Quantity::Energy),
+];
+
+/// The pair columns of the CSV (prefixed by the pair name, and for the sides of a split pair
+/// by `PAIR_SIDE`) and their quantities.
+pub const PAIR_COLUMNS: [(&str, Quantity); 16] = [
+    ("force_x", Quantity::Force),
+    ("force_y", Quantity::Force),
+    ("force_z", Quantity::Force),
+    ("normal_force", Quantity::Force),
+    ("tangential_force", Quantity::Force),
+    ("contact_area", Quantity::Area),
+    ("peak_pressure", Quantity::Pressure),
+    ("stick_area", Quantity::Area),
+    ("slip_area", Quantity::Area),
+    ("moment_x", Quantity::Moment),
+    ("moment_y", Quantity::Moment),
+    ("moment_z", Quantity::Moment),
+    ("centre_of_pressure_x", Quantity::Length),
+    ("centre_of_pressure_y", Quantity::Length),
+    ("centre_of_pressure_z", Quantity::Length),
+    ("mean_pressure", Quantity::Pressure),
+];
+
+/// The cells of one pair (or side) record in the order of [`PAIR_COLUMNS`]; no contact:
+/// empty centre-of-pressure cells (no made-up position).
+fn pair_cells(p: &PairRecord) -> String {
+    let cop = match p.centre_of_pressure {
+        None => ",,".to_string(),
+        Some(c) => format!("{},{},{}", c[0], c[1], c[2]),
+    };
+    format!(
+        "{},{},{},{},{},{},{},{},{},{},{},{},{cop},{}",
+        p.force[0],
+        p.force[1],
+        p.force[2],
+        p.normal_force,
+        p.tangential_force,
+        p.contact_area,
+        p.peak_pressure,
+        p.stick_area,
+        p.slip_area,
+        p.moment[0],
+        p.moment[1],
+        p.moment[2],
+        p.mean_pressure
+    )
+}
+
+/// Writes the records as CSV with the default unit labels ([`Units::default`]: mm, N, s) of
+/// a 3D model; see [`write_csv_with_units`].
 pub fn write_csv(path: &Path, records: &[StepRecord]) -> Result<(), IoError> {
+    write_csv_with_units(path, records, &Units::default(), 3)
+}
+
+/// Writes the records as CSV: one row per step; pair columns are prefixed by the pair name
+/// (`PAIR_force_x`), the columns of the sides of a split pair by the pair and side names
+/// (`PAIR_SIDE_force_x`, after the pair's own). Every header cell carries its unit as
+/// `name [unit]` ([`Units::label`] for `dimension`; `[-]` for counts). The columns are those
+/// of the first record; a later record without a side of it gets empty cells there.
+pub fn write_csv_with_units(
+    path: &Path,
+    records: &[StepRecord],
+    units: &Units,
+    dimension: usize,
+) -> Result<(), IoError> {
     let io = |source| IoError::Io { path: path.to_path_buf(), source };
     let mut f = std::io::BufWriter::new(std::fs::File::create(path).map_err(io)?);
-    let mut header = String::from(
-        "step,time,iterations,step_s,kinetic_energy,strain_energy,viscous_dissipation,friction_dissipation,cumulative_friction_dissipation",
-    );
-    if let Some(first) = records.first() {
-        for p in &first.pairs {
-            for col in [
-                "force_x",
-                "force_y",
-                "force_z",
-                "normal_force",
-                "tangential_force",
-                "contact_area",
-                "peak_pressure",
-                "stick_area",
-                "slip_area",
-                "moment_x",
-                "moment_y",
-                "moment_z",
-                "centre_of_pressure_x",
-                "centre_of_pressure_y",
-                "centre_of_pressure_z",
-                "mean_pressure",
-            ] {
-                header.push_str(&format!(",{}_{col}", p.name));
+    let mut header: Vec<String> =
+        STEP_COLUMNS.iter().map(|(c, q)| format!("{c} [{}]", units.label(*q, dimension))).collect();
+    // the layout: pairs and their sides' names
+    let layout: Vec<(String, Vec<String>)> = records.first().map_or_else(Vec::new, |r| {
+        r.pairs.iter().map(|p| (p.name.clone(), p.sides.iter().map(|s| s.name.clone()).collect())).collect()
+    });
+    for (pair, sides) in &layout {
+        let prefixes = std::iter::once(pair.clone()).chain(sides.iter().map(|s| format!("{pair}_{s}")));
+        for prefix in prefixes {
+            for (col, q) in PAIR_COLUMNS {
+                header.push(format!("{prefix}_{col} [{}]", units.label(q, dimension)));
             }
         }
     }
-    writeln!(f, "{header}").map_err(io)?;
+    writeln!(f, "{}", header.join(",")).map_err(io)?;
+    let empty = vec![""; PAIR_COLUMNS.len()].join(",");
     for r in records {
         let mut line = format!(
             "{},{},{},{},{},{},{},{},{}",
@@ -255,26 +440,17 @@ pub fn write_csv(path: &Path, records: &[StepRecord]) -> Result<(), IoError> {
             r.friction_dissipation,
             r.cumulative_friction_dissipation
         );
-        for p in &r.pairs {
-            line.push_str(&format!(
-                ",{},{},{},{},{},{},{},{},{}",
-                p.force[0],
-                p.force[1],
-                p.force[2],
-                p.normal_force,
-                p.tangential_force,
-                p.contact_area,
-                p.peak_pressure,
-                p.stick_area,
-                p.slip_area
-            ));
-            line.push_str(&format!(",{},{},{}", p.moment[0], p.moment[1], p.moment[2]));
-            match p.centre_of_pressure {
-                // no contact: empty cells (no made-up position)
-                None => line.push_str(",,,"),
-                Some(c) => line.push_str(&format!(",{},{},{}", c[0], c[1], c[2])),
+        for (k, (pair, sides)) in layout.iter().enumerate() {
+            let rec = r.pairs.get(k).filter(|p| &p.name == pair);
+            line.push(',');
+            line.push_str(&rec.map_or_else(|| empty.clone(), pair_cells));
+            for side in sides {
+                line.push(',');
+                match rec.and_then(|p| p.sides.iter().find(|s| &s.name == side)) {
+                    Some(s) => line.push_str(&pair_cells(s)),
+                    None => line.push_str(&empty),
+                }
             }
-            line.push_str(&format!(",{}", p.mean_pressure));
         }
         writeln!(f, "{line}").map_err(io)?;
     }

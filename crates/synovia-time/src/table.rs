@@ -53,6 +53,16 @@ pub enum TableError {
         /// The columns of the table.
         available: Vec<String>,
     },
+    /// Several columns that were asked for are not in the table ([`Table::require`]).
+    #[error("table `{}` has no columns {}; its columns are: {}", path.display(), missing.iter().map(|c| format!("`{c}`")).collect::<Vec<_>>().join(", "), available.join(", "))]
+    MissingColumns {
+        /// The file.
+        path: PathBuf,
+        /// The columns asked for that are missing.
+        missing: Vec<String>,
+        /// The columns of the table.
+        available: Vec<String>,
+    },
     /// A unit factor that is not finite or is zero.
     #[error("invalid unit factor {factor} for column `{column}` (must be finite and non-zero)")]
     InvalidFactor {
@@ -211,6 +221,32 @@ impl Table {
                 available: self.names.clone(),
             },
         )
+    }
+    /// Checks that the table has every column of `names` (e.g. the six coordinates of a
+    /// kinematics file) before any is used, naming all that are missing at once.
+    ///
+    /// # Errors
+    /// [`TableError::MissingColumn`] for one missing column, [`TableError::MissingColumns`]
+    /// for several; both list the columns that exist.
+    pub fn require(&self, names: &[&str]) -> Result<(), TableError> {
+        let missing: Vec<String> = names
+            .iter()
+            .filter(|n| !self.names.iter().skip(1).any(|m| m == *n))
+            .map(|n| n.to_string())
+            .collect();
+        match missing.len() {
+            0 => Ok(()),
+            1 => Err(TableError::MissingColumn {
+                path: self.path.clone(),
+                column: missing[0].clone(),
+                available: self.names.clone(),
+            }),
+            _ => Err(TableError::MissingColumns {
+                path: self.path.clone(),
+                missing,
+                available: self.names.clone(),
+            }),
+        }
     }
     /// Column `name` times `factor` (the unit conversion) as a history of the table's time
     /// times `time_factor` (e.g. `0.01` for a gait cycle in percent to cycles).

@@ -484,6 +484,10 @@ fn csv_and_pvd_series_are_written_and_read_back() {
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), times.len() + 1);
     let header: Vec<&str> = lines[0].split(',').collect();
+    // every header cell is `name [unit]`; the names without units:
+    assert!(header.iter().all(|c| c.ends_with(']') && c.contains(" [")), "{header:?}");
+    assert!(lines[0].contains("indenter-base_peak_pressure [MPa]"), "{}", lines[0]);
+    let header: Vec<&str> = header.iter().map(|c| c.split(" [").next().unwrap_or(c)).collect();
     for col in [
         "step",
         "time",
