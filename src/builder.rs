@@ -273,6 +273,7 @@ pub struct JointModel<const D: usize> {
     rigid_pairs: Vec<(String, usize)>,
     rigid_ties: Vec<(BodyId, String, usize)>,
     force_control: ForceControlParams,
+    interface_block: synovia_linalg::InterfaceBlockParams,
 }
 
 impl<const D: usize> fmt::Debug for JointModel<D> {
@@ -343,6 +344,7 @@ impl<const D: usize> JointModel<D> {
             rigid_pairs: Vec::new(),
             rigid_ties: Vec::new(),
             force_control: ForceControlParams::default(),
+            interface_block: synovia_linalg::InterfaceBlockParams::default(),
         }
     }
 
@@ -428,6 +430,20 @@ impl<const D: usize> JointModel<D> {
             .ok_or_else(|| JointError::Invalid(format!("no contact pair `{pair}`")))?;
         *p = p.clone().with_search_distance(distance);
         Ok(self)
+    }
+
+    /// Sets how many interface dofs are ordered last in the factorisation (the dense block of
+    /// the interface Schur complement, [`synovia_linalg::InterfaceBlockParams`]; e.g.
+    /// `with_max_dofs(0)` for a large candidate surface whose contact patches move, where
+    /// whole-factor solves of the few active rows are cheaper than a large dense block).
+    pub fn interface_block(&mut self, params: synovia_linalg::InterfaceBlockParams) -> &mut Self {
+        self.interface_block = params;
+        self
+    }
+
+    /// The interface block parameters ([`JointModel::interface_block`]).
+    pub fn interface_block_params(&self) -> synovia_linalg::InterfaceBlockParams {
+        self.interface_block
     }
 
     /// Sets the parameters of the force-control iteration ([`ForceControlParams`]).
@@ -1097,7 +1113,12 @@ impl<const D: usize> JointModel<D> {
         if self.pairs.is_empty() {
             return self.run_elastic(times, solver.name(), start, observer);
         }
-        let mut contact = StaticContact::new(&self.model, &self.pairs, self.elastic_params)?;
+        let mut contact = StaticContact::with_interface_block(
+            &self.model,
+            &self.pairs,
+            self.elastic_params,
+            self.interface_block,
+        )?;
         contact.set_nested_iteration(self.nested);
         let n_dofs = contact.elastic().info().n_dofs;
         let mut stepper = QuasiStaticStepper::from_contact(&self.model, contact, self.quasistatic_params)?;

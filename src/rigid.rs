@@ -544,7 +544,9 @@ impl RigidDriver {
             for (k, c) in body.controls.iter().enumerate() {
                 match c {
                     DofControl::Prescribed(_) => self.q[bi][k] = values[bi][k],
-                    DofControl::Force { guess: Some(g), .. } => self.q[bi][k] = g.value(t) + self.offset[bi][k],
+                    DofControl::Force { guess: Some(g), .. } => {
+                        self.q[bi][k] = g.value(t) + self.offset[bi][k]
+                    }
                     DofControl::Force { guess: None, .. } => {}
                 }
             }
@@ -592,6 +594,9 @@ impl RigidDriver {
             let mut z = base.clone();
             let mut history: Vec<(Vec<Real>, Vec<Real>)> = Vec::new();
             let mut bracket = Bracket::default();
+            // several unknowns: the last iterate that reduced the error, and backtracking
+            let mut accepted: Option<(Vec<Real>, Vec<Real>, Real)> = None;
+            let mut backtracks = 0;
             loop {
                 if solves >= params.max_solves {
                     return Err(self.no_convergence(joint, &unknowns, &best, solves, t));
@@ -619,7 +624,7 @@ impl RigidDriver {
                 }
                 let (record, result) = self.solve_once(joint, stepper, t, solver, mode, &mut solves)?;
                 let reactions = self.reactions(joint, &geometry, &record, &result, t)?;
-                let r: Vec<Real> =
+                let mut r: Vec<Real> =
                     unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
                 let error = r.iter().zip(&scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
                 if best.as_ref().is_none_or(|(e, _)| error < *e) {
@@ -638,6 +643,27 @@ impl RigidDriver {
                 }
                 if unknowns.len() == 1 {
                     bracket.update(z[0], r[0]);
+                } else {
+                    match &accepted {
+                        Some((za, ra, ea)) if error >= *ea => {
+                            if backtracks < 3 {
+                                // halve the step back toward the last good iterate
+                                z = za.iter().zip(&z).map(|(a, b)| a + 0.5 * (b - a)).collect();
+                                backtracks += 1;
+                                continue;
+                            }
+                            // a fresh finite-difference Jacobian at the last good iterate
+                            z = za.clone();
+                            r = ra.clone();
+                            jac = None;
+                            history.clear();
+                            backtracks = 0;
+                        }
+                        _ => {
+                            accepted = Some((z.clone(), r.clone(), error));
+                            backtracks = 0;
+                        }
+                    }
                 }
                 let dz = match (&mut jac, history.last()) {
                     (Some(j), Some((zp, rp))) => {
@@ -1076,10 +1102,10 @@ impl Bracket {
     }
 }
 
-/// Limits a step to a tenth of the model size (translations) or 0.1 rad (rotations).
+/// Limits a step to 2 % of the model size (translations) or 0.02 rad (rotations).
 fn limit_step<const D: usize>(next: &mut [Real], z: &[Real], unknowns: &[(usize, usize)], length: Real) {
     for ((n, zj), &(_, k)) in next.iter_mut().zip(z).zip(unknowns) {
-        let cap = if k < D { 0.1 * length } else { 0.1 };
+        let cap = if k < D { 0.02 * length } else { 0.02 };
         *n = zj + (*n - zj).clamp(-cap, cap);
     }
 }

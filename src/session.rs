@@ -113,7 +113,12 @@ impl<'a, const D: usize> JointSession<'a, D> {
                 step: 0,
             }
         } else {
-            let mut contact = StaticContact::new(model, joint.pairs(), elastic_params)?;
+            let mut contact = StaticContact::with_interface_block(
+                model,
+                joint.pairs(),
+                elastic_params,
+                joint.interface_block_params(),
+            )?;
             contact.set_nested_iteration(nested);
             let mut stepper = QuasiStaticStepper::from_contact(model, contact, quasistatic_params)?;
             for (pair, law) in joint.pair_friction_laws() {

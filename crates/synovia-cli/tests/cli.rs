@@ -269,3 +269,58 @@ fn check_builds_without_solving_and_missing_files_fail() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot read"));
 }
+
+/// `hertz3d_force.toml`: the rigid plate's force control balances the contact resultant to
+/// 1e-9, and Hertz's `a` (from the contact area) and `p₀` (the peak pressure) come out within
+/// 3 % for two elastic bodies.
+#[test]
+fn force_controlled_hertz_matches_hertz() {
+    let out = tmp("hertz3d-force");
+    let o = run(&scenarios_dir().join("hertz3d_force.toml"), &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let step = &summary["steps"][0];
+    let pair = &step["pairs"][0];
+    let plate = &step["rigid_bodies"][0];
+    let load = 2.0;
+    let fz = pair["force"][2].as_f64().unwrap();
+    // the contact force on the sphere pushes it up with the plate's load
+    assert!((fz - load).abs() <= 1e-9 * load, "resultant {fz}");
+    assert!(plate["balance_error"].as_f64().unwrap() <= 1e-9);
+    assert!((plate["reaction"][2].as_f64().unwrap() - load).abs() <= 1e-9 * load);
+    assert!(plate["dofs"][2].as_f64().unwrap() < 0.0, "the plate moved down");
+    // Hertz, two elastic bodies (E = 10 and 10 000 MPa, ν = 0.3, R = 10 mm)
+    let (e1, e2, nu, r) = (10.0_f64, 1.0e4_f64, 0.3_f64, 10.0_f64);
+    let e_star = 1.0 / ((1.0 - nu * nu) / e1 + (1.0 - nu * nu) / e2);
+    let a = (3.0 * load * r / (4.0 * e_star)).cbrt();
+    let p0 = 3.0 * load / (2.0 * std::f64::consts::PI * a * a);
+    let a_fe = (pair["contact_area"].as_f64().unwrap() / std::f64::consts::PI).sqrt();
+    let p0_fe = pair["peak_pressure"].as_f64().unwrap();
+    assert!((a_fe / a - 1.0).abs() < 0.03, "a = {a_fe} vs Hertz {a}");
+    assert!((p0_fe / p0 - 1.0).abs() < 0.03, "p0 = {p0_fe} vs Hertz {p0}");
+}
+
+/// `tkr3d_stance.toml`: an STL rigid body posed from a kinematics table, force-controlled,
+/// split medial/lateral; the axial force is balanced at every pose.
+#[test]
+fn knee_replacement_scenario_balances_the_axial_force() {
+    let out = tmp("tkr3d-stance");
+    let o = run(&scenarios_dir().join("tkr3d_stance.toml"), &out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for step in summary["steps"].as_array().unwrap() {
+        let femur = &step["rigid_bodies"][0];
+        let applied = femur["applied"][1].as_f64().unwrap();
+        assert!(applied < -100.0, "the ISO axial force pushes the femur down: {applied}");
+        assert!(femur["balance_error"].as_f64().unwrap() <= 1e-9);
+        assert!((femur["reaction"][1].as_f64().unwrap() + applied).abs() <= 1e-6 * applied.abs());
+        let pair = &step["pairs"][0];
+        let sides = pair["sides"].as_array().unwrap();
+        assert_eq!(sides.len(), 2);
+        let sum: f64 = sides.iter().map(|s| s["normal_force"].as_f64().unwrap()).sum();
+        assert!((sum - pair["normal_force"].as_f64().unwrap()).abs() <= 1e-9 * sum.max(1.0));
+        assert!(step["kkt"].as_f64().unwrap() <= 1e-8);
+    }
+}

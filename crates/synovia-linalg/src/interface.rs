@@ -282,6 +282,48 @@ pub(crate) fn cholesky_interface_columns(
     let directions: Vec<RowDirection> =
         inside.iter().map(|&j| RowDirection::new(mapped[j].as_deref().unwrap_or(&[]))).collect();
     let mut solves: Vec<Option<Vec<f64>>> = directions.iter().map(|d| kept.get(block_id, d)).collect();
+    // rows on one node (a few entries, e.g. a node against a rigid obstacle): combinations of
+    // kept unit solves `x_c = Σ_p c_p L₂₂⁻ᵀ L₂₂⁻¹ e_p`, shared by every row on that node
+    // whatever its normal or tangent (a rigid partner that moves changes the normals)
+    let few: Vec<usize> = (0..inside.len())
+        .filter(|&a| solves[a].is_none() && mapped[inside[a]].as_ref().is_some_and(|r| r.len() <= UNIT_SPLIT))
+        .collect();
+    let mut solved_units = 0;
+    if !few.is_empty() {
+        let mut positions: Vec<usize> =
+            few.iter().flat_map(|&a| mapped[inside[a]].iter().flatten().map(|&(p, _)| p)).collect();
+        positions.sort_unstable();
+        positions.dedup();
+        let unit_dirs: Vec<RowDirection> =
+            positions.iter().map(|&p| RowDirection::new(&[(p, 1.0)])).collect();
+        let mut units: Vec<Option<Vec<f64>>> = unit_dirs.iter().map(|d| kept.get(block_id, d)).collect();
+        let missing_units: Vec<usize> = (0..positions.len()).filter(|&u| units[u].is_none()).collect();
+        if !missing_units.is_empty() {
+            let mut rhs = faer::Mat::<f64>::zeros(block.dofs.len(), missing_units.len());
+            for (c, &u) in missing_units.iter().enumerate() {
+                rhs[(positions[u], c)] = 1.0;
+            }
+            block.solve_in_place(rhs.as_mut());
+            for (c, &u) in missing_units.iter().enumerate() {
+                let x: Vec<f64> = rhs.col(c).iter().copied().collect();
+                kept.put(block_id, &unit_dirs[u], &x);
+                units[u] = Some(x);
+            }
+            solved_units = missing_units.len();
+        }
+        for &a in &few {
+            let mut x = vec![0.0; block.dofs.len()];
+            for &(p, v) in mapped[inside[a]].iter().flatten() {
+                let Ok(u) = positions.binary_search(&p) else { continue };
+                if let Some(unit) = &units[u] {
+                    for (xi, ui) in x.iter_mut().zip(unit) {
+                        *xi += v * ui;
+                    }
+                }
+            }
+            solves[a] = Some(x);
+        }
+    }
     let todo: Vec<usize> = (0..inside.len()).filter(|&a| solves[a].is_none()).collect();
     let todo_rows: Vec<usize> = todo.iter().map(|&a| inside[a]).collect();
     let computed = in_two_halves(&todo_rows, block.dofs.len() >= 256, |cols| {
@@ -304,8 +346,11 @@ pub(crate) fn cholesky_interface_columns(
             .collect();
         columns[j] = Some(col);
     }
-    Ok(solved + todo.len())
+    Ok(solved + todo.len() + solved_units)
 }
+
+/// Rows with at most this many entries in the trailing block are combined from unit solves.
+const UNIT_SPLIT: usize = 3;
 
 /// The trailing-block solves `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` (in trailing positions) of the rows
 /// `j ∈ cols` (`rows`: the rows of `C` in trailing positions; every `j ∈ cols` must be one):
@@ -381,8 +426,9 @@ mod tests {
                 .expect("factor");
         let rows_scaled = |g: &[f64]| {
             let mut rows = SparseRows::new(n);
-            rows.push_row([(31, g[0] * 1.0), (32, g[0] * -0.5)]);
-            rows.push_row([(35, g[1] * 0.25), (36, g[1] * 0.75), (37, g[1] * -0.1)]);
+            // more entries than UNIT_SPLIT: kept by direction
+            rows.push_row([(31, g[0] * 1.0), (32, g[0] * -0.5), (33, g[0] * 0.2), (34, g[0] * 0.1)]);
+            rows.push_row([(35, g[1] * 0.25), (36, g[1] * 0.75), (37, g[1] * -0.1), (38, g[1] * 0.3)]);
             rows
         };
         let store = BlockSolveStore::default();
@@ -404,11 +450,42 @@ mod tests {
         assert_eq!(store.len(), 2, "one kept solve per row direction");
         // another direction of the first row: a new solve
         let mut rows = SparseRows::new(n);
-        rows.push_row([(31, 1.0), (32, -0.4)]);
+        rows.push_row([(31, 1.0), (32, -0.4), (33, 0.2), (34, 0.1)]);
         let mut columns = vec![None; 1];
         op.view().interface_columns(RowStack::new(&rows, None), &[0], &mut columns, &store).expect("columns");
         assert_eq!(store.len(), 3);
         assert!(solved >= 2);
+    }
+
+    /// Rows on one node (at most `UNIT_SPLIT` entries) with changing normals share the kept
+    /// unit solves of that node's dofs, and their columns agree with fresh solves.
+    #[test]
+    fn node_rows_share_unit_solves_whatever_their_normal() {
+        let n = 40;
+        let last: Vec<usize> = (30..n).collect();
+        let op =
+            SparseCholesky::new(tridiagonal(n), &Ordering::Trailing { base: Box::new(Ordering::Amd), last })
+                .expect("factor");
+        let store = BlockSolveStore::default();
+        for angle in [0.0_f64, 0.3, 1.1] {
+            let (s, c) = angle.sin_cos();
+            let mut rows = SparseRows::new(n);
+            rows.push_row([(31, c), (32, s)]);
+            rows.push_row([(35, -s), (36, c), (37, 0.5)]);
+            let mut columns = vec![None; rows.nrows()];
+            op.view()
+                .interface_columns(RowStack::new(&rows, None), &[0, 1], &mut columns, &store)
+                .expect("columns");
+            let reference = reference_columns(&op, &rows);
+            for (j, col) in columns.iter().enumerate() {
+                let col = col.as_ref().expect("column computed");
+                let diagonal = reference[j][j].abs();
+                for (i, (&x, &y)) in col.iter().zip(&reference[j]).enumerate() {
+                    assert!((x - y).abs() <= 1e-13 * diagonal, "S[{i},{j}] at {angle}: {x} vs {y}");
+                }
+            }
+        }
+        assert_eq!(store.len(), 5, "one kept solve per dof of the two nodes");
     }
 
     #[test]

@@ -1331,7 +1331,9 @@ fn contact<const D: usize>(
             .map_err(|e| cx.err(key(k, "part"), s.part.span(), e.to_string()))?;
         if let Some(d) = &s.search_distance {
             let dk = key(k, "search_distance");
-            joint.search_distance(&name, cx.positive(d, &dk)?).map_err(|e| cx.err(dk, d.span(), e.to_string()))?;
+            joint
+                .search_distance(&name, cx.positive(d, &dk)?)
+                .map_err(|e| cx.err(dk, d.span(), e.to_string()))?;
         }
         return contact_options(cx, joint, s, k, &name, dynamic);
     }
@@ -1544,7 +1546,8 @@ fn obstacle<const D: usize>(
                 synovia::io::read_stl(&path).map_err(|e| cx.err(&fk, f.span(), e.to_string()))?;
             if let Some(sc) = &s.scale {
                 let factor = cx.positive(sc, &key(k, "scale"))?;
-                surface = surface.scaled(factor).map_err(|e| cx.err(key(k, "scale"), sc.span(), e.to_string()))?;
+                surface =
+                    surface.scaled(factor).map_err(|e| cx.err(key(k, "scale"), sc.span(), e.to_string()))?;
             }
             let solid = s.solid.as_ref().is_none_or(|v| *v.get_ref());
             let obstacle = if solid {
@@ -1559,7 +1562,11 @@ fn obstacle<const D: usize>(
                     format!(
                         "{}: {e}{}",
                         f.get_ref(),
-                        if solid { " (a `solid` surface must be closed; `solid = false` accepts an open patch)" } else { "" }
+                        if solid {
+                            " (a `solid` surface must be closed; `solid = false` accepts an open patch)"
+                        } else {
+                            ""
+                        }
                     ),
                 )
             })?;
@@ -1601,6 +1608,11 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
     if let Some(n) = &s.nested_iteration {
         let v = *n.get_ref();
         joint.nested_iteration((v > 0).then_some(v));
+    }
+    if let Some(n) = &s.interface_block_dofs {
+        let v = *n.get_ref();
+        let base = synovia::linalg::InterfaceBlockParams::default();
+        joint.interface_block(base.with_max_dofs(v).with_screened_dofs(base.screened_dofs.min(v)));
     }
     let mut elastic = ElasticParams::default();
     if let Some(o) = &s.ordering {
@@ -1841,7 +1853,8 @@ fn rigid_body<const D: usize>(
         Some(c) => cx.point::<D>(c, &key(k, "center"))?,
         None => Point::<D>::zeros(),
     };
-    let mut body = RigidBody::<D>::new(&name, centre).map_err(|e| cx.err(key(k, "name"), s.name.span(), e.to_string()))?;
+    let mut body = RigidBody::<D>::new(&name, centre)
+        .map_err(|e| cx.err(key(k, "name"), s.name.span(), e.to_string()))?;
     if let Some(o) = &s.rotation_order {
         if D != 3 {
             return Err(cx.err(key(k, "rotation_order"), o.span(), "a rotation order is 3D only"));
@@ -1863,13 +1876,21 @@ fn rigid_body<const D: usize>(
         let find_table = |t: &Sp<String>| {
             tables.get(t.get_ref()).ok_or_else(|| {
                 let known: Vec<&String> = tables.keys().collect();
-                cx.err(key(&dk, "table"), t.span(), format!("no [[table]] called `{}` (tables: {known:?})", t.get_ref()))
+                cx.err(
+                    key(&dk, "table"),
+                    t.span(),
+                    format!("no [[table]] called `{}` (tables: {known:?})", t.get_ref()),
+                )
             })
         };
         let guess: Option<Arc<dyn LoadHistory>> = match &ds.guess_column {
             None => {
                 if let Some(g) = &ds.guess_scale {
-                    return Err(cx.err(key(&dk, "guess_scale"), g.span(), "`guess_scale` needs `guess_column`"));
+                    return Err(cx.err(
+                        key(&dk, "guess_scale"),
+                        g.span(),
+                        "`guess_scale` needs `guess_column`",
+                    ));
                 }
                 None
             }
@@ -1878,7 +1899,11 @@ fn rigid_body<const D: usize>(
                     cx.err(key(&dk, "guess_column"), gc.span(), "`guess_column` needs the `table` it is in")
                 })?;
                 if ds.force.is_none() {
-                    return Err(cx.err(key(&dk, "guess_column"), gc.span(), "`guess_column` applies to a force-controlled coordinate (`force`)"));
+                    return Err(cx.err(
+                        key(&dk, "guess_column"),
+                        gc.span(),
+                        "`guess_column` applies to a force-controlled coordinate (`force`)",
+                    ));
                 }
                 let (table, time_scale) = find_table(t)?;
                 let factor = match &ds.guess_scale {
@@ -1896,13 +1921,21 @@ fn rigid_body<const D: usize>(
             (None, Some(f)) => (Some(cx.finite(f, &key(&dk, "force"))?), true),
             (None, None) => (None, false),
             (Some(_), Some(f)) => {
-                return Err(cx.err(key(&dk, "force"), f.span(), "give either `value` (prescribed) or `force`, not both"))
+                return Err(cx.err(
+                    key(&dk, "force"),
+                    f.span(),
+                    "give either `value` (prescribed) or `force`, not both",
+                ))
             }
         };
         let history: Arc<dyn LoadHistory> = match (&ds.table, &ds.column) {
             (Some(t), Some(c)) => {
                 if ds.history.is_some() {
-                    return Err(cx.err(&dk, d.span(), "give either `history` or `table` with `column`, not both"));
+                    return Err(cx.err(
+                        &dk,
+                        d.span(),
+                        "give either `history` or `table` with `column`, not both",
+                    ));
                 }
                 let (table, time_scale) = find_table(t)?;
                 let mut factor = match &ds.scale {
@@ -1916,7 +1949,9 @@ fn rigid_body<const D: usize>(
                         return Err(cx.err(
                             key(&dk, "unit"),
                             span,
-                            format!("unit `{other}`: only angles take a unit, `rad` or `deg` (lengths: use `scale`)"),
+                            format!(
+                            "unit `{other}`: only angles take a unit, `rad` or `deg` (lengths: use `scale`)"
+                        ),
                         ))
                     }
                 }
@@ -1929,15 +1964,25 @@ fn rigid_body<const D: usize>(
             (Some(t), None) if guess.is_none() => {
                 return Err(cx.err(key(&dk, "table"), t.span(), "a `table` needs its `column`"))
             }
-            (None, Some(c)) => return Err(cx.err(key(&dk, "column"), c.span(), "a `column` needs its `table`")),
+            (None, Some(c)) => {
+                return Err(cx.err(key(&dk, "column"), c.span(), "a `column` needs its `table`"))
+            }
             (_, None) => {
                 for (n, sp) in present.iter() {
                     if let (true, Some(sp)) = (matches!(*n, "scale" | "unit"), sp) {
-                        return Err(cx.err(key(&dk, n), sp.clone(), format!("`{n}` applies to a table column")));
+                        return Err(cx.err(
+                            key(&dk, n),
+                            sp.clone(),
+                            format!("`{n}` applies to a table column"),
+                        ));
                     }
                 }
                 let Some(a) = amount else {
-                    return Err(cx.err(&dk, d.span(), "give `value` (prescribed), `force`, or `table` with `column`"));
+                    return Err(cx.err(
+                        &dk,
+                        d.span(),
+                        "give `value` (prescribed), `force`, or `table` with `column`",
+                    ));
                 };
                 // prescribed angles are given in degrees
                 let a = if rotation && !is_force { a.to_radians() } else { a };

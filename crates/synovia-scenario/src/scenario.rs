@@ -614,6 +614,9 @@ pub struct SolverSpec {
     pub ordering: Option<Sp<String>>,
     pub load_degree: Option<Sp<usize>>,
     pub memory_limit_mb: Option<Sp<f64>>,
+    /// Largest number of contact dofs ordered last as a dense interface block (default 8000;
+    /// 0: none, whole-factor solves of the active rows).
+    pub interface_block_dofs: Option<Sp<usize>>,
 }
 
 /// The analysis (flat table; `type` says which keys apply).

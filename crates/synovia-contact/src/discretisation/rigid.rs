@@ -23,8 +23,9 @@ pub struct RigidObstacle<const D: usize> {
     /// that the obstacle faces away from, keep their row with the body's own outward normal
     /// and their gap `φ`: constraints that cannot become active near this configuration (a
     /// femoral component above the far side of an insert), kept so that the pair's nodes do
-    /// not change from pose to pose. `None` (default): every node uses the obstacle's normal,
-    /// and an obstacle facing away from a node is an error.
+    /// not change from pose to pose; nodes inside the obstacle keep its normal whichever way
+    /// it faces. `None` (default): every node uses the obstacle's normal, and an obstacle
+    /// facing away from a node is an error.
     pub search_distance: Option<Real>,
 }
 
@@ -70,7 +71,9 @@ impl<const D: usize> ContactDiscretisation<D> for RigidObstacle<D> {
                     continue;
                 }
             }
-            if n.dot(&nk) <= 0.0 {
+            // with a search distance, a node inside the obstacle keeps the obstacle's normal
+            // whichever way it faces (a rim node overlapped from the side at a measured pose)
+            if n.dot(&nk) <= 0.0 && self.search_distance.is_none() {
                 return Err(cx.invalid(format!(
                     "at node {i} the obstacle faces away from the body (outward normal · obstacle normal = {:.3} ≤ 0)",
                     n.dot(&nk)
