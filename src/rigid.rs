@@ -1,4 +1,4 @@
-//! Rigid bodies with mixed control (docs/model.md §8, docs/scenario.md `[[rigid_body]]`).
+//! Rigid bodies with mixed control (docs/model.md §10, docs/scenario.md `[[rigid_body]]`).
 //!
 //! A [`RigidBody`] has `3` (2D) or `6` (3D) degrees of freedom `q`: the translation `t` of its
 //! reference point `c` and its rotation angles. Its pose maps a point `X` of the body to
