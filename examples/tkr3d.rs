@@ -266,45 +266,38 @@ fn csv_text(poses: &[Pose]) -> String {
 type Curve<'a> = (&'a str, RGBColor, &'a dyn Fn(&Pose) -> f64);
 
 fn plot_forces(poses: &[Pose], path: &str) -> Result<(), Error> {
-    let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let top = poses.iter().map(|p| p.load).fold(0.0, f64::max) * 1.1;
-    let mut chart = ChartBuilder::on(&root)
-        .caption("tkr3d: axial force and its medial / lateral split", ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..100.0, 0.0..top)?;
-    chart.configure_mesh().x_desc("gait cycle (%)").y_desc("force (N)").draw()?;
-    let series: [Curve; 3] = [
+    let curves: [Curve; 3] = [
         ("ISO 14243-1 axial force (applied)", BLACK, &|p| p.load),
         ("medial", BLUE, &|p| p.medial.force),
         ("lateral", RED, &|p| p.lateral.force),
     ];
-    for (label, colour, f) in series {
-        chart
-            .draw_series(LineSeries::new(poses.iter().map(|p| (p.percent, f(p))), colour.stroke_width(2)))?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
-    }
-    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw()?;
-    root.present()?;
-    Ok(())
+    plot_lines(poses, path, "tkr3d: axial force and its medial / lateral split", "force (N)", &curves)
 }
 
 fn plot_peak(poses: &[Pose], path: &str) -> Result<(), Error> {
+    let curves: [Curve; 2] = [("medial", BLUE, &|p| p.medial.peak), ("lateral", RED, &|p| p.lateral.peak)];
+    plot_lines(poses, path, "tkr3d: peak contact pressure on the insert", "pressure (MPa)", &curves)
+}
+
+/// Curves over the gait cycle in one SVG chart.
+fn plot_lines(
+    poses: &[Pose],
+    path: &str,
+    caption: &str,
+    y_desc: &str,
+    curves: &[Curve],
+) -> Result<(), Error> {
     let root = SVGBackend::new(path, (800, 480)).into_drawing_area();
     root.fill(&WHITE)?;
-    let top = poses.iter().map(|p| p.peak).fold(0.0, f64::max) * 1.1 + 1e-9;
+    let top = curves.iter().flat_map(|(_, _, f)| poses.iter().map(f)).fold(0.0, f64::max) * 1.1 + 1e-9;
     let mut chart = ChartBuilder::on(&root)
-        .caption("tkr3d: peak contact pressure on the insert", ("sans-serif", 20))
+        .caption(caption, ("sans-serif", 20))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(60)
         .build_cartesian_2d(0.0..100.0, 0.0..top)?;
-    chart.configure_mesh().x_desc("gait cycle (%)").y_desc("pressure (MPa)").draw()?;
-    let series: [Curve; 2] = [("medial", BLUE, &|p| p.medial.peak), ("lateral", RED, &|p| p.lateral.peak)];
-    for (label, colour, f) in series {
+    chart.configure_mesh().x_desc("gait cycle (%)").y_desc(y_desc).draw()?;
+    for &(label, colour, f) in curves {
         chart
             .draw_series(LineSeries::new(poses.iter().map(|p| (p.percent, f(p))), colour.stroke_width(2)))?
             .label(label)

@@ -493,6 +493,39 @@ pub(crate) struct RigidDriver {
 
 type Level<const D: usize> = (StepRecord, StaticContactResult<D>);
 
+/// What the trial solves of one level share.
+struct LevelContext<'a, const D: usize> {
+    joint: &'a JointModel<D>,
+    t: Real,
+    solver: &'a dyn ContactSolver,
+    mode: LevelMode,
+    /// The stepper's state at the start of a quasi-static level (each trial starts there).
+    checkpoint: Option<StepperCheckpoint<D>>,
+    /// The force-controlled coordinates `(rigid body, degree of freedom)`.
+    unknowns: &'a [(usize, usize)],
+}
+
+/// The gaps of a geometry built at the coordinates `base`, followed to first order in the
+/// force-controlled coordinates (docs/model.md (10.4)): `d(z) = d₀ + S (z − base)`.
+struct LinearGaps {
+    base: Vec<Real>,
+    gaps0: Vec<Real>,
+    /// `∂d_r/∂z_j` per contact node.
+    sens: Vec<Vec<Real>>,
+}
+
+impl LinearGaps {
+    fn at(&self, z: &[Real]) -> Vec<Real> {
+        self.gaps0
+            .iter()
+            .zip(&self.sens)
+            .map(|(g, s)| {
+                g + s.iter().zip(z.iter().zip(&self.base)).map(|(sj, (zj, bj))| sj * (zj - bj)).sum::<Real>()
+            })
+            .collect()
+    }
+}
+
 /// A force system: its resultant and its moment about the origin (3 components each).
 type ForceSystem = ([Real; 3], [Real; 3]);
 
@@ -564,6 +597,7 @@ impl RigidDriver {
             .collect();
         let posed_pairs = !joint.rigid_pair_bodies().is_empty();
         let checkpoint = (mode == LevelMode::Step).then(|| stepper.checkpoint());
+        let cx = LevelContext { joint, t, solver, mode, checkpoint, unknowns: &unknowns };
         let mut solves = 0usize;
         let length = joint.model_size();
         // the level without force control: pose, rebuild, solve
@@ -587,10 +621,13 @@ impl RigidDriver {
             if posed_pairs {
                 stepper.contact_mut().rebuild_geometry(model, joint.pairs())?;
             }
-            let base: Vec<Real> = unknowns.iter().map(|&(b, k)| self.q[b][k]).collect();
             let geometry = stepper.geometry().clone();
-            let gaps0: Vec<Real> = geometry.nodes.iter().map(|n| n.gap).collect();
-            let sens = self.gap_sensitivities(joint, &geometry, &unknowns);
+            let linear = LinearGaps {
+                base: unknowns.iter().map(|&(b, k)| self.q[b][k]).collect(),
+                gaps0: geometry.nodes.iter().map(|n| n.gap).collect(),
+                sens: self.gap_sensitivities(joint, &geometry, &unknowns),
+            };
+            let base = linear.base.clone();
             let mut z = base.clone();
             let mut history: Vec<(Vec<Real>, Vec<Real>)> = Vec::new();
             let mut bracket = Bracket::default();
@@ -601,29 +638,8 @@ impl RigidDriver {
                 if solves >= params.max_solves {
                     return Err(self.no_convergence(joint, &unknowns, &best, solves, t));
                 }
-                for (&(b, k), &zj) in unknowns.iter().zip(&z) {
-                    self.q[b][k] = zj;
-                }
-                self.set_poses(joint);
-                if posed_pairs {
-                    let gaps: Vec<Real> = gaps0
-                        .iter()
-                        .zip(&sens)
-                        .map(|(g, s)| {
-                            g + s
-                                .iter()
-                                .zip(z.iter().zip(&base))
-                                .map(|(sj, (zj, bj))| sj * (zj - bj))
-                                .sum::<Real>()
-                        })
-                        .collect();
-                    stepper.contact_mut().set_gaps(&gaps)?;
-                }
-                if let Some(c) = &checkpoint {
-                    stepper.rollback(c.clone());
-                }
-                let (record, result) = self.solve_once(joint, stepper, t, solver, mode, &mut solves)?;
-                let reactions = self.reactions(joint, &geometry, &record, &result, t)?;
+                let ((record, result), reactions) =
+                    self.trial(&cx, stepper, &linear, &geometry, &z, &mut solves)?;
                 let mut r: Vec<Real> =
                     unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
                 let error = r.iter().zip(&scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
@@ -637,7 +653,7 @@ impl RigidDriver {
                 let touching = reactions.iter().flatten().any(|v| *v != 0.0)
                     || unknowns.iter().any(|&(b, _)| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b));
                 if !touching {
-                    z = self.approach(joint, &unknowns, &target, &z, &gaps0, &sens, &base, length)?;
+                    z = self.approach(joint, &unknowns, &target, &z, &linear, length)?;
                     history.clear();
                     continue;
                 }
@@ -679,19 +695,13 @@ impl RigidDriver {
                     None => {
                         // a finite-difference column per unknown, then Newton
                         let j = self.fd_jacobian(
-                            joint,
+                            &cx,
                             stepper,
-                            t,
-                            solver,
-                            mode,
-                            &checkpoint,
-                            &unknowns,
+                            &linear,
+                            &geometry,
                             &z,
                             &r,
                             &target,
-                            &gaps0,
-                            &sens,
-                            &base,
                             length,
                             &mut solves,
                         )?;
@@ -904,11 +914,10 @@ impl RigidDriver {
         unknowns: &[(usize, usize)],
         target: &[Real],
         z: &[Real],
-        gaps0: &[Real],
-        sens: &[Vec<Real>],
-        base: &[Real],
+        linear: &LinearGaps,
         length: Real,
     ) -> Result<Vec<Real>, JointError> {
+        let gaps = linear.at(z);
         let mut next = z.to_vec();
         let mut moved = false;
         for (j, (&f, zj)) in target.iter().zip(z).enumerate() {
@@ -918,9 +927,7 @@ impl RigidDriver {
             let s = f.signum();
             // gap at z of every node, and its rate along s
             let mut best = Real::INFINITY;
-            for (g0, sr) in gaps0.iter().zip(sens) {
-                let g =
-                    g0 + sr.iter().zip(z.iter().zip(base)).map(|(a, (zi, bi))| a * (zi - bi)).sum::<Real>();
+            for (g, sr) in gaps.iter().zip(&linear.sens) {
                 let rate = sr[j] * s;
                 if rate < 0.0 {
                     best = best.min(g.max(0.0) / -rate);
@@ -937,62 +944,61 @@ impl RigidDriver {
         Ok(next)
     }
 
+    /// One trial solve of the level at the force-controlled coordinates `z`: the rigid bodies
+    /// posed, the gaps followed to first order (10.4), the stepper back at the level's start;
+    /// returns the solve and the generalised forces on every rigid body.
+    fn trial<const D: usize>(
+        &mut self,
+        cx: &LevelContext<'_, D>,
+        stepper: &mut QuasiStaticStepper<D>,
+        linear: &LinearGaps,
+        geometry: &ContactGeometry<D>,
+        z: &[Real],
+        solves: &mut usize,
+    ) -> Result<(Level<D>, Vec<Vec<Real>>), JointError> {
+        for (&(b, k), &zj) in cx.unknowns.iter().zip(z) {
+            self.q[b][k] = zj;
+        }
+        self.set_poses(cx.joint);
+        if !cx.joint.rigid_pair_bodies().is_empty() {
+            stepper.contact_mut().set_gaps(&linear.at(z))?;
+        }
+        if let Some(c) = &cx.checkpoint {
+            stepper.rollback(c.clone());
+        }
+        let (record, result) = self.solve_once(cx.joint, stepper, cx.t, cx.solver, cx.mode, solves)?;
+        let reactions = self.reactions(cx.joint, geometry, &record, &result, cx.t)?;
+        Ok(((record, result), reactions))
+    }
+
+    /// The Jacobian `∂r/∂z` by one finite-difference trial per unknown (a step of 1e-4 of the
+    /// model size, or 1e-4 rad, along the applied force); the coordinates are left at `z`.
     #[allow(clippy::too_many_arguments)]
     fn fd_jacobian<const D: usize>(
         &mut self,
-        joint: &JointModel<D>,
+        cx: &LevelContext<'_, D>,
         stepper: &mut QuasiStaticStepper<D>,
-        t: Real,
-        solver: &dyn ContactSolver,
-        mode: LevelMode,
-        checkpoint: &Option<StepperCheckpoint<D>>,
-        unknowns: &[(usize, usize)],
+        linear: &LinearGaps,
+        geometry: &ContactGeometry<D>,
         z: &[Real],
         r: &[Real],
         target: &[Real],
-        gaps0: &[Real],
-        sens: &[Vec<Real>],
-        base: &[Real],
         length: Real,
         solves: &mut usize,
     ) -> Result<nalgebra::DMatrix<Real>, JointError> {
-        let m = unknowns.len();
+        let m = cx.unknowns.len();
         let mut j = nalgebra::DMatrix::<Real>::zeros(m, m);
-        let geometry = stepper.geometry().clone();
         for col in 0..m {
-            let (_, k) = unknowns[col];
-            // along the applied force: into the contact
+            let (_, k) = cx.unknowns[col];
             let h = if k < D { 1e-4 * length } else { 1e-4 } * if target[col] < 0.0 { -1.0 } else { 1.0 };
             let mut zp = z.to_vec();
             zp[col] += h;
-            for (&(b, kk), &zj) in unknowns.iter().zip(&zp) {
-                self.q[b][kk] = zj;
-            }
-            self.set_poses(joint);
-            if !joint.rigid_pair_bodies().is_empty() {
-                let gaps: Vec<Real> = gaps0
-                    .iter()
-                    .zip(sens)
-                    .map(|(g, s)| {
-                        g + s
-                            .iter()
-                            .zip(zp.iter().zip(base))
-                            .map(|(sj, (zj, bj))| sj * (zj - bj))
-                            .sum::<Real>()
-                    })
-                    .collect();
-                stepper.contact_mut().set_gaps(&gaps)?;
-            }
-            if let Some(c) = checkpoint {
-                stepper.rollback(c.clone());
-            }
-            let (record, result) = self.solve_once(joint, stepper, t, solver, mode, solves)?;
-            let reactions = self.reactions(joint, &geometry, &record, &result, t)?;
-            for (row, &(b, kk)) in unknowns.iter().enumerate() {
+            let (_, reactions) = self.trial(cx, stepper, linear, geometry, &zp, solves)?;
+            for (row, &(b, kk)) in cx.unknowns.iter().enumerate() {
                 j[(row, col)] = (reactions[b][kk] + target[row] - r[row]) / h;
             }
         }
-        for (&(b, k), &zj) in unknowns.iter().zip(z) {
+        for (&(b, k), &zj) in cx.unknowns.iter().zip(z) {
             self.q[b][k] = zj;
         }
         Ok(j)
