@@ -86,6 +86,17 @@ fn open_or_inconsistent_surfaces_are_refused_where_a_solid_is_needed() {
     SurfaceObstacle::new(open).expect("an open patch is a valid obstacle surface");
     let err = SurfaceObstacle::solid(s.flipped()).expect_err("inward");
     assert!(err.to_string().contains("inward"), "{err}");
+    // two overlapping closed spheres in one surface: closed and consistent, but it crosses
+    // itself, so it bounds no solid
+    let other = s.transformed(&nalgebra::Rotation3::identity(), &Vector::<3>::new(0.5, 0.0, 0.0));
+    let mut vertices = s.vertices().to_vec();
+    let shift = vertices.len();
+    vertices.extend_from_slice(other.vertices());
+    let mut tris = s.triangles().to_vec();
+    tris.extend(other.triangles().iter().map(|t| [t[0] + shift, t[1] + shift, t[2] + shift]));
+    let crossing = TriangleSurface::new(vertices, tris).expect("two spheres");
+    let err = SurfaceObstacle::solid(crossing).expect_err("self-intersecting");
+    assert!(err.to_string().contains("cross") || err.to_string().contains("intersect"), "{err}");
 }
 
 /// Normal force of a block `[−½, ½]² × [0, ½]` (E = 1000, ν = 0.3) whose top is pushed down

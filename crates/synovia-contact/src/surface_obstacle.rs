@@ -71,9 +71,10 @@ impl SurfaceObstacle {
     ///
     /// # Errors
     /// [`ContactError::InvalidParameter`] with the surface's error
-    /// ([`TriangleSurface::check_closed`]: open, non-manifold, inconsistent or inward).
+    /// ([`TriangleSurface::check_closed_solid`]: open, non-manifold, inconsistent, inward, or
+    /// crossing itself — a self-intersecting surface has no well-defined inside).
     pub fn solid(surface: TriangleSurface) -> Result<Self, ContactError> {
-        surface.check_closed().map_err(surface_error)?;
+        surface.check_closed_solid().map_err(surface_error)?;
         Ok(Self::build(surface))
     }
 
