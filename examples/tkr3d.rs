@@ -117,10 +117,15 @@ fn main() -> Result<(), Error> {
         synovia::contact_ops::operators::PairSplit::new("lateral", "medial", [0.0; 3], [0.0, 0.0, 1.0])?,
     )?;
     joint.solver("pdas-fallback")?;
+    let mut control = synovia::rigid::ForceControlParams::default();
     if let Some(tol) = std::env::args().skip_while(|a| a != "--geometry-tolerance").nth(1) {
-        let geometry_tolerance: f64 = tol.parse()?;
-        joint.force_control(synovia::rigid::ForceControlParams { geometry_tolerance, ..Default::default() });
+        control.geometry_tolerance = tol.parse()?;
     }
+    if free_adduction {
+        control.fresh_jacobian = true;
+        control.max_solves = 200;
+    }
+    joint.force_control(control);
     // the candidate surface is large and the contact patches move: whole-factor solves of the
     // active rows instead of a dense interface block (docs/tkr3d.md, performance)
     if std::env::args().any(|a| a == "--dense-interface") {

@@ -462,11 +462,14 @@ pub struct ForceControlParams {
     /// Largest motion from the pose the contact geometry was built at (relative to the model
     /// size) before the geometry is rebuilt.
     pub geometry_tolerance: Real,
+    /// Several force-controlled coordinates: a finite-difference Jacobian at every accepted
+    /// iterate (`true`) instead of Broyden updates (`false`, default).
+    pub fresh_jacobian: bool,
 }
 
 impl Default for ForceControlParams {
     fn default() -> Self {
-        Self { tolerance: 1e-10, max_solves: 60, geometry_tolerance: 1e-6 }
+        Self { tolerance: 1e-10, max_solves: 60, geometry_tolerance: 1e-6, fresh_jacobian: false }
     }
 }
 
@@ -678,6 +681,14 @@ impl RigidDriver {
                         _ => {
                             accepted = Some((z.clone(), r.clone(), error));
                             backtracks = 0;
+                            // several unknowns: the residual is piecewise affine with kinks
+                            // where a contact region lifts off (one condyle, then both), so a
+                            // fresh Jacobian at every accepted iterate (one finite-difference
+                            // trial per unknown) rather than Broyden updates across kinks
+                            if params.fresh_jacobian {
+                                jac = None;
+                                history.clear();
+                            }
                         }
                     }
                 }
