@@ -90,7 +90,7 @@ fn main() -> Result<(), Error> {
     let table = Table::read(format!("{DATA}/fluoroscopic_gait_kinematics.sto"))?;
     let column = |name: &str, factor: f64| table.history(name, factor, 0.01);
     let force = iso14243_axial_force().map_err(|e| e.to_string())?;
-    let down = FnHistoryOf(move |t| -force.value(t));
+    let down = synovia::time::history::FnHistory::new(move |t| -force.value(t));
     let femur = RigidBody::<3>::new("femur", Point::<3>::zeros())?
         .with_rotation_order("zxy")?
         .prescribe(0, column("knee_ant_r", 1000.0)?)?
@@ -219,21 +219,6 @@ fn main() -> Result<(), Error> {
         start.elapsed().as_secs_f64()
     );
     Ok(())
-}
-
-/// A history from a closure.
-struct FnHistoryOf<F>(F);
-
-impl<F: Fn(f64) -> f64 + Send + Sync> std::fmt::Debug for FnHistoryOf<F> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("FnHistoryOf")
-    }
-}
-
-impl<F: Fn(f64) -> f64 + Send + Sync> LoadHistory for FnHistoryOf<F> {
-    fn value(&self, t: f64) -> f64 {
-        (self.0)(t)
-    }
 }
 
 fn csv_text(poses: &[Pose]) -> String {

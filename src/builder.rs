@@ -1206,16 +1206,7 @@ impl<const D: usize> JointModel<D> {
         start: Instant,
         mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
-        for (i, &t) in times.iter().enumerate() {
-            if !t.is_finite() || (i > 0 && t <= times[i - 1]) {
-                return Err(JointError::Invalid(format!(
-                    "time levels must be finite and increase strictly (level {i}: {t})"
-                )));
-            }
-        }
-        if times.is_empty() {
-            return Err(JointError::Invalid("no time levels".into()));
-        }
+        check_levels(times)?;
         let mut elastic = ElasticSolver::new(&self.model, self.elastic_params)?;
         let setup_s = start.elapsed().as_secs_f64();
         let geometry = empty_geometry::<D>();

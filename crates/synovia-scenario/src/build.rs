@@ -1992,11 +1992,11 @@ fn rigid_body<const D: usize>(
         };
         body = if is_force {
             match guess {
-                Some(g) => body.force_with_guess(index, ArcHistory(history), ArcHistory(g)),
-                None => body.force(index, ArcHistory(history)),
+                Some(g) => body.force_with_guess(index, history, g),
+                None => body.force(index, history),
             }
         } else {
-            body.prescribe(index, ArcHistory(history))
+            body.prescribe(index, history)
         }
         .map_err(|e| cx.err(&dk, d.span(), e.to_string()))?;
     }
@@ -2005,16 +2005,6 @@ fn rigid_body<const D: usize>(
     }
     joint.add_rigid_body(body).map_err(|e| cx.err(key(k, "name"), s.name.span(), e.to_string()))?;
     Ok(())
-}
-
-/// A shared history as a history.
-#[derive(Debug, Clone)]
-struct ArcHistory(Arc<dyn LoadHistory>);
-
-impl LoadHistory for ArcHistory {
-    fn value(&self, t: f64) -> f64 {
-        self.0.value(t)
-    }
 }
 
 /// Strain above which the unit check refuses a model (100 %).
