@@ -15,6 +15,7 @@
 //! ```sh
 //! cargo run --release --example tkr3d            # 1 mm articular mesh
 //! cargo run --release --example tkr3d -- --fine  # 0.5 mm
+//! cargo run --release --example tkr3d -- --fine --poses 13,50  # only these % of the cycle
 //! ```
 
 use std::fmt::Write as _;
@@ -65,6 +66,14 @@ struct Side {
 
 fn main() -> Result<(), Error> {
     let start = Instant::now();
+    if std::env::args().any(|a| a == "-v") {
+        tracing_subscriber::fmt()
+            .with_max_level(tracing::Level::DEBUG)
+            .with_span_events(tracing_subscriber::fmt::format::FmtSpan::CLOSE)
+            .with_ansi(false)
+            .with_writer(std::io::stderr)
+            .init();
+    }
     let fine = std::env::args().any(|a| a == "--fine");
     let free_adduction = std::env::args().any(|a| a == "--free-adduction");
     let out = std::env::args().skip_while(|a| a != "--out").nth(1).unwrap_or_else(|| {
@@ -143,7 +152,15 @@ fn main() -> Result<(), Error> {
     let mut poses = Vec::new();
     println!("| cycle % | F (N) | SI (mm) | SI measured (mm) | balance | KKT | medial (N) | lateral (N) | area (mm²) | peak p (MPa) | solves | s |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for i in 0..=100 {
+    // `--poses 13,50`: only these percentages of the cycle (e.g. the mesh-convergence study)
+    let percents: Vec<u32> = match std::env::args().skip_while(|a| a != "--poses").nth(1) {
+        Some(list) => list.split(',').map(|v| v.trim().parse::<u32>()).collect::<Result<_, _>>()?,
+        None => (0..=100).collect(),
+    };
+    if percents.is_empty() || percents.iter().any(|&p| p > 100) || percents.windows(2).any(|w| w[0] >= w[1]) {
+        return Err("--poses takes increasing percentages of the cycle in 0..=100, e.g. 13,50".into());
+    }
+    for &i in &percents {
         let t = f64::from(i) / 100.0;
         let report = session.solve_static(t)?;
         let record = session.record().ok_or("no record")?;

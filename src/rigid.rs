@@ -172,6 +172,11 @@ impl<const D: usize> SignedDistance<D> for PosedObstacle<D> {
         let pose = self.pose.get();
         pose.rotation * self.shape.gradient(&pose.to_body(x))
     }
+    fn distance_and_gradient(&self, x: &Point<D>) -> (Real, Vector<D>) {
+        let pose = self.pose.get();
+        let (d, g) = self.shape.distance_and_gradient(&pose.to_body(x));
+        (d, pose.rotation * g)
+    }
     fn validate(&self) -> Result<(), String> {
         let p = self.pose.get();
         if !(p.rotation.iter().chain(p.translation.iter()).all(|v| v.is_finite())) {
@@ -618,144 +623,164 @@ impl RigidDriver {
         let scales = force_scales(bodies, &values, &unknowns, length);
         let mut best: Option<(Real, Level<D>)> = None;
         let mut jac = self.jacobian.clone().filter(|j| j.nrows() == unknowns.len());
-        for _pass in 0..8 {
-            // the geometry at the current pose
-            self.set_poses(joint);
-            if posed_pairs {
-                stepper.contact_mut().rebuild_geometry(model, joint.pairs())?;
-            }
-            let geometry = stepper.geometry().clone();
-            let linear = LinearGaps {
-                base: unknowns.iter().map(|&(b, k)| self.q[b][k]).collect(),
-                gaps0: geometry.nodes.iter().map(|n| n.gap).collect(),
-                sens: self.gap_sensitivities(joint, &geometry, &unknowns),
-            };
-            let base = linear.base.clone();
-            let mut z = base.clone();
-            let mut history: Vec<(Vec<Real>, Vec<Real>)> = Vec::new();
-            let mut bracket = Bracket::default();
-            // several unknowns: the last iterate that reduced the error, and backtracking
-            let mut accepted: Option<(Vec<Real>, Vec<Real>, Real)> = None;
-            let mut backtracks = 0;
-            loop {
-                if solves >= params.max_solves {
-                    return Err(self.no_convergence(joint, &unknowns, &best, solves, t));
-                }
-                let ((record, result), reactions) =
-                    self.trial(&cx, stepper, &linear, &geometry, &z, &mut solves)?;
-                let mut r: Vec<Real> =
-                    unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
-                let error = r.iter().zip(&scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
-                if best.as_ref().is_none_or(|(e, _)| error < *e) {
-                    best = Some((error, (record, result)));
-                }
-                if error <= params.tolerance {
-                    break;
-                }
-                // not touching: move to first contact along the applied forces
-                let touching = reactions.iter().flatten().any(|v| *v != 0.0)
-                    || unknowns.iter().any(|&(b, _)| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b));
-                if !touching {
-                    z = self.approach(joint, &unknowns, &target, &z, &linear, length)?;
-                    history.clear();
-                    continue;
-                }
-                if unknowns.len() == 1 {
-                    bracket.update(z[0], r[0]);
-                } else {
-                    match &accepted {
-                        Some((za, ra, ea)) if error >= *ea => {
-                            if backtracks < 3 {
-                                // halve the step back toward the last good iterate
-                                z = za.iter().zip(&z).map(|(a, b)| a + 0.5 * (b - a)).collect();
-                                backtracks += 1;
-                                continue;
-                            }
-                            // a fresh finite-difference Jacobian at the last good iterate
-                            z = za.clone();
-                            r = ra.clone();
-                            jac = None;
-                            history.clear();
-                            backtracks = 0;
-                        }
-                        _ => {
-                            accepted = Some((z.clone(), r.clone(), error));
-                            backtracks = 0;
-                            // several unknowns: the residual is piecewise affine with kinks
-                            // where a contact region lifts off (one condyle, then both), so a
-                            // fresh Jacobian at every accepted iterate (one finite-difference
-                            // trial per unknown) rather than Broyden updates across kinks
-                            if params.fresh_jacobian {
-                                jac = None;
-                                history.clear();
-                            }
-                        }
-                    }
-                }
-                let dz = match (&mut jac, history.last()) {
-                    (Some(j), Some((zp, rp))) => {
-                        broyden(j, &z, &r, zp, rp);
-                        newton_step(j, &r)
-                    }
-                    (Some(j), None) => newton_step(j, &r),
-                    (None, _) => None,
-                };
-                history.push((z.clone(), r.clone()));
-                let mut next = match dz {
-                    Some(dz) => z.iter().zip(&dz).map(|(a, d)| a + d).collect::<Vec<_>>(),
-                    None => {
-                        // a finite-difference column per unknown, then Newton
-                        let j = self.fd_jacobian(
-                            &cx,
-                            stepper,
-                            &linear,
-                            &geometry,
-                            &z,
-                            &r,
-                            &target,
-                            length,
-                            &mut solves,
-                        )?;
-                        let step = newton_step(&j, &r);
-                        jac = Some(j);
-                        match step {
-                            Some(dz) => z.iter().zip(&dz).map(|(a, d)| a + d).collect(),
-                            None => return Err(self.unresisted(joint, &unknowns)),
-                        }
-                    }
-                };
-                limit_step::<D>(&mut next, &z, &unknowns, length);
-                if let (Some((lo, hi)), 1) = (bracket.interval(), unknowns.len()) {
-                    if !(next[0] > lo && next[0] < hi) {
-                        next[0] = 0.5 * (lo + hi);
-                    }
-                }
-                z = next;
-            }
-            // converged on this geometry: done if the motion from its pose is small
-            let moved = unknowns
+        // the Jacobian was computed at the current iterate (by finite differences)
+        let mut fresh = false;
+        let geometry_tolerance = params.geometry_tolerance * length;
+        let moved = |a: &[Real], b: &[Real]| {
+            unknowns
                 .iter()
-                .zip(z.iter().zip(&base))
-                .map(|(&(_, k), (a, b))| (a - b).abs() * if k < D { 1.0 } else { length })
-                .fold(0.0, Real::max);
-            if !posed_pairs || moved <= params.geometry_tolerance * length {
-                self.jacobian = jac;
-                for (bi, body) in bodies.iter().enumerate() {
-                    for (k, c) in body.controls.iter().enumerate() {
-                        if let DofControl::Force { guess: Some(g), .. } = c {
-                            self.offset[bi][k] = self.q[bi][k] - g.value(t);
+                .zip(a.iter().zip(b))
+                .map(|(&(_, k), (x, y))| (x - y).abs() * if k < D { 1.0 } else { length })
+                .fold(0.0, Real::max)
+        };
+        let mut z: Vec<Real> = unknowns.iter().map(|&(b, k)| self.q[b][k]).collect();
+        let (mut geometry, mut linear) = self.linearise(joint, stepper, &unknowns, &z, posed_pairs)?;
+        let mut bracket = Bracket::default();
+        // several unknowns: the last iterate that reduced the error, and backtracking
+        let mut accepted: Option<(Vec<Real>, Vec<Real>, Real)> = None;
+        let mut backtracks = 0;
+        let mut previous: Option<(Vec<Real>, Vec<Real>, Real)> = None;
+        stepper.set_record_strain_energy(false);
+        let outcome = loop {
+            if solves >= params.max_solves {
+                break Err(self.no_convergence(joint, &unknowns, &best, solves, t));
+            }
+            // the geometry at the pose `z` once it moved beyond the tolerance from the pose it
+            // was built at: the gaps of `linear` are exact to first order only
+            if posed_pairs && moved(&z, &linear.base) > geometry_tolerance {
+                (geometry, linear) = self.linearise(joint, stepper, &unknowns, &z, posed_pairs)?;
+            }
+            let ((record, result), reactions) =
+                match self.trial(&cx, stepper, &linear, &geometry, &z, &mut solves) {
+                    Ok(v) => v,
+                    Err(e) => break Err(e),
+                };
+            let mut r: Vec<Real> =
+                unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
+            let error = r.iter().zip(&scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
+            tracing::debug!(t, solves, ?z, ?r, error, "force-control trial");
+            let converged = error <= params.tolerance;
+            if best.as_ref().is_none_or(|(e, _)| error < *e) || converged {
+                best = Some((error, (record, result)));
+            }
+            if converged {
+                break Ok(geometry);
+            }
+            // not touching: move to first contact along the applied forces
+            let touching = reactions.iter().flatten().any(|v| *v != 0.0)
+                || unknowns.iter().any(|&(b, _)| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b));
+            if !touching {
+                match self.approach(joint, &unknowns, &target, &z, &linear, length) {
+                    Ok(next) => z = next,
+                    Err(e) => break Err(e),
+                }
+                previous = None;
+                continue;
+            }
+            if unknowns.len() == 1 {
+                bracket.update(z[0], r[0]);
+            } else {
+                match &accepted {
+                    Some((za, ra, ea)) if error >= *ea => {
+                        if backtracks < 3 {
+                            // halve the step back toward the last good iterate
+                            z = za.iter().zip(&z).map(|(a, b)| a + 0.5 * (b - a)).collect();
+                            backtracks += 1;
+                            continue;
+                        }
+                        // a fresh finite-difference Jacobian at the last good iterate
+                        z = za.clone();
+                        r = ra.clone();
+                        jac = None;
+                        previous = None;
+                        backtracks = 0;
+                    }
+                    _ => {
+                        accepted = Some((z.clone(), r.clone(), error));
+                        backtracks = 0;
+                        if params.fresh_jacobian {
+                            jac = None;
                         }
                     }
                 }
-                let Some((_, (record, result))) = best.take() else {
-                    return Err(JointError::Invalid("internal: no solve".into()));
-                };
-                let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
-                return Ok((record, result));
             }
-            best = None;
+            // a Jacobian that did not reduce the error fourfold is refreshed (the residual is
+            // piecewise affine: a contact region that lifts off or closes changes its slope);
+            // otherwise it is updated by Broyden's formula (the secant in one unknown)
+            match (&mut jac, &previous) {
+                (Some(_), Some((_, _, ep))) if error > 0.25 * ep && !fresh => jac = None,
+                (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
+                _ => {}
+            }
+            fresh = false;
+            if jac.is_none() {
+                match self.fd_jacobian(&cx, stepper, &linear, &geometry, &z, &r, &target, length, &mut solves)
+                {
+                    Ok(j) => {
+                        jac = Some(j);
+                        fresh = true;
+                    }
+                    Err(e) => break Err(e),
+                }
+            }
+            let Some(dz) = jac.as_ref().and_then(|j| newton_step(j, &r)) else {
+                break Err(self.unresisted(joint, &unknowns));
+            };
+            previous = Some((z.clone(), r.clone(), error));
+            let mut next: Vec<Real> = z.iter().zip(&dz).map(|(a, d)| a + d).collect();
+            limit_step::<D>(&mut next, &z, &unknowns, length);
+            if let (Some((lo, hi)), 1) = (bracket.interval(), unknowns.len()) {
+                if !(next[0] > lo && next[0] < hi) {
+                    next[0] = 0.5 * (lo + hi);
+                }
+            }
+            z = next;
+        };
+        stepper.set_record_strain_energy(true);
+        let geometry = outcome?;
+        self.jacobian = jac;
+        for (bi, body) in bodies.iter().enumerate() {
+            for (k, c) in body.controls.iter().enumerate() {
+                if let DofControl::Force { guess: Some(g), .. } = c {
+                    self.offset[bi][k] = self.q[bi][k] - g.value(t);
+                }
+            }
         }
-        Err(self.no_convergence(joint, &unknowns, &best, solves, t))
+        let Some((_, (mut record, result))) = best.take() else {
+            return Err(JointError::Invalid("internal: no solve".into()));
+        };
+        record.strain_energy = synovia_fem::post::body_fields(model, &result.displacement)?
+            .iter()
+            .map(|f| f.strain_energy)
+            .sum();
+        let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
+        Ok((record, result))
+    }
+
+    /// The rigid bodies posed at the force-controlled coordinates `z`, the contact geometry
+    /// rebuilt there, and its gaps as first-order functions of `z` (docs/model.md (10.4)).
+    fn linearise<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        stepper: &mut QuasiStaticStepper<D>,
+        unknowns: &[(usize, usize)],
+        z: &[Real],
+        posed_pairs: bool,
+    ) -> Result<(ContactGeometry<D>, LinearGaps), JointError> {
+        for (&(b, k), &zj) in unknowns.iter().zip(z) {
+            self.q[b][k] = zj;
+        }
+        self.set_poses(joint);
+        if posed_pairs {
+            stepper.contact_mut().rebuild_geometry(joint.model(), joint.pairs())?;
+        }
+        let geometry = stepper.geometry().clone();
+        let linear = LinearGaps {
+            base: z.to_vec(),
+            gaps0: geometry.nodes.iter().map(|n| n.gap).collect(),
+            sens: self.gap_sensitivities(joint, &geometry, unknowns),
+        };
+        Ok((geometry, linear))
     }
 
     /// One contact solve of the level.
@@ -806,6 +831,7 @@ impl RigidDriver {
 
     /// Generalised forces `Q` on every rigid body from its contact pairs and tied parts,
     /// with the resultant and moment (about the origin).
+    #[tracing::instrument(level = "debug", skip_all)]
     fn loads<const D: usize>(
         &self,
         joint: &JointModel<D>,
@@ -958,6 +984,7 @@ impl RigidDriver {
     /// One trial solve of the level at the force-controlled coordinates `z`: the rigid bodies
     /// posed, the gaps followed to first order (10.4), the stepper back at the level's start;
     /// returns the solve and the generalised forces on every rigid body.
+    #[tracing::instrument(level = "debug", skip_all)]
     fn trial<const D: usize>(
         &mut self,
         cx: &LevelContext<'_, D>,
@@ -982,8 +1009,8 @@ impl RigidDriver {
         Ok(((record, result), reactions))
     }
 
-    /// The Jacobian `∂r/∂z` by one finite-difference trial per unknown (a step of 1e-4 of the
-    /// model size, or 1e-4 rad, along the applied force); the coordinates are left at `z`.
+    /// The Jacobian `∂r/∂z` by one finite-difference trial per unknown (a step of 1e-7 of the
+    /// model size, or 1e-7 rad, along the applied force); the coordinates are left at `z`.
     #[allow(clippy::too_many_arguments)]
     fn fd_jacobian<const D: usize>(
         &mut self,
@@ -1001,7 +1028,9 @@ impl RigidDriver {
         let mut j = nalgebra::DMatrix::<Real>::zeros(m, m);
         for col in 0..m {
             let (_, k) = cx.unknowns[col];
-            let h = if k < D { 1e-4 * length } else { 1e-4 } * if target[col] < 0.0 { -1.0 } else { 1.0 };
+            // a step small enough to keep the contact sets (the derivative of the affine piece
+            // at `z`), large against the rounding of the reactions (≈ 1e-12 relative)
+            let h = if k < D { 1e-7 * length } else { 1e-7 } * if target[col] < 0.0 { -1.0 } else { 1.0 };
             let mut zp = z.to_vec();
             zp[col] += h;
             let (_, reactions) = self.trial(cx, stepper, linear, geometry, &zp, solves)?;

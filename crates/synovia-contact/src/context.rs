@@ -153,6 +153,16 @@ impl SolveContext {
         *lock(&self.load) = None;
         self.row_solves.clear();
     }
+    /// Forgets the kept columns of `S` and the load solve, keeping the row solves (keyed by
+    /// the factor and the rows' directions or dofs, so they stay valid on the same operator)
+    /// and the recycled load solves, and keeps unit solves from now on
+    /// ([`BlockSolveStore::set_unit_solves`]): the rows of a moving rigid partner, rebuilt at
+    /// every pose.
+    pub fn clear_moved_rows(&self) {
+        *lock(&self.columns) = None;
+        *lock(&self.load) = None;
+        self.row_solves.set_unit_solves(true);
+    }
     /// Number of columns of `S` kept.
     pub fn kept_columns(&self) -> usize {
         lock(&self.columns).as_ref().map_or(0, |(_, c)| c.iter().filter(|c| c.is_some()).count())

@@ -54,6 +54,7 @@ pub(crate) fn inf_norm(v: &[f64]) -> f64 {
 /// A solution whose vectors do not fit the problem (e.g. the empty `U` of a multipliers-only
 /// solve, or multipliers of another row set) cannot satisfy the conditions: every residual is
 /// then `+∞`.
+#[tracing::instrument(level = "debug", skip_all)]
 pub fn check_kkt(problem: &ContactProblem<'_>, u: &[f64], lambda_n: &[f64], lambda_t: &[f64]) -> KktReport {
     let n = problem.operator.n();
     if u.len() != n || lambda_n.len() != problem.n_normal() || lambda_t.len() != problem.n_tangential() {

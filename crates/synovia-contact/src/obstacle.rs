@@ -15,6 +15,12 @@ pub trait SignedDistance<const D: usize>: Send + Sync + fmt::Debug {
     fn distance(&self, x: &Point<D>) -> Real;
     /// `∇φ(x)`: the unit normal of the obstacle surface pointing into the free space.
     fn gradient(&self, x: &Point<D>) -> Vector<D>;
+    /// `(φ(x), ∇φ(x))` in one query (default: [`SignedDistance::distance`] and
+    /// [`SignedDistance::gradient`]); shapes whose two values come from the same search (a
+    /// closest point on a surface) override it.
+    fn distance_and_gradient(&self, x: &Point<D>) -> (Real, Vector<D>) {
+        (self.distance(x), self.gradient(x))
+    }
     /// Checks the obstacle's parameters (finite, positive radius, unit directions); the
     /// error names the offending parameter. [`ContactGeometry::new`](crate::operators::ContactGeometry::new) calls it for every rigid
     /// pair and reports a failure as [`ContactError::InvalidPair`]. Default: no check.

@@ -231,6 +231,7 @@ impl Drop for Interface<'_> {
 impl<'a> Interface<'a> {
     /// Validates the problem and computes `w = C A⁻¹ F` (one solve, unless the context holds
     /// `A⁻¹ F` for the same `F` and operator, or was given it).
+    #[tracing::instrument(level = "debug", skip_all)]
     pub fn new(problem: ContactProblem<'a>, context: &'a SolveContext) -> Result<Self, ContactError> {
         problem.validate()?;
         let t0 = Instant::now();
@@ -298,6 +299,7 @@ impl<'a> Interface<'a> {
     }
 
     /// Makes sure the columns `cols` of `S` are computed.
+    #[tracing::instrument(level = "debug", skip_all)]
     pub fn ensure_columns(&mut self, cols: &[usize]) -> Result<(), ContactError> {
         if cols.iter().all(|&j| self.columns[j].is_some()) {
             return Ok(());
@@ -343,6 +345,7 @@ impl<'a> Interface<'a> {
     /// The displacement `U = A⁻¹ F − A⁻¹ (Cᵀ ν)` (one solve supported on the interface dofs,
     /// [`FactorisedOperator::solve_supported_in_place`]); empty when the context asks for
     /// the multipliers only ([`SolveContext::multipliers_only`]).
+    #[tracing::instrument(level = "debug", skip_all)]
     pub fn displacement(&mut self, nu: &[f64]) -> Result<Vec<f64>, ContactError> {
         if self.context.multipliers_only() {
             return Ok(Vec::new());

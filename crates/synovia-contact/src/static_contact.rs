@@ -253,17 +253,20 @@ impl<const D: usize> StaticContact<D> {
     /// Rebuilds the contact geometry of `pairs` on the reference meshes
     /// ([`ContactGeometry::new`]), keeping the factorisation of `A`: for contact partners that
     /// moved (a posed rigid body's shape reads its pose when the geometry is built). Returns
-    /// the previous geometry. The kept Schur columns are dropped (the rows changed).
+    /// the previous geometry. The kept Schur columns are dropped (the rows changed); from the
+    /// first rebuild on, the columns of single-node rows come from kept unit solves
+    /// ([`SolveContext::clear_moved_rows`]), so a node's rows cost no solve at later poses.
     ///
     /// # Errors
     /// From [`ContactGeometry::new`].
+    #[tracing::instrument(level = "debug", skip_all)]
     pub fn rebuild_geometry(
         &mut self,
         model: &Model<D>,
         pairs: &[ContactPair<D>],
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
-        self.context.clear_rows();
+        self.context.clear_moved_rows();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -403,6 +406,7 @@ impl<const D: usize> StaticContact<D> {
     }
 
     #[allow(clippy::too_many_arguments)]
+    #[tracing::instrument(level = "debug", skip_all)]
     fn solve_with(
         &self,
         source: Source<'_, D>,
@@ -504,6 +508,7 @@ impl<const D: usize> StaticContact<D> {
     }
 
     /// The load, the lifts of prescribed displacements and the constraints at `t`.
+    #[tracing::instrument(level = "debug", skip_all)]
     fn assemble(
         &self,
         source: Source<'_, D>,
@@ -655,6 +660,7 @@ impl<const D: usize> StaticContact<D> {
         (!inside.iter().all(|&b| b)).then_some(inside)
     }
 
+    #[tracing::instrument(level = "debug", skip_all)]
     fn finish(
         &self,
         solution: ContactSolution,

@@ -194,6 +194,10 @@ impl SignedDistance<3> for SurfaceObstacle {
     fn gradient(&self, x: &Point<3>) -> Vector<3> {
         self.closest_point(x).gradient
     }
+    fn distance_and_gradient(&self, x: &Point<3>) -> (Real, Vector<3>) {
+        let p = self.closest_point(x);
+        (p.distance, p.gradient)
+    }
     fn validate(&self) -> Result<(), String> {
         if self.translation.iter().chain(self.rotation.matrix().iter()).all(|v| v.is_finite()) {
             Ok(())

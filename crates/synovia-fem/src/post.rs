@@ -63,6 +63,7 @@ pub fn principal_stresses(voigt: &[Real], sigma_zz: Real) -> [Real; 3] {
 }
 
 /// Computes the fields of every body from nodal displacements (`displacement[body][node]`).
+#[tracing::instrument(level = "debug", skip_all)]
 pub fn body_fields<const D: usize>(
     model: &Model<D>,
     displacement: &[Vec<Vector<D>>],

@@ -21,6 +21,9 @@ use crate::operator::{CholeskyOperator, FactorisedOperator, RowStack};
 pub struct BlockSolveStore {
     inner: Mutex<BlockSolves>,
     budget_bytes: usize,
+    /// Whole-factor interfaces: keep unit solves restricted to the interface dofs (see
+    /// [`BlockSolveStore::set_unit_solves`]).
+    unit_solves: std::sync::atomic::AtomicBool,
 }
 
 #[derive(Debug, Default)]
@@ -28,7 +31,14 @@ struct BlockSolves {
     block: usize,
     solves: HashMap<u64, StoredSolve>,
     bytes: usize,
+    /// Whole-factor unit solves: the dofs they are restricted to (sorted).
+    support: Arc<Vec<usize>>,
+    /// The last interface rows' entries as `(position in support, value)`, with the rows'
+    /// fingerprint.
+    row_positions: Option<(u64, RowPositions)>,
 }
+
+type RowPositions = Arc<Vec<Vec<(usize, f64)>>>;
 
 /// A kept solve `x_d` of the row direction `d`.
 #[derive(Debug)]
@@ -101,7 +111,24 @@ impl BlockSolveStore {
 
     /// An empty store holding at most `budget_bytes` of solves.
     pub fn with_budget(budget_bytes: usize) -> Self {
-        Self { inner: Mutex::new(BlockSolves::default()), budget_bytes }
+        Self {
+            inner: Mutex::new(BlockSolves::default()),
+            budget_bytes,
+            unit_solves: std::sync::atomic::AtomicBool::new(false),
+        }
+    }
+    /// With `on`, interfaces solved with the whole factor (no dense trailing block) build the
+    /// columns of rows on at most three dofs (a node's normal or tangent) from kept unit
+    /// solves `P A⁻¹ e_p` restricted to the interface dofs `P` — three solves per node instead
+    /// of one per row, but reused by every later row on that node whatever its direction: for
+    /// rows rebuilt at every pose of a moving rigid partner (docs/model.md §10). Off (default),
+    /// each column is one solve, kept only while the rows stay the same.
+    pub fn set_unit_solves(&self, on: bool) {
+        self.unit_solves.store(on, std::sync::atomic::Ordering::Relaxed);
+    }
+    /// Whether [`BlockSolveStore::set_unit_solves`] is on.
+    pub fn unit_solves(&self) -> bool {
+        self.unit_solves.load(std::sync::atomic::Ordering::Relaxed)
     }
     /// The budget in bytes.
     pub fn budget_bytes(&self) -> usize {
@@ -135,14 +162,51 @@ impl BlockSolveStore {
         };
         let bytes = stored.bytes();
         let mut store = self.lock();
-        if store.block != block || store.bytes + bytes > self.budget_bytes {
+        if store.block != block {
             *store = BlockSolves { block, ..Default::default() };
+        } else if store.bytes + bytes > self.budget_bytes {
+            let support = store.support.clone();
+            let row_positions = store.row_positions.take();
+            *store = BlockSolves { block, support, row_positions, ..Default::default() };
         }
         if bytes <= self.budget_bytes {
             if let Some(old) = store.solves.insert(row.key, stored) {
                 store.bytes -= old.bytes().min(store.bytes);
             }
             store.bytes += bytes;
+        }
+    }
+    /// The dofs the kept unit solves of the factor `block` are restricted to, made to contain
+    /// `dofs` (sorted): a store for another factor, or one whose dofs miss some of `dofs`, is
+    /// emptied and restricted to the union.
+    fn unit_support(&self, block: usize, dofs: &[usize]) -> Arc<Vec<usize>> {
+        let mut store = self.lock();
+        let covered = store.block == block && dofs.iter().all(|p| store.support.binary_search(p).is_ok());
+        if !covered {
+            let mut union: Vec<usize> =
+                if store.block == block { store.support.iter().copied().collect() } else { Vec::new() };
+            union.extend_from_slice(dofs);
+            union.sort_unstable();
+            union.dedup();
+            *store = BlockSolves { block, support: Arc::new(union), ..Default::default() };
+        }
+        store.support.clone()
+    }
+    /// The kept support and row positions of the rows with fingerprint `rows` on the factor
+    /// `block`, if kept.
+    fn unit_rows(&self, block: usize, rows: u64) -> Option<(Arc<Vec<usize>>, RowPositions)> {
+        let store = self.lock();
+        match &store.row_positions {
+            Some((fp, pos)) if store.block == block && *fp == rows => {
+                Some((store.support.clone(), pos.clone()))
+            }
+            _ => None,
+        }
+    }
+    fn keep_unit_rows(&self, block: usize, support: &Arc<Vec<usize>>, rows: u64, positions: RowPositions) {
+        let mut store = self.lock();
+        if store.block == block && Arc::ptr_eq(&store.support, support) {
+            store.row_positions = Some((rows, positions));
         }
     }
     /// Number of kept solves.
@@ -255,6 +319,9 @@ pub(crate) fn cholesky_interface_columns(
         return Ok(0);
     }
     let Some((block, mapped)) = trailing_rows(op.factor(), rows) else {
+        if kept.unit_solves() {
+            return whole_factor_unit_columns(op, rows, &missing, columns, kept);
+        }
         let computed = in_two_halves(&missing, true, |cols| columns_by_solves(op, rows, cols))?;
         let solved = computed.len();
         for (j, col) in computed {
@@ -351,6 +418,112 @@ pub(crate) fn cholesky_interface_columns(
 
 /// Rows with at most this many entries in the trailing block are combined from unit solves.
 const UNIT_SPLIT: usize = 3;
+
+/// The columns `missing` of `S = C A⁻¹ Cᵀ` with the whole factor, rows on at most
+/// [`UNIT_SPLIT`] dofs from kept unit solves: `x_p = P A⁻¹ e_p` restricted to the interface
+/// dofs `P` (the union of the rows' dofs), `S_ij = Σ_{(q,w) ∈ c_i} w Σ_{(p,v) ∈ c_j} v x_p[q]`.
+/// The store keys them by the factor and the interface dofs. Other rows: one solve each.
+fn whole_factor_unit_columns(
+    op: &CholeskyOperator<'_>,
+    rows: RowStack<'_>,
+    missing: &[usize],
+    columns: &mut [Option<Vec<f64>>],
+    kept: &BlockSolveStore,
+) -> Result<usize, LinalgError> {
+    use std::hash::{Hash, Hasher};
+    let n = op.n();
+    if rows.ncols() != n {
+        return Err(LinalgError::Length { what: "interface rows (columns)", expected: n, got: rows.ncols() });
+    }
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (op.factor() as *const CholeskySolver as usize).hash(&mut h);
+    n.hash(&mut h);
+    let id = h.finish() as usize;
+    let fingerprint = rows.fingerprint();
+    let (support, row_positions) = match kept.unit_rows(id, fingerprint) {
+        Some(kept_rows) => kept_rows,
+        None => {
+            let row_entries: Vec<Vec<(usize, f64)>> =
+                (0..rows.n_rows()).map(|r| rows.row(r).collect()).collect();
+            let mut dofs_of_rows: Vec<usize> = row_entries.iter().flatten().map(|&(p, _)| p).collect();
+            dofs_of_rows.sort_unstable();
+            dofs_of_rows.dedup();
+            // the store's dofs (a superset of these rows' dofs: rows whose normals gain or lose
+            // a zero component, coarse levels of a nested iteration)
+            let support = kept.unit_support(id, &dofs_of_rows);
+            let positions: RowPositions = Arc::new(
+                row_entries
+                    .iter()
+                    .map(|row| {
+                        row.iter()
+                            .filter_map(|&(q, w)| support.binary_search(&q).ok().map(|k| (k, w)))
+                            .collect()
+                    })
+                    .collect(),
+            );
+            kept.keep_unit_rows(id, &support, fingerprint, positions.clone());
+            (support, positions)
+        }
+    };
+    let (few, many): (Vec<usize>, Vec<usize>) =
+        missing.iter().partition(|&&j| row_positions[j].len() <= UNIT_SPLIT);
+    let mut solved = 0;
+    if !many.is_empty() {
+        let computed = in_two_halves(&many, true, |cols| columns_by_solves(op, rows, cols))?;
+        solved += computed.len();
+        for (j, col) in computed {
+            columns[j] = Some(col);
+        }
+    }
+    if few.is_empty() {
+        return Ok(solved);
+    }
+    let mut dofs: Vec<usize> =
+        few.iter().flat_map(|&j| row_positions[j].iter().map(|&(k, _)| support[k])).collect();
+    dofs.sort_unstable();
+    dofs.dedup();
+    let unit_dirs: Vec<RowDirection> = dofs.iter().map(|&p| RowDirection::new(&[(p, 1.0)])).collect();
+    let mut units: Vec<Option<Vec<f64>>> = unit_dirs.iter().map(|d| kept.get(id, d)).collect();
+    let absent: Vec<usize> = (0..dofs.len()).filter(|&u| units[u].is_none()).collect();
+    if !absent.is_empty() {
+        let computed = in_two_halves(&absent, true, |list| {
+            let mut out = Vec::with_capacity(list.len());
+            for chunk in list.chunks(32) {
+                let k = chunk.len();
+                let mut rhs = vec![0.0; n * k];
+                for (c, &u) in chunk.iter().enumerate() {
+                    rhs[c * n + dofs[u]] = 1.0;
+                }
+                op.solve_many_in_place(&mut rhs, k)?;
+                for (c, &u) in chunk.iter().enumerate() {
+                    let x = &rhs[c * n..(c + 1) * n];
+                    out.push((u, support.iter().map(|&p| x[p]).collect::<Vec<f64>>()));
+                }
+            }
+            Ok(out)
+        })?;
+        solved += computed.len();
+        for (u, x) in computed {
+            kept.put(id, &unit_dirs[u], &x);
+            units[u] = Some(x);
+        }
+    }
+    for &j in &few {
+        // x_j = Σ v x_p on the interface dofs, then S_ij = c_i · x_j
+        let mut x = vec![0.0; support.len()];
+        for &(k, v) in &row_positions[j] {
+            let Ok(u) = dofs.binary_search(&support[k]) else { continue };
+            if let Some(unit) = &units[u] {
+                for (xi, ui) in x.iter_mut().zip(unit) {
+                    *xi += v * ui;
+                }
+            }
+        }
+        let col = row_positions.iter().map(|row| row.iter().map(|&(k, w)| w * x[k]).sum()).collect();
+        columns[j] = Some(col);
+    }
+    Ok(solved)
+}
 
 /// The trailing-block solves `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` (in trailing positions) of the rows
 /// `j ∈ cols` (`rows`: the rows of `C` in trailing positions; every `j ∈ cols` must be one):
@@ -499,5 +672,65 @@ mod tests {
         assert_eq!(zero.scale, 1.0);
         let c = RowDirection::new(&[(3, 2.0), (4, -6.0 * (1.0 + 1e-9))]);
         assert!(!a.matches(&c.direction) || a.key != c.key);
+    }
+
+    /// Whole-factor interfaces with unit solves on: rows on one node (≤ `UNIT_SPLIT` dofs)
+    /// with normals that change from call to call (a moving rigid partner) cost no solve
+    /// once their dofs are kept, rows that lose a dof keep the store, and every column agrees
+    /// with fresh solves; a budget too small for them empties the store instead of growing.
+    #[test]
+    fn moving_normals_on_the_whole_factor_reuse_unit_solves() {
+        let n = 150;
+        let op = SparseCholesky::new(tridiagonal(n), &Ordering::Amd).expect("factor");
+        let node_rows = |angle: f64| {
+            let mut rows = SparseRows::new(n);
+            for node in [3usize, 10, 20, 40] {
+                let (c, s) = (angle.cos(), angle.sin());
+                if s == 0.0 {
+                    rows.push_row([(3 * node, c)]);
+                } else {
+                    rows.push_row([(3 * node, c), (3 * node + 1, s), (3 * node + 2, 0.5 * s)]);
+                }
+            }
+            // a row on many dofs: one whole solve
+            rows.push_row([(1, 1.0), (5, 0.5), (7, 0.25), (9, 0.125)]);
+            rows
+        };
+        let check = |rows: &SparseRows, columns: &[Option<Vec<f64>>]| {
+            let reference = reference_columns(&op, rows);
+            for (j, col) in columns.iter().enumerate() {
+                let col = col.as_ref().expect("column computed");
+                let scale = reference[j].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+                for (i, (&x, &y)) in col.iter().zip(&reference[j]).enumerate() {
+                    assert!((x - y).abs() <= 1e-13 * scale, "S[{i},{j}]: {x} vs {y}");
+                }
+            }
+        };
+        let store = BlockSolveStore::default();
+        store.set_unit_solves(true);
+        let mut solves = Vec::new();
+        for angle in [0.3, 0.5, 0.0, 0.7] {
+            let rows = node_rows(angle);
+            let mut columns = vec![None; rows.nrows()];
+            let all: Vec<usize> = (0..rows.nrows()).collect();
+            solves.push(
+                op.view()
+                    .interface_columns(RowStack::new(&rows, None), &all, &mut columns, &store)
+                    .expect("columns"),
+            );
+            check(&rows, &columns);
+        }
+        // 12 unit solves and the long row at first, then only the long row
+        assert_eq!(solves, vec![13, 1, 1, 1], "solves per call");
+        assert_eq!(store.len(), 12, "one kept unit solve per node dof");
+        // a budget below one unit solve: nothing is kept, the columns are still right
+        let small = BlockSolveStore::with_budget(8);
+        small.set_unit_solves(true);
+        let rows = node_rows(0.3);
+        let mut columns = vec![None; rows.nrows()];
+        let all: Vec<usize> = (0..rows.nrows()).collect();
+        op.view().interface_columns(RowStack::new(&rows, None), &all, &mut columns, &small).expect("columns");
+        check(&rows, &columns);
+        assert!(small.bytes() <= 8);
     }
 }

@@ -134,6 +134,7 @@ impl Pdas {
         trace
     }
 
+    #[tracing::instrument(level = "debug", skip_all)]
     fn iterate(
         &self,
         problem: &ContactProblem<'_>,

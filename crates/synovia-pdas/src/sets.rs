@@ -147,6 +147,7 @@ pub(crate) fn check_params(params: &ContactParams) -> Result<(), ContactError> {
 impl<'p> State<'p> {
     /// Validates the problem and parameters, detects empty rows (an empty normal row with
     /// `d_r < 0` is infeasible) and computes `w` (one solve).
+    #[tracing::instrument(level = "debug", skip_all)]
     pub fn new(
         problem: &ContactProblem<'p>,
         context: &'p SolveContext,
@@ -424,6 +425,7 @@ impl<'p> State<'p> {
     }
 
     /// `y = w − S ν`.
+    #[tracing::instrument(level = "debug", skip_all)]
     pub fn values(&mut self, nu: &[f64]) -> Result<Vec<f64>, ContactError> {
         let y = self.iface.interface_values(nu)?;
         self.update_rho(nu)?;
@@ -462,6 +464,7 @@ impl<'p> State<'p> {
     /// [`Unknown::Direction`] unknowns (zero otherwise). The matrix is symmetric positive
     /// (semi-)definite; it is factorised by Cholesky and a failed or tiny pivot is reported as
     /// [`ContactError::Singular`].
+    #[tracing::instrument(level = "debug", skip_all)]
     pub fn solve_step(
         &mut self,
         mut nu: Vec<f64>,

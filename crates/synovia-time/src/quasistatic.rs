@@ -217,6 +217,8 @@ pub struct QuasiStaticStepper<const D: usize> {
     laws: PairFrictionLaws,
     /// Slip rate `|[u'_t]|` per contact node of the last level (0 at step 0).
     slip_rate: Vec<Real>,
+    /// Whether each level's record carries the strain energy (an element loop per level).
+    record_strain_energy: bool,
 }
 
 impl<const D: usize> QuasiStaticStepper<D> {
@@ -408,6 +410,15 @@ impl<const D: usize> QuasiStaticStepper<D> {
         self.level(model, t, solver, Some(warm))
     }
 
+    /// Whether the records of the following levels carry the strain energy (default `true`).
+    /// Computing it is an element loop per level, as costly as a contact solve on a large
+    /// model; trial solves whose records are discarded (force control, docs/model.md §10)
+    /// switch it off and compute it once for the accepted level. Off, a record's
+    /// `strain_energy` is `0`.
+    pub fn set_record_strain_energy(&mut self, on: bool) {
+        self.record_strain_energy = on;
+    }
+
     /// The state of the sequence (last level's solution, slip rates, step counter, time,
     /// dissipation), to try a level and go back ([`QuasiStaticStepper::rollback`]): e.g. the
     /// trial solves of a force-controlled rigid body, each from the same previous level.
@@ -486,12 +497,14 @@ impl<const D: usize> QuasiStaticStepper<D> {
             next_step: 0,
             last_time: None,
             cumulative: 0.0,
+            record_strain_energy: true,
         }
     }
 
     /// One level at `t`: the next level of the current sequence (`restart = None`; step 0 if
     /// there is none), or step 0 of a new sequence warm-started from the given solution
     /// (`restart = Some(warm)`). Commits the state only on success.
+    #[tracing::instrument(level = "debug", skip_all)]
     fn level(
         &mut self,
         model: &Model<D>,
@@ -543,7 +556,11 @@ impl<const D: usize> QuasiStaticStepper<D> {
         let dissipation =
             friction_dissipation(geometry, &result, previous.map(|p| p.displacement.as_slice()))?;
         let cumulative = base + dissipation;
-        let strain_energy = body_fields(model, &result.displacement)?.iter().map(|f| f.strain_energy).sum();
+        let strain_energy = if self.record_strain_energy {
+            body_fields(model, &result.displacement)?.iter().map(|f| f.strain_energy).sum()
+        } else {
+            0.0
+        };
         let record = StepRecord {
             step,
             time: t,

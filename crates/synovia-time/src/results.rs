@@ -150,6 +150,7 @@ pub struct RigidRecord {
 
 /// Computes the pair records of a contact solution, with the sides of the pairs that have a
 /// reporting split ([`ContactGeometry::report_splits`]).
+#[tracing::instrument(level = "debug", skip_all)]
 pub fn pair_records<const D: usize>(
     geometry: &ContactGeometry<D>,
     result: &StaticContactResult<D>,

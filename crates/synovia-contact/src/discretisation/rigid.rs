@@ -7,8 +7,9 @@
 
 use std::sync::Arc;
 
+use rayon::prelude::*;
 use synovia_fem::BodyId;
-use synovia_mesh::math::Real;
+use synovia_mesh::math::{Real, Vector};
 
 use super::{ContactDiscretisation, ContactRow, PairContext};
 use crate::error::ContactError;
@@ -48,11 +49,11 @@ impl<const D: usize> ContactDiscretisation<D> for RigidObstacle<D> {
     fn rows(&self, cx: &PairContext<'_, D>) -> Result<Vec<ContactRow<D>>, ContactError> {
         self.obstacle.validate().map_err(|m| cx.invalid(format!("obstacle: {m}")))?;
         let pos_k = cx.positions(cx.body()).ok_or_else(|| cx.invalid("unknown body"))?;
+        // the obstacle queries (closest points on a surface) are independent per node
+        let queries: Vec<(Real, Vector<D>)> =
+            cx.normals().par_iter().map(|&(i, _)| self.obstacle.distance_and_gradient(&pos_k[i])).collect();
         let mut rows = Vec::with_capacity(cx.normals().len());
-        for &(i, nk) in cx.normals() {
-            let x = pos_k[i];
-            let phi = self.obstacle.distance(&x);
-            let grad = self.obstacle.gradient(&x);
+        for (&(i, nk), &(phi, grad)) in cx.normals().iter().zip(&queries) {
             let gl = grad.norm();
             if !(phi.is_finite() && gl.is_finite() && gl > 0.0) {
                 return Err(cx.invalid(format!("obstacle distance or gradient not finite/zero at node {i}")));
