@@ -35,11 +35,12 @@
 //! The stiffness is factorised once: a pose changes only the contact rows and gaps (rigid
 //! contact partners) and the prescribed displacements (tied parts). The force-controlled
 //! degrees of freedom are found by a Newton iteration on `r(q) = Q(q) + F` around the contact
-//! solve (Broyden updates of a finite-difference Jacobian, bracketed bisection for a single
-//! degree of freedom), in which the contact geometry is built at a pose and the gaps follow the
-//! motion to first order (`d_r(q) = d_r(q₀) + n_r · v_k(x_r) (q_k − q₀_k)`, the rows and the
-//! Schur columns kept); once the motion from that pose exceeds the geometry tolerance, the
-//! geometry is rebuilt at the new pose and the iteration continues. The level is accepted
+//! solve (a finite-difference Jacobian of the affine piece at the iterate, carried between levels
+//! with Broyden updates; bracketed secant steps for a single degree of freedom), in which the
+//! contact geometry is built at a pose and the gaps follow the motion to first order
+//! (`d_r(q) = d_r(q₀) + n_r · v_k(x_r) (q_k − q₀_k)`, the rows and the Schur columns kept); an
+//! iterate farther than the geometry tolerance from that pose gets the geometry rebuilt there
+//! (docs/model.md §10). The level is accepted
 //! when `|r_k| ≤ tolerance × scale` for every force-controlled degree of freedom
 //! ([`ForceControlParams`]).
 //!
@@ -468,7 +469,8 @@ pub struct ForceControlParams {
     /// size) before the geometry is rebuilt.
     pub geometry_tolerance: Real,
     /// Several force-controlled coordinates: a finite-difference Jacobian at every accepted
-    /// iterate (`true`) instead of Broyden updates (`false`, default).
+    /// iterate (`true`) instead of Broyden updates with a fresh one when a step did not reduce
+    /// the error fourfold (`false`, default).
     pub fresh_jacobian: bool,
 }
 
@@ -707,12 +709,17 @@ impl RigidDriver {
             // a Jacobian that did not reduce the error fourfold is refreshed (the residual is
             // piecewise affine: a contact region that lifts off or closes changes its slope);
             // otherwise it is updated by Broyden's formula (the secant in one unknown)
+            // (one unknown: always the secant, the bracket keeps it safe)
             match (&mut jac, &previous) {
-                (Some(_), Some((_, _, ep))) if error > 0.25 * ep && !fresh => jac = None,
+                (Some(_), Some((_, _, ep))) if error > 0.25 * ep && !fresh && unknowns.len() > 1 => jac = None,
                 (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
                 _ => {}
             }
             fresh = false;
+            // a secant update without slope (the residual did not change): a fresh Jacobian
+            if jac.as_ref().is_some_and(|j| newton_step(j, &r).is_none()) {
+                jac = None;
+            }
             if jac.is_none() {
                 match self.fd_jacobian(&cx, stepper, &linear, &geometry, &z, &r, &target, length, &mut solves)
                 {
