@@ -706,12 +706,14 @@ impl RigidDriver {
                     }
                 }
             }
-            // a Jacobian that did not reduce the error fourfold is refreshed (the residual is
-            // piecewise affine: a contact region that lifts off or closes changes its slope);
-            // otherwise it is updated by Broyden's formula (the secant in one unknown)
-            // (one unknown: always the secant, the bracket keeps it safe)
+            // several unknowns: a Jacobian that did not reduce the error fourfold is refreshed
+            // (the residual is piecewise affine: a contact region that lifts off or closes
+            // changes its slope); otherwise, and always for one unknown (the secant, kept safe
+            // by the bracket), it is updated by Broyden's formula
             match (&mut jac, &previous) {
-                (Some(_), Some((_, _, ep))) if error > 0.25 * ep && !fresh && unknowns.len() > 1 => jac = None,
+                (Some(_), Some((_, _, ep))) if error > 0.25 * ep && !fresh && unknowns.len() > 1 => {
+                    jac = None
+                }
                 (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
                 _ => {}
             }
