@@ -76,6 +76,7 @@ fn main() -> Result<(), Error> {
     }
     let fine = std::env::args().any(|a| a == "--fine");
     let free_adduction = std::env::args().any(|a| a == "--free-adduction");
+    let free_ml = std::env::args().any(|a| a == "--free-ml");
     let out = std::env::args().skip_while(|a| a != "--out").nth(1).unwrap_or_else(|| {
         if fine {
             "out/tkr3d_fine".into()
@@ -90,6 +91,9 @@ fn main() -> Result<(), Error> {
     let uhmwpe = isotropic(UHMWPE.0, UHMWPE.1)?;
     joint.add_gmsh_bodies(format!("{DATA}/mesh/{mesh_file}"), |_| Some(uhmwpe.clone().into()))?;
     joint.clamp("insert", "tray")?;
+    // the contact candidates: every upward-facing facet above the tray (the meshes' `articular`
+    // part starts at y = 6 mm and misses the bottom of the dishes, at 5.9 mm; docs/meshing.md)
+    joint.define_part("insert", "contact", |x, n| n[1] > 0.5 && x[1] > 1.0)?;
 
     // the femoral component: rigid, bounded by its closed surface (metres → mm)
     let femur_surface = read_stl(format!("{DATA}/femoral_component.stl"))?.scaled(1000.0)?;
@@ -103,11 +107,16 @@ fn main() -> Result<(), Error> {
     let femur = RigidBody::<3>::new("femur", Point::<3>::zeros())?
         .with_rotation_order("zxy")?
         .prescribe(0, column("knee_ant_r", 1000.0)?)?
-        .force_with_guess(1, down, column("knee_sup_r", 1000.0)?)?
-        .prescribe(2, column("knee_lat_r", 1000.0)?)?;
+        .force_with_guess(1, down, column("knee_sup_r", 1000.0)?)?;
+    // column 4: the medial–lateral translation, prescribed as measured; with `--free-ml` free
+    // under zero force (a load-controlled knee simulator leaves it free)
+    let femur = if free_ml {
+        femur.force_with_guess(2, Constant(0.0), column("knee_lat_r", 1000.0)?)?
+    } else {
+        femur.prescribe(2, column("knee_lat_r", 1000.0)?)?
+    };
     // column 5: ab/adduction (rotation about the anterior axis), prescribed as measured; with
-    // `--free-adduction` free under zero moment about the femoral origin (experimental: the
-    // two-unknown iteration is slow and fails at some poses, docs/tkr3d.md)
+    // `--free-adduction` free under zero moment about the femoral origin (docs/tkr3d.md)
     let femur = if free_adduction {
         femur.force_with_guess(3, Constant(0.0), column("knee_flex_r", 1.0)?)?
     } else {
@@ -118,7 +127,7 @@ fn main() -> Result<(), Error> {
         .prescribe(5, column("knee_rot_r", 1.0)?)?; // column 7: rotation about z
     let measured_si = column("knee_sup_r", 1000.0)?;
     joint.add_rigid_body(femur)?;
-    joint.contact_rigid_body("femur-insert", "insert", "articular", "femur", shape, 0.0)?;
+    joint.contact_rigid_body("femur-insert", "insert", "contact", "femur", shape, 0.0)?;
     joint.search_distance("femur-insert", SEARCH_DISTANCE)?;
     // medial (−z, right knee) and lateral (+z) sides of the insert
     joint.split_pair_report(
@@ -130,7 +139,7 @@ fn main() -> Result<(), Error> {
     if let Some(tol) = std::env::args().skip_while(|a| a != "--geometry-tolerance").nth(1) {
         control.geometry_tolerance = tol.parse()?;
     }
-    if free_adduction {
+    if free_adduction || free_ml {
         control.fresh_jacobian = true;
         control.max_solves = 200;
     }

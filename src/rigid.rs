@@ -642,6 +642,8 @@ impl RigidDriver {
         let mut accepted: Option<(Vec<Real>, Vec<Real>, Real)> = None;
         let mut backtracks = 0;
         let mut previous: Option<(Vec<Real>, Vec<Real>, Real)> = None;
+        // several unknowns: the walk along the null direction of a rank-deficient Jacobian
+        let mut walk: Option<NullWalk> = None;
         stepper.set_record_strain_energy(false);
         let outcome = loop {
             if solves >= params.max_solves {
@@ -678,6 +680,21 @@ impl RigidDriver {
                 }
                 previous = None;
                 continue;
+            }
+            if let Some(w) = walk.take() {
+                let phi = w.component(&r, &scales);
+                if (phi - w.phi0).abs() <= 0.01 * w.phi0.abs() && w.doublings < 12 {
+                    // nothing new resists the motion yet: twice as far
+                    let next = w.doubled();
+                    z = next.at();
+                    walk = Some(next);
+                    continue;
+                }
+                // a new contact region took load: Newton from here with a fresh Jacobian
+                jac = None;
+                previous = None;
+                accepted = None;
+                backtracks = 0;
             }
             if unknowns.len() == 1 {
                 bracket.update(z[0], r[0]);
@@ -737,6 +754,22 @@ impl RigidDriver {
             };
             previous = Some((z.clone(), r.clone(), error));
             let mut next: Vec<Real> = z.iter().zip(&dz).map(|(a, d)| a + d).collect();
+            if unknowns.len() > 1 && fresh && step_capped::<D>(&next, &z, &unknowns, length) {
+                if let Some(w) = jac
+                    .as_ref()
+                    .and_then(|j| NullWalk::start::<D>(j, &z, &r, &scales, &unknowns, length, &linear))
+                {
+                    // one contact region resists a combination of the unknowns only (e.g. one
+                    // condyle: force and moment from one contact force): move along the
+                    // direction it does not resist, toward the net generalised force, until
+                    // another region takes load (docs/model.md §10)
+                    tracing::debug!(t, ?w.direction, w.alpha, "force control: walk along the null direction");
+                    z = w.at();
+                    walk = Some(w);
+                    previous = None;
+                    continue;
+                }
+            }
             limit_step::<D>(&mut next, &z, &unknowns, length);
             if let (Some((lo, hi)), 1) = (bracket.interval(), unknowns.len()) {
                 if !(next[0] > lo && next[0] < hi) {
@@ -1162,5 +1195,91 @@ fn limit_step<const D: usize>(next: &mut [Real], z: &[Real], unknowns: &[(usize,
     for ((n, zj), &(_, k)) in next.iter_mut().zip(z).zip(unknowns) {
         let cap = if k < D { 0.02 * length } else { 0.02 };
         *n = zj + (*n - zj).clamp(-cap, cap);
+    }
+}
+
+/// `true` if the step from `z` to `next` exceeds the caps of [`limit_step`].
+fn step_capped<const D: usize>(next: &[Real], z: &[Real], unknowns: &[(usize, usize)], length: Real) -> bool {
+    next.iter().zip(z).zip(unknowns).any(|((n, zj), &(_, k))| {
+        let cap = if k < D { 0.02 * length } else { 0.02 };
+        (n - zj).abs() > cap
+    })
+}
+
+/// A walk from `base` along `direction` (the right singular vector of the scaled Jacobian's
+/// smallest singular value, signed so that the net generalised force does positive work on
+/// it), by `alpha` doubled at every trial, until the residual's component `phi` along the
+/// matching left singular vector changes: a new contact region took load.
+#[derive(Debug, Clone)]
+struct NullWalk {
+    base: Vec<Real>,
+    direction: Vec<Real>,
+    alpha: Real,
+    left: Vec<Real>,
+    phi0: Real,
+    doublings: usize,
+    /// The largest `alpha` (10 % of the model size).
+    reach: Real,
+}
+
+impl NullWalk {
+    /// The walk at the iterate `z` with residual `r`, if the Jacobian `j` in scaled variables
+    /// (`r_i / scale_i`, lengths and angles × model size) has a singular value below 1 % of
+    /// the largest; the first step closes the nearest open gap that the direction closes (at
+    /// least 10⁻⁴, at most 2·10⁻² of the model size).
+    #[allow(clippy::too_many_arguments)]
+    fn start<const D: usize>(
+        j: &nalgebra::DMatrix<Real>,
+        z: &[Real],
+        r: &[Real],
+        scales: &[Real],
+        unknowns: &[(usize, usize)],
+        length: Real,
+        linear: &LinearGaps,
+    ) -> Option<Self> {
+        let m = z.len();
+        let w: Vec<Real> = unknowns.iter().map(|&(_, k)| if k < D { 1.0 } else { length }).collect();
+        let scaled = nalgebra::DMatrix::from_fn(m, m, |a, b| j[(a, b)] / scales[a] / w[b]);
+        let svd = scaled.svd(true, true);
+        let (u, vt) = (svd.u?, svd.v_t?);
+        let (mut kmin, mut smax) = (0, 0.0_f64);
+        for (k, &sv) in svd.singular_values.iter().enumerate() {
+            smax = smax.max(sv);
+            if sv < svd.singular_values[kmin] {
+                kmin = k;
+            }
+        }
+        if !(smax > 0.0 && svd.singular_values[kmin] < 1e-2 * smax) {
+            return None;
+        }
+        let mut direction: Vec<Real> = (0..m).map(|b| vt[(kmin, b)] / w[b]).collect();
+        let work: Real = r.iter().zip(&direction).map(|(ri, di)| ri * di).sum();
+        if work < 0.0 {
+            direction.iter_mut().for_each(|d| *d = -*d);
+        }
+        let left: Vec<Real> = (0..m).map(|a| u[(a, kmin)]).collect();
+        // the nearest open gap the direction closes (first order, undeformed)
+        let gaps = linear.at(z);
+        let mut alpha = 0.02 * length;
+        for (g, sens) in gaps.iter().zip(&linear.sens) {
+            let rate: Real = sens.iter().zip(&direction).map(|(s, d)| s * d).sum();
+            if *g > 0.0 && rate < 0.0 {
+                alpha = alpha.min(g / -rate);
+            }
+        }
+        let alpha = alpha.max(1e-4 * length);
+        let mut walk =
+            Self { base: z.to_vec(), direction, alpha, left, phi0: 0.0, doublings: 0, reach: 0.1 * length };
+        walk.phi0 = walk.component(r, scales);
+        Some(walk)
+    }
+    fn component(&self, r: &[Real], scales: &[Real]) -> Real {
+        r.iter().zip(scales).zip(&self.left).map(|((ri, s), l)| ri / s * l).sum()
+    }
+    fn at(&self) -> Vec<Real> {
+        self.base.iter().zip(&self.direction).map(|(b, d)| b + self.alpha * d).collect()
+    }
+    fn doubled(self) -> Self {
+        Self { alpha: (2.0 * self.alpha).min(self.reach), doublings: self.doublings + 1, ..self }
     }
 }

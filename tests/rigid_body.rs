@@ -108,3 +108,71 @@ fn unresisted_force_is_refused() -> Result<(), Box<dyn std::error::Error>> {
     assert!(msg.contains("`indenter`.tx") && msg.contains("not resisted"), "{msg}");
     Ok(())
 }
+
+/// Two discs of one rigid body (a 2D "femur" with two condyles), pushed down with a force and
+/// free to rotate under zero moment, start tilted so that one disc alone touches: one contact
+/// region resists only one combination of translation and rotation (the Jacobian is of rank
+/// one), and the iteration walks along the other until the second disc takes load. By symmetry
+/// the equilibrium is level with the force shared equally (up to the mesh, whose triangles all
+/// have their diagonal the same way: not mirror-symmetric).
+#[test]
+fn two_condyles_free_to_rotate_share_the_force() -> Result<(), Box<dyn std::error::Error>> {
+    #[derive(Debug)]
+    struct TwoDiscs {
+        centres: [Point<2>; 2],
+        radius: f64,
+    }
+    impl TwoDiscs {
+        fn nearest(&self, x: &Point<2>) -> (f64, Vector<2>) {
+            let [a, b] = self.centres.map(|c| {
+                let d = x - c;
+                (d.norm() - self.radius, d / d.norm())
+            });
+            if a.0 <= b.0 {
+                a
+            } else {
+                b
+            }
+        }
+    }
+    impl synovia::contact_ops::operators::SignedDistance<2> for TwoDiscs {
+        fn distance(&self, x: &Point<2>) -> f64 {
+            self.nearest(x).0
+        }
+        fn gradient(&self, x: &Point<2>) -> Vector<2> {
+            self.nearest(x).1
+        }
+    }
+    let mesh = rectangle(-1.0, 1.0, 0.0, 1.0, 32, 8, Grading::Uniform, Grading::Uniform)?;
+    let mut joint = JointModel::<2>::new();
+    joint.add_body("block", mesh, plane_strain(1.0e3, 0.3)?)?;
+    joint.clamp("block", "bottom")?;
+    let centre = Point::<2>::new(0.0, 1.5);
+    let rz = RigidBody::<2>::dof_index("rz")?;
+    let femur = RigidBody::<2>::new("femur", centre)?
+        .force(1, Constant(-4.0))?
+        // zero moment about the centre, started tilted by 0.02 rad: the right disc sinks by
+        // 0.01, the left one lifts by 0.01
+        .force_with_guess(rz, Constant(0.0), Constant(-0.02))?;
+    joint.add_rigid_body(femur)?;
+    let shape =
+        Arc::new(TwoDiscs { centres: [Point::<2>::new(-0.5, 1.3), Point::<2>::new(0.5, 1.3)], radius: 0.3 });
+    joint.contact_rigid_body("condyles", "block", "top", "femur", shape, 0.0)?;
+    joint.search_distance("condyles", 0.5)?;
+    joint.split_pair_report(
+        "condyles",
+        synovia::contact_ops::operators::PairSplit::new("right", "left", [0.0; 3], [1.0, 0.0, 0.0])?,
+    )?;
+    let mut session = joint.prepare()?;
+    let report = session.solve_static(0.0)?;
+    assert!(report.kkt < 1e-8);
+    let rec = session.record().ok_or("no record")?;
+    let rigid = &rec.rigid[0];
+    assert!(rigid.balance_error < 1e-9, "{rigid:?}");
+    assert!(rigid.dofs[rz].abs() < 1e-3, "nearly level: {rigid:?}");
+    let side = |name: &str| rec.pairs[0].sides.iter().find(|s| s.name == name).map(|s| -s.force[1]);
+    let (left, right) = (side("left").ok_or("no left side")?, side("right").ok_or("no right side")?);
+    assert!((left - 2.0).abs() < 0.02 && (right - 2.0).abs() < 0.02, "left {left}, right {right}");
+    assert!((left + right - 4.0).abs() < 1e-9, "left {left}, right {right}");
+    Ok(())
+}
