@@ -322,12 +322,7 @@ pub(crate) fn cholesky_interface_columns(
         if kept.unit_solves() {
             return whole_factor_unit_columns(op, rows, &missing, columns, kept);
         }
-        let computed = in_two_halves(&missing, true, |cols| columns_by_solves(op, rows, cols))?;
-        let solved = computed.len();
-        for (j, col) in computed {
-            columns[j] = Some(col);
-        }
-        return Ok(solved);
+        return solve_columns_into(op, rows, &missing, columns);
     };
     let mut solved = 0;
     let (inside, mut outside): (Vec<usize>, Vec<usize>) = missing.iter().partition(|&&j| mapped[j].is_some());
@@ -335,11 +330,7 @@ pub(crate) fn cholesky_interface_columns(
         outside = (0..mapped.len()).filter(|&j| mapped[j].is_none() && columns[j].is_none()).collect();
     }
     if !outside.is_empty() {
-        let computed = in_two_halves(&outside, true, |cols| columns_by_solves(op, rows, cols))?;
-        solved += computed.len();
-        for (j, col) in computed {
-            columns[j] = Some(col);
-        }
+        solved += solve_columns_into(op, rows, &outside, columns)?;
     }
     if inside.is_empty() {
         return Ok(solved);
@@ -419,6 +410,22 @@ pub(crate) fn cholesky_interface_columns(
 /// Rows with at most this many entries in the trailing block are combined from unit solves.
 const UNIT_SPLIT: usize = 3;
 
+/// The columns `cols` of `S` by whole solves (two halves in parallel), stored in `columns`;
+/// returns the number of solves.
+fn solve_columns_into(
+    op: &CholeskyOperator<'_>,
+    rows: RowStack<'_>,
+    cols: &[usize],
+    columns: &mut [Option<Vec<f64>>],
+) -> Result<usize, LinalgError> {
+    let computed = in_two_halves(cols, true, |c| columns_by_solves(op, rows, c))?;
+    let solved = computed.len();
+    for (j, col) in computed {
+        columns[j] = Some(col);
+    }
+    Ok(solved)
+}
+
 /// The columns `missing` of `S = C A⁻¹ Cᵀ` with the whole factor, rows on at most
 /// [`UNIT_SPLIT`] dofs from kept unit solves: `x_p = P A⁻¹ e_p` restricted to the interface
 /// dofs `P` (the union of the rows' dofs), `S_ij = Σ_{(q,w) ∈ c_i} w Σ_{(p,v) ∈ c_j} v x_p[q]`.
@@ -469,11 +476,7 @@ fn whole_factor_unit_columns(
         missing.iter().partition(|&&j| row_positions[j].len() <= UNIT_SPLIT);
     let mut solved = 0;
     if !many.is_empty() {
-        let computed = in_two_halves(&many, true, |cols| columns_by_solves(op, rows, cols))?;
-        solved += computed.len();
-        for (j, col) in computed {
-            columns[j] = Some(col);
-        }
+        solved += solve_columns_into(op, rows, &many, columns)?;
     }
     if few.is_empty() {
         return Ok(solved);
