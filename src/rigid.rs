@@ -652,7 +652,11 @@ impl RigidDriver {
             // the geometry at the pose `z` once it moved beyond the tolerance from the pose it
             // was built at: the gaps of `linear` are exact to first order only
             if posed_pairs && moved(&z, &linear.base) > geometry_tolerance {
-                (geometry, linear) = self.linearise(joint, stepper, &unknowns, &z, posed_pairs)?;
+                // (errors leave the loop by `break`, so the stepper records energies again)
+                match self.linearise(joint, stepper, &unknowns, &z, posed_pairs) {
+                    Ok(built) => (geometry, linear) = built,
+                    Err(e) => break Err(e),
+                }
             }
             let ((record, result), reactions) =
                 match self.trial(&cx, stepper, &linear, &geometry, &z, &mut solves) {
@@ -1193,17 +1197,24 @@ impl Bracket {
 /// Limits a step to 2 % of the model size (translations) or 0.02 rad (rotations).
 fn limit_step<const D: usize>(next: &mut [Real], z: &[Real], unknowns: &[(usize, usize)], length: Real) {
     for ((n, zj), &(_, k)) in next.iter_mut().zip(z).zip(unknowns) {
-        let cap = if k < D { 0.02 * length } else { 0.02 };
+        let cap = step_cap::<D>(k, length);
         *n = zj + (*n - zj).clamp(-cap, cap);
     }
 }
 
 /// `true` if the step from `z` to `next` exceeds the caps of [`limit_step`].
 fn step_capped<const D: usize>(next: &[Real], z: &[Real], unknowns: &[(usize, usize)], length: Real) -> bool {
-    next.iter().zip(z).zip(unknowns).any(|((n, zj), &(_, k))| {
-        let cap = if k < D { 0.02 * length } else { 0.02 };
-        (n - zj).abs() > cap
-    })
+    next.iter().zip(z).zip(unknowns).any(|((n, zj), &(_, k))| (n - zj).abs() > step_cap::<D>(k, length))
+}
+
+/// The largest step of degree of freedom `k`: 2 % of the model size (translations) or
+/// 0.02 rad (rotations).
+fn step_cap<const D: usize>(k: usize, length: Real) -> Real {
+    if k < D {
+        0.02 * length
+    } else {
+        0.02
+    }
 }
 
 /// A walk from `base` along `direction` (the right singular vector of the scaled Jacobian's
