@@ -84,7 +84,7 @@ fn main() -> Result<(), Error> {
             "out/tkr3d".into()
         }
     });
-    let mesh_file = if fine { "tibial_insert_h05.msh" } else { "tibial_insert_h1.msh" };
+    let mesh_file = if fine { "tibial_insert_h05.msh.gz" } else { "tibial_insert_h1.msh" };
 
     // the insert
     let mut joint = JointModel::<3>::new();

@@ -202,7 +202,8 @@ pub struct GmshMesh {
     pub element_blocks: Vec<ElementBlock>,
 }
 
-/// Reads a Gmsh `.msh` file (MSH 4.1 or 2.2, ASCII or binary).
+/// Reads a Gmsh `.msh` file (MSH 4.1 or 2.2, ASCII or binary), also gzip-compressed
+/// (`.msh.gz`, recognised by its content).
 ///
 /// # Errors
 /// [`IoError::Io`] if the file cannot be read, [`IoError::MshVersion`] for other versions,
@@ -707,7 +708,34 @@ struct Parser<'a> {
     block_pos: Vec<usize>,
 }
 
+/// The largest decompressed size of a gzip-compressed `.msh` file (a guard against inputs
+/// that expand without bound).
+const MAX_DECOMPRESSED_BYTES: u64 = 1 << 30;
+
+/// `bytes`, or their gzip decompression if they start with the gzip magic `1f 8b` (a
+/// `.msh.gz` file; MSH itself starts with `$MeshFormat`).
+fn decompressed<'a>(bytes: &'a [u8], path: &Path) -> Result<std::borrow::Cow<'a, [u8]>, IoError> {
+    use std::io::Read;
+    if !bytes.starts_with(&[0x1f, 0x8b]) {
+        return Ok(std::borrow::Cow::Borrowed(bytes));
+    }
+    let mut out = Vec::new();
+    flate2::read::MultiGzDecoder::new(bytes)
+        .take(MAX_DECOMPRESSED_BYTES + 1)
+        .read_to_end(&mut out)
+        .map_err(|e| IoError::parse(path, format!("gzip-compressed mesh: {e}")))?;
+    if out.len() as u64 > MAX_DECOMPRESSED_BYTES {
+        return Err(IoError::parse(
+            path,
+            format!("gzip-compressed mesh expands beyond {MAX_DECOMPRESSED_BYTES} bytes"),
+        ));
+    }
+    Ok(std::borrow::Cow::Owned(out))
+}
+
 fn parse_with_path(bytes: &[u8], path: &Path) -> Result<GmshMesh, IoError> {
+    let bytes = decompressed(bytes, path)?;
+    let bytes: &[u8] = &bytes;
     let mut p = Parser {
         r: Reader::new(bytes),
         version: None,
