@@ -48,7 +48,6 @@ use synovia_contact::{
     ContactError, ContactParams, ContactSolution, ContactSolver, FrictionLaw, KktReport, StaticContact,
     StaticContactResult,
 };
-use synovia_fem::post::body_fields;
 use synovia_fem::{BodyId, ComponentMask, ElasticParams, ElasticSolver, FemError, Model};
 use synovia_io::IoError;
 use synovia_material::{KelvinVoigt, LinearElastic, Material, MaterialError};
@@ -1215,8 +1214,7 @@ impl<const D: usize> JointModel<D> {
         for (step, &time) in times.iter().enumerate() {
             let t0 = Instant::now();
             let sol = elastic.solve(&self.model, time)?;
-            let strain_energy =
-                body_fields(&self.model, &sol.displacement)?.iter().map(|f| f.strain_energy).sum();
+            let strain_energy = synovia_fem::post::total_strain_energy(&self.model, &sol.displacement)?;
             let record = StepRecord {
                 step,
                 time,

@@ -795,10 +795,7 @@ impl RigidDriver {
         let Some((_, (mut record, result))) = best.take() else {
             return Err(JointError::Invalid("internal: no solve".into()));
         };
-        record.strain_energy = synovia_fem::post::body_fields(model, &result.displacement)?
-            .iter()
-            .map(|f| f.strain_energy)
-            .sum();
+        record.strain_energy = synovia_fem::post::total_strain_energy(model, &result.displacement)?;
         let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
         Ok((record, result))
     }

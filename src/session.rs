@@ -39,7 +39,6 @@ use std::time::Instant;
 
 use synovia_contact::operators::ContactGeometry;
 use synovia_contact::{ContactSolver, StaticContact, StaticContactResult};
-use synovia_fem::post::body_fields;
 use synovia_fem::{ElasticInfo, ElasticSolver, Model};
 use synovia_mesh::math::{Real, Vector};
 use synovia_time::quasistatic::QuasiStaticStepper;
@@ -252,7 +251,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
         };
         let level = if restart || result.is_none() { 0 } else { *step + 1 };
         let sol = solver.solve(model, t)?;
-        let strain_energy = body_fields(model, &sol.displacement)?.iter().map(|f| f.strain_energy).sum();
+        let strain_energy = synovia_fem::post::total_strain_energy(model, &sol.displacement)?;
         let record = StepRecord {
             step: level,
             time: t,

@@ -62,6 +62,18 @@ pub fn principal_stresses(voigt: &[Real], sigma_zz: Real) -> [Real; 3] {
     p
 }
 
+/// The strain energy of all bodies, `Σ_bodies ½ ∫ ε : C ε` ([`BodyFields::strain_energy`]
+/// summed over [`body_fields`]).
+///
+/// # Errors
+/// As [`body_fields`].
+pub fn total_strain_energy<const D: usize>(
+    model: &Model<D>,
+    displacement: &[Vec<Vector<D>>],
+) -> Result<Real, FemError> {
+    Ok(body_fields(model, displacement)?.iter().map(|f| f.strain_energy).sum())
+}
+
 /// Computes the fields of every body from nodal displacements (`displacement[body][node]`).
 #[tracing::instrument(level = "debug", skip_all)]
 pub fn body_fields<const D: usize>(

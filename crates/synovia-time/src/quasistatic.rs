@@ -557,7 +557,7 @@ impl<const D: usize> QuasiStaticStepper<D> {
             friction_dissipation(geometry, &result, previous.map(|p| p.displacement.as_slice()))?;
         let cumulative = base + dissipation;
         let strain_energy = if self.record_strain_energy {
-            body_fields(model, &result.displacement)?.iter().map(|f| f.strain_energy).sum()
+            synovia_fem::post::total_strain_energy(model, &result.displacement)?
         } else {
             0.0
         };
