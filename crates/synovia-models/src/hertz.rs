@@ -71,7 +71,9 @@ pub struct ContactRun {
     pub pressure_l2_err: Real,
     /// Cattaneo–Mindlin only: `Q / (μ P)`.
     pub q_ratio: Real,
-    /// Cattaneo–Mindlin only: measured stick half-width.
+    /// Cattaneo–Mindlin only: measured stick half-width (2D: midway between the outermost
+    /// sticking node and the next slipping one; 3D: the stick radius of the moments of the stick
+    /// deficit, [`stick_radius_from_moments`]).
     pub c: Real,
     /// Cattaneo–Mindlin only: analytic stick half-width.
     pub c_exact: Real,
@@ -81,6 +83,9 @@ pub struct ContactRun {
     /// 3D only: the contact radius `sqrt(A_contact/π)` of the area of the nodes in contact
     /// (0 elsewhere).
     pub a_contact_area: Real,
+    /// 3D Cattaneo–Mindlin only: the stick radius of Mindlin's traction ratio fitted to the
+    /// nodal `‖Λ_t‖` ([`fit_stick_radius`]; 0 elsewhere).
+    pub c_fit: Real,
     /// Cattaneo–Mindlin only: relative L² error of the tangential traction.
     pub traction_l2_err: Real,
     /// Cattaneo–Mindlin only: `max (|q| − μ p)` over the contact nodes (≤ 0 up to round-off).
@@ -121,8 +126,8 @@ impl ContactRun {
         }
         if self.c_stick_area > 0.0 {
             s.push_str(&format!(
-                ",\"c_stick_area\":{:.6e},\"a_contact_area\":{:.6e}",
-                self.c_stick_area, self.a_contact_area
+                ",\"c_fit\":{:.6e},\"c_stick_area\":{:.6e},\"a_contact_area\":{:.6e}",
+                self.c_fit, self.c_stick_area, self.a_contact_area
             ));
         }
         s.push('}');
@@ -408,6 +413,7 @@ fn hertz_run<const D: usize>(
         c_exact: 0.0,
         c_stick_area: 0.0,
         a_contact_area: 0.0,
+        c_fit: 0.0,
         traction_l2_err: 0.0,
         coulomb_excess: 0.0,
         kkt: res.kkt.max(),
@@ -931,14 +937,19 @@ pub fn hertz3d_block(
 /// ```text
 /// a_Hertz = (3 P R*/(4 E*))^{1/3},  R* = R/2,  1/E* = 2 (1 − ν²)/E,     p₀ = 3P/(2π a²),
 /// c_exact = a_Hertz (1 − Q/(μP))^{1/3}                                    (Mindlin),
-/// c_FE    = Mindlin's traction ratio fitted to ‖Λ_t,r‖ = |q_r|/(μ p_r)   ([`fit_stick_radius`]),
+/// c       = sqrt(5/2 · Σ_r D_r ρ_r² / Σ_r D_r),  D_r = κ_r g_r (1 − ‖Λ_t,r‖)
+///                                                 ([`stick_radius_from_moments`], run.c),
+/// c_fit   = Mindlin's traction ratio fitted to ‖Λ_t,r‖ = |q_r|/(μ p_r)   ([`fit_stick_radius`]),
 /// c_area  = sqrt(A_stick / π),   A_stick = Σ_{stick cells} κ_r   (cells with ‖Λ_t‖ < 1 − 10⁻⁶),
 /// q(r)    = μ p₀ sqrt(1 − r²/a²) − (c/a) μ p₀ sqrt(1 − r²/c²)   (second term for r ≤ c),
 /// ```
 ///
 /// `a` (fit of the pressure, [`fit_elliptic`]), the relative L² error of `|q|` and the
-/// Coulomb check `max(|q| − μ p)`. `c_FE` uses every node in contact; `c_area` (the area of
-/// the dual cells of the sticking nodes) moves by whole cells and is reported beside it.
+/// Coulomb check `max(|q| − μ p)`. `D_r` is the stick deficit `μ p − |q|` of cell `r` as a
+/// force (`ρ_r` its distance from the axis): a sum of nodal forces, it needs neither `a` nor the
+/// nodal pressures `Λ_n = F_n/κ`, which alternate by a few per cent between the contact nodes
+/// with large and small dual cells of these bisection meshes; `c_fit` and `c_area` are built
+/// on those nodal values and are reported beside `c` (docs/contact.md).
 /// Mindlin's solution (uniform tangential displacement of the stick zone, traction parallel to
 /// the load) is exact for `ν = 0`; for `ν > 0` it neglects a small transverse traction.
 ///
@@ -1046,6 +1057,7 @@ pub fn cattaneo_mindlin_3d(
         let c_exact = a_exact * (1.0 - q1).cbrt();
         let (mut stick_area, mut num, mut den, mut excess) = (0.0, 0.0, 0.0, Real::NEG_INFINITY);
         let mut ratio_points = Vec::with_capacity(res.cell_node.len());
+        let mut deficit_points = Vec::with_capacity(res.cell_node.len());
         for c in 0..res.cell_node.len() {
             let (node, norm, q) = traction(&res, c);
             let w = geo.nodes[node].weight;
@@ -1056,6 +1068,8 @@ pub fn cattaneo_mindlin_3d(
             if res.solution.lambda_n[node] > 0.0 {
                 ratio_points.push((x, norm, w));
             }
+            // the stick deficit μ p − |q| of the cell as a force, κ g_c (1 − ‖Λ_t‖) (0 if it slips)
+            deficit_points.push((x, w * res.slip_bound[c] * (1.0 - norm)));
             let s1 = 1.0 - (x / a_exact).powi(2);
             let s2 = 1.0 - (x / c_exact).powi(2);
             let mut qe = if s1 > 0.0 { mu * p0_exact * s1.sqrt() } else { 0.0 };
@@ -1080,7 +1094,8 @@ pub fn cattaneo_mindlin_3d(
         run.iterations = iterations.get();
         run.coarse_iterations = normal.coarse_iterations;
         run.q_ratio = q1;
-        run.c = fit_stick_radius(&ratio_points, a_exact);
+        run.c = stick_radius_from_moments(&deficit_points);
+        run.c_fit = fit_stick_radius(&ratio_points, a_exact);
         run.c_stick_area = (stick_area / std::f64::consts::PI).sqrt();
         let contact_area: Real = geo
             .nodes
@@ -1097,6 +1112,25 @@ pub fn cattaneo_mindlin_3d(
         runs.push(run);
     }
     Ok(runs)
+}
+
+/// The stick radius `c` from the moments of the stick deficit `D = μ p − |q|`: for Mindlin's
+/// traction `D(ρ) = μ p₀ (c/a) sqrt(1 − ρ²/c²)` for `ρ ≤ c` and `0` in the slip annulus, so
+///
+/// ```text
+/// ∫ D dA = (2π/3) μ p₀ c³/a,   ∫ D ρ² dA = (4π/15) μ p₀ c⁵/a,   c² = (5/2) ∫ D ρ² dA / ∫ D dA,
+/// ```
+///
+/// independent of `a`, `p₀` and `μ`. `points` are `(ρ_r, D_r)`, `D_r` the deficit of cell `r` as a
+/// force (`κ_r (μ p_r − |q_r|)`, zero on slipping cells); the integrals become sums of nodal
+/// forces. Returns NaN unless `Σ D_r > 0`.
+pub fn stick_radius_from_moments(points: &[(Real, Real)]) -> Real {
+    let (m0, m2) = points.iter().fold((0.0, 0.0), |(m0, m2), &(rho, d)| (m0 + d, m2 + d * rho * rho));
+    if m0 > 0.0 {
+        (2.5 * m2 / m0).sqrt()
+    } else {
+        Real::NAN
+    }
 }
 
 /// The stick radius `c` of Mindlin's traction ratio fitted to the nodal ratios `φ_r = |q_r|/(μ p_r)`
@@ -1135,4 +1169,30 @@ pub fn fit_stick_radius(points: &[(Real, Real, Real)], a: Real) -> Real {
         }
     }
     0.5 * (lo + hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Mindlin's deficit on a fine polar grid (cell forces = deficit × cell area), with slipping
+    /// cells (zero deficit) out to `a`: the moments give `c` to the quadrature error.
+    #[test]
+    fn moments_recover_mindlin_stick_radius() {
+        let (a, p0, mu) = (0.1, 0.06, 0.3);
+        for c in [0.02, 0.05, 0.09] {
+            let (nr, nt) = (2000, 64);
+            let mut points = Vec::new();
+            for i in 0..nr {
+                let (r0, r1) = (a * i as Real / nr as Real, a * (i + 1) as Real / nr as Real);
+                let rho = 0.5 * (r0 + r1);
+                let area = std::f64::consts::PI * (r1 * r1 - r0 * r0) / nt as Real;
+                let d = mu * p0 * (c / a) * (1.0 - (rho / c).powi(2)).max(0.0).sqrt();
+                points.extend((0..nt).map(|_| (rho, d * area)));
+            }
+            let got = stick_radius_from_moments(&points);
+            assert!((got / c - 1.0).abs() < 1e-4, "c = {c}: got {got}");
+        }
+        assert!(stick_radius_from_moments(&[(0.01, 0.0)]).is_nan());
+    }
 }
