@@ -499,6 +499,9 @@ pub(crate) struct RigidDriver {
     /// `q_k − guess_k(t)` of the last level, per force-controlled coordinate with a guess.
     offset: Vec<Vec<Real>>,
     jacobian: Option<nalgebra::DMatrix<Real>>,
+    /// The coordinates of the last accepted level (the slip origin of friction against the
+    /// rigid bodies at the next quasi-static level).
+    accepted: Option<Vec<Vec<Real>>>,
 }
 
 type Level<const D: usize> = (StepRecord, StaticContactResult<D>);
@@ -555,7 +558,7 @@ fn cross(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
 impl RigidDriver {
     pub(crate) fn new<const D: usize>(joint: &JointModel<D>) -> Self {
         let zeros = || joint.rigid_bodies().iter().map(|_| vec![0.0; rigid_dofs(D)]).collect();
-        Self { q: zeros(), offset: zeros(), jacobian: None }
+        Self { q: zeros(), offset: zeros(), jacobian: None, accepted: None }
     }
 
     /// Forgets the force-controlled coordinates and the Jacobian.
@@ -615,9 +618,11 @@ impl RigidDriver {
             self.set_poses(joint);
             if posed_pairs {
                 stepper.contact_mut().rebuild_geometry(model, joint.pairs())?;
+                self.set_partner_motion(joint, stepper, mode)?;
             }
             let (record, result) = self.solve_once(joint, stepper, t, solver, mode, &mut solves)?;
             let record = self.finish(joint, stepper.geometry(), record, &result, &values, t, solves)?;
+            self.accepted = Some(self.q.clone());
             return Ok((record, result));
         }
         let params = joint.force_control_params();
@@ -638,12 +643,9 @@ impl RigidDriver {
         let mut z: Vec<Real> = unknowns.iter().map(|&(b, k)| self.q[b][k]).collect();
         let (mut geometry, mut linear) = self.linearise(joint, stepper, &unknowns, &z, posed_pairs)?;
         let mut bracket = Bracket::default();
-        // several unknowns: the last iterate that reduced the error, and backtracking
-        let mut accepted: Option<(Vec<Real>, Vec<Real>, Real)> = None;
-        let mut backtracks = 0;
         let mut previous: Option<(Vec<Real>, Vec<Real>, Real)> = None;
-        // several unknowns: the walk along the null direction of a rank-deficient Jacobian
-        let mut walk: Option<NullWalk> = None;
+        // several unknowns: the line search under way
+        let mut line: Option<LineSearch> = None;
         stepper.set_record_strain_energy(false);
         let outcome = loop {
             if solves >= params.max_solves {
@@ -663,8 +665,7 @@ impl RigidDriver {
                     Ok(v) => v,
                     Err(e) => break Err(e),
                 };
-            let mut r: Vec<Real> =
-                unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
+            let r: Vec<Real> = unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
             let error = r.iter().zip(&scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
             tracing::debug!(t, solves, ?z, ?r, error, "force-control trial");
             let converged = error <= params.tolerance;
@@ -683,62 +684,65 @@ impl RigidDriver {
                     Err(e) => break Err(e),
                 }
                 previous = None;
+                line = None;
                 continue;
             }
-            if let Some(w) = walk.take() {
-                let phi = w.component(&r, &scales);
-                if (phi - w.phi0).abs() <= 0.01 * w.phi0.abs() && w.doublings < 12 {
-                    // nothing new resists the motion yet: twice as far
-                    let next = w.doubled();
-                    z = next.at();
-                    walk = Some(next);
-                    continue;
-                }
-                // a new contact region took load: Newton from here with a fresh Jacobian
-                jac = None;
-                previous = None;
-                accepted = None;
-                backtracks = 0;
-            }
-            if unknowns.len() == 1 {
-                bracket.update(z[0], r[0]);
-            } else {
-                match &accepted {
-                    Some((za, ra, ea)) if error >= *ea => {
-                        if backtracks < 3 {
-                            // halve the step back toward the last good iterate
-                            z = za.iter().zip(&z).map(|(a, b)| a + 0.5 * (b - a)).collect();
-                            backtracks += 1;
-                            continue;
-                        }
-                        // a fresh finite-difference Jacobian at the last good iterate
-                        z = za.clone();
-                        r = ra.clone();
-                        jac = None;
-                        previous = None;
-                        backtracks = 0;
-                    }
-                    _ => {
-                        accepted = Some((z.clone(), r.clone(), error));
-                        backtracks = 0;
-                        if params.fresh_jacobian {
-                            jac = None;
-                        }
+            if unknowns.len() > 1 {
+                // several unknowns: line searches on the potential Π (docs/model.md §10)
+                if let Some(mut ls) = line.take() {
+                    let phi = -dot(&r, &ls.direction);
+                    if let Some(alpha) = ls.next_alpha(phi, error) {
+                        z = ls.at(alpha);
+                        line = Some(ls);
+                        continue;
                     }
                 }
-            }
-            // several unknowns: a Jacobian that did not reduce the error fourfold is refreshed
-            // (the residual is piecewise affine: a contact region that lifts off or closes
-            // changes its slope); otherwise, and always for one unknown (the secant, kept safe
-            // by the bracket), it is updated by Broyden's formula
-            match (&mut jac, &previous) {
-                (Some(_), Some((_, _, ep))) if error > 0.25 * ep && !fresh && unknowns.len() > 1 => {
-                    jac = None
+                // a Jacobian that did not reduce the error fourfold is refreshed (the residual
+                // is piecewise affine: a contact region that lifts off or closes changes its
+                // slope); otherwise it is updated by Broyden's formula
+                match (&mut jac, &previous) {
+                    (Some(_), Some((_, _, ep))) if (error > 0.25 * ep || params.fresh_jacobian) && !fresh => {
+                        jac = None
+                    }
+                    (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
+                    _ => {}
                 }
-                (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
-                _ => {}
+                fresh = false;
+                if jac.is_none() {
+                    match self.fd_jacobian(
+                        &cx,
+                        stepper,
+                        &linear,
+                        &geometry,
+                        &z,
+                        &r,
+                        &target,
+                        length,
+                        &mut solves,
+                    ) {
+                        Ok(j) => {
+                            jac = Some(j);
+                            fresh = true;
+                        }
+                        Err(e) => break Err(e),
+                    }
+                }
+                let Some(ls) =
+                    jac.as_ref().and_then(|j| LineSearch::start::<D>(j, &z, &r, error, &unknowns, length))
+                else {
+                    break Err(self.unresisted(joint, &unknowns));
+                };
+                tracing::debug!(t, ?ls.direction, ls.alpha, "force control: line search");
+                previous = Some((z.clone(), r.clone(), error));
+                z = ls.at(ls.alpha);
+                line = Some(ls);
+                continue;
             }
-            fresh = false;
+            bracket.update(z[0], r[0]);
+            // one unknown: the secant, kept safe by the bracket
+            if let (Some(j), Some((zp, rp, _))) = (&mut jac, &previous) {
+                broyden(j, &z, &r, zp, rp);
+            }
             // a secant update without slope (the residual did not change): a fresh Jacobian
             if jac.as_ref().is_some_and(|j| newton_step(j, &r).is_none()) {
                 jac = None;
@@ -746,10 +750,7 @@ impl RigidDriver {
             if jac.is_none() {
                 match self.fd_jacobian(&cx, stepper, &linear, &geometry, &z, &r, &target, length, &mut solves)
                 {
-                    Ok(j) => {
-                        jac = Some(j);
-                        fresh = true;
-                    }
+                    Ok(j) => jac = Some(j),
                     Err(e) => break Err(e),
                 }
             }
@@ -758,24 +759,8 @@ impl RigidDriver {
             };
             previous = Some((z.clone(), r.clone(), error));
             let mut next: Vec<Real> = z.iter().zip(&dz).map(|(a, d)| a + d).collect();
-            if unknowns.len() > 1 && fresh && step_capped::<D>(&next, &z, &unknowns, length) {
-                if let Some(w) = jac
-                    .as_ref()
-                    .and_then(|j| NullWalk::start::<D>(j, &z, &r, &scales, &unknowns, length, &linear))
-                {
-                    // one contact region resists a combination of the unknowns only (e.g. one
-                    // condyle: force and moment from one contact force): move along the
-                    // direction it does not resist, toward the net generalised force, until
-                    // another region takes load (docs/model.md §10)
-                    tracing::debug!(t, ?w.direction, w.alpha, "force control: walk along the null direction");
-                    z = w.at();
-                    walk = Some(w);
-                    previous = None;
-                    continue;
-                }
-            }
             limit_step::<D>(&mut next, &z, &unknowns, length);
-            if let (Some((lo, hi)), 1) = (bracket.interval(), unknowns.len()) {
+            if let Some((lo, hi)) = bracket.interval() {
                 if !(next[0] > lo && next[0] < hi) {
                     next[0] = 0.5 * (lo + hi);
                 }
@@ -797,6 +782,7 @@ impl RigidDriver {
         };
         record.strain_energy = synovia_fem::post::total_strain_energy(model, &result.displacement)?;
         let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
+        self.accepted = Some(self.q.clone());
         Ok((record, result))
     }
 
@@ -824,6 +810,48 @@ impl RigidDriver {
             sens: self.gap_sensitivities(joint, &geometry, unknowns),
         };
         Ok((geometry, linear))
+    }
+
+    /// The motion of the rigid partners' material points at the contact nodes since the last
+    /// accepted level, `w_r = P(q)(P(q_{i−1})⁻¹(y_r)) − y_r` at the nodes' deformed positions
+    /// `y_r = x_r + u_r(t_{i−1})` (docs/model.md §10): the slip of friction against a moving
+    /// rigid body is measured relative to it. Zero for a static solve (no slip origin) and for
+    /// nodes of pairs without a rigid body.
+    fn set_partner_motion<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        stepper: &mut QuasiStaticStepper<D>,
+        mode: LevelMode,
+    ) -> Result<(), JointError> {
+        let motion = match (&self.accepted, stepper.last_result(), mode) {
+            (Some(old), Some(last), LevelMode::Step) => {
+                let geometry = stepper.geometry();
+                let owner = joint.pair_rigid_owner(geometry);
+                let bodies = joint.rigid_bodies();
+                let poses: Vec<(RigidPose<D>, RigidPose<D>)> = bodies
+                    .iter()
+                    .zip(old.iter().zip(&self.q))
+                    .map(|(b, (qo, qn))| (b.pose_of(qo), b.pose_of(qn)))
+                    .collect();
+                geometry
+                    .nodes
+                    .iter()
+                    .enumerate()
+                    .map(|(r, node)| match owner.get(node.pair).copied().flatten() {
+                        Some(b) => {
+                            let y = node.position
+                                + geometry.jump(r, &last.displacement).unwrap_or_else(Vector::<D>::zeros);
+                            let (old, new) = &poses[b];
+                            new.position(&old.to_body(&y)) - y
+                        }
+                        None => Vector::<D>::zeros(),
+                    })
+                    .collect()
+            }
+            _ => Vec::new(),
+        };
+        stepper.contact_mut().set_partner_motion(motion)?;
+        Ok(())
     }
 
     /// One contact solve of the level.
@@ -1047,6 +1075,9 @@ impl RigidDriver {
         if let Some(c) = &cx.checkpoint {
             stepper.rollback(c.clone());
         }
+        if !cx.joint.rigid_pair_bodies().is_empty() {
+            self.set_partner_motion(cx.joint, stepper, cx.mode)?;
+        }
         let (record, result) = self.solve_once(cx.joint, stepper, cx.t, cx.solver, cx.mode, solves)?;
         let reactions = self.reactions(cx.joint, geometry, &record, &result, cx.t)?;
         Ok(((record, result), reactions))
@@ -1199,11 +1230,6 @@ fn limit_step<const D: usize>(next: &mut [Real], z: &[Real], unknowns: &[(usize,
     }
 }
 
-/// `true` if the step from `z` to `next` exceeds the caps of [`limit_step`].
-fn step_capped<const D: usize>(next: &[Real], z: &[Real], unknowns: &[(usize, usize)], length: Real) -> bool {
-    next.iter().zip(z).zip(unknowns).any(|((n, zj), &(_, k))| (n - zj).abs() > step_cap::<D>(k, length))
-}
-
 /// The largest step of degree of freedom `k`: 2 % of the model size (translations) or
 /// 0.02 rad (rotations).
 fn step_cap<const D: usize>(k: usize, length: Real) -> Real {
@@ -1214,80 +1240,126 @@ fn step_cap<const D: usize>(k: usize, length: Real) -> Real {
     }
 }
 
-/// A walk from `base` along `direction` (the right singular vector of the scaled Jacobian's
-/// smallest singular value, signed so that the net generalised force does positive work on
-/// it), by `alpha` doubled at every trial, until the residual's component `phi` along the
-/// matching left singular vector changes: a new contact region took load.
+fn dot(a: &[Real], b: &[Real]) -> Real {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// A line search of the force-control iteration with several unknowns on the potential
+/// `Π(z) = E(z) − F·z` (`E` the elastic energy at the contact solution for the pose `z`,
+/// `F` the applied generalised forces), whose gradient is `−r = −(Q + F)`: along
+/// `z(α) = base + α d`, `φ(α) = dΠ/dα = −r(z(α))·d` starts negative and grows (`Π` is convex
+/// for a convex contact problem); the step ends where `|φ(α)| ≤ 0.1 |φ(0)|` (strong Wolfe),
+/// bracketing by regula falsi once `φ` changed sign and doubling `α` (up to 10 % of the model
+/// size) while it did not — this also walks along directions nothing resists yet (one condyle
+/// in contact: the moment about it) until a new contact region takes load.
 #[derive(Debug, Clone)]
-struct NullWalk {
+struct LineSearch {
     base: Vec<Real>,
     direction: Vec<Real>,
     alpha: Real,
-    left: Vec<Real>,
     phi0: Real,
-    doublings: usize,
-    /// The largest `alpha` (10 % of the model size).
+    error0: Real,
+    /// The largest `α` with `φ < 0` so far, and `φ` there.
+    lo: (Real, Real),
+    /// The smallest `α` with `φ ≥ 0`, and `φ` there.
+    hi: Option<(Real, Real)>,
+    /// The largest `α` (10 % of the model size in the scaled step).
     reach: Real,
+    trials: usize,
 }
 
-impl NullWalk {
-    /// The walk at the iterate `z` with residual `r`, if the Jacobian `j` in scaled variables
-    /// (`r_i / scale_i`, lengths and angles × model size) has a singular value below 1 % of
-    /// the largest; the first step closes the nearest open gap that the direction closes (at
-    /// least 10⁻⁴, at most 2·10⁻² of the model size).
-    #[allow(clippy::too_many_arguments)]
+impl LineSearch {
+    /// The search from `z` (residual `r`, scaled error `error`) along the modified Newton
+    /// direction of the Jacobian `j = ∂r/∂z`: with `H = −(j + jᵀ)/2` in scaled variables
+    /// (angles × model size), `d = Σ_i v_i (v_iᵀ r) / max(λ_i, 10⁻² λ_max)` over its
+    /// eigenpairs — Newton's step where `H` is well conditioned, a step toward the net
+    /// generalised force along directions it hardly resists. `α` starts at 1, limited to the
+    /// step caps (2 % of the model size, 0.02 rad). `None` if `H` has no positive eigenvalue.
     fn start<const D: usize>(
         j: &nalgebra::DMatrix<Real>,
         z: &[Real],
         r: &[Real],
-        scales: &[Real],
+        error: Real,
         unknowns: &[(usize, usize)],
         length: Real,
-        linear: &LinearGaps,
     ) -> Option<Self> {
         let m = z.len();
         let w: Vec<Real> = unknowns.iter().map(|&(_, k)| if k < D { 1.0 } else { length }).collect();
-        let scaled = nalgebra::DMatrix::from_fn(m, m, |a, b| j[(a, b)] / scales[a] / w[b]);
-        let svd = scaled.svd(true, true);
-        let (u, vt) = (svd.u?, svd.v_t?);
-        let (mut kmin, mut smax) = (0, 0.0_f64);
-        for (k, &sv) in svd.singular_values.iter().enumerate() {
-            smax = smax.max(sv);
-            if sv < svd.singular_values[kmin] {
-                kmin = k;
-            }
-        }
-        if !(smax > 0.0 && svd.singular_values[kmin] < 1e-2 * smax) {
+        let h = nalgebra::DMatrix::from_fn(m, m, |a, b| -0.5 * (j[(a, b)] + j[(b, a)]) / (w[a] * w[b]));
+        let eig = h.symmetric_eigen();
+        let lmax = eig.eigenvalues.iter().copied().fold(0.0, Real::max);
+        if !(lmax > 0.0 && lmax.is_finite()) {
             return None;
         }
-        let mut direction: Vec<Real> = (0..m).map(|b| vt[(kmin, b)] / w[b]).collect();
-        let work: Real = r.iter().zip(&direction).map(|(ri, di)| ri * di).sum();
-        if work < 0.0 {
-            direction.iter_mut().for_each(|d| *d = -*d);
-        }
-        let left: Vec<Real> = (0..m).map(|a| u[(a, kmin)]).collect();
-        // the nearest open gap the direction closes (first order, undeformed)
-        let gaps = linear.at(z);
-        let mut alpha = 0.02 * length;
-        for (g, sens) in gaps.iter().zip(&linear.sens) {
-            let rate: Real = sens.iter().zip(&direction).map(|(s, d)| s * d).sum();
-            if *g > 0.0 && rate < 0.0 {
-                alpha = alpha.min(g / -rate);
+        let rs: Vec<Real> = r.iter().zip(&w).map(|(ri, wi)| ri / wi).collect();
+        let mut scaled = vec![0.0; m];
+        for (i, &l) in eig.eigenvalues.iter().enumerate() {
+            let v = eig.eigenvectors.column(i);
+            let c = v.iter().zip(&rs).map(|(a, b)| a * b).sum::<Real>() / l.max(1e-2 * lmax);
+            for (s, vk) in scaled.iter_mut().zip(v.iter()) {
+                *s += c * vk;
             }
         }
-        let alpha = alpha.max(1e-4 * length);
-        let mut walk =
-            Self { base: z.to_vec(), direction, alpha, left, phi0: 0.0, doublings: 0, reach: 0.1 * length };
-        walk.phi0 = walk.component(r, scales);
-        Some(walk)
+        let direction: Vec<Real> = scaled.iter().zip(&w).map(|(s, wi)| s / wi).collect();
+        let phi0 = -dot(r, &direction);
+        let longest = scaled.iter().map(|s| s.abs()).fold(0.0, Real::max);
+        if !(phi0 < 0.0 && longest > 0.0 && longest.is_finite()) {
+            return None;
+        }
+        let alpha = direction
+            .iter()
+            .zip(unknowns)
+            .map(|(d, &(_, k))| step_cap::<D>(k, length) / d.abs())
+            .fold(1.0, Real::min);
+        Some(Self {
+            base: z.to_vec(),
+            direction,
+            alpha,
+            phi0,
+            error0: error,
+            lo: (0.0, phi0),
+            hi: None,
+            reach: 0.1 * length / longest,
+            trials: 0,
+        })
     }
-    fn component(&self, r: &[Real], scales: &[Real]) -> Real {
-        r.iter().zip(scales).zip(&self.left).map(|((ri, s), l)| ri / s * l).sum()
+
+    fn at(&self, alpha: Real) -> Vec<Real> {
+        self.base.iter().zip(&self.direction).map(|(b, d)| b + alpha * d).collect()
     }
-    fn at(&self) -> Vec<Real> {
-        self.base.iter().zip(&self.direction).map(|(b, d)| b + self.alpha * d).collect()
-    }
-    fn doubled(self) -> Self {
-        Self { alpha: (2.0 * self.alpha).min(self.reach), doublings: self.doublings + 1, ..self }
+
+    /// The next `α` after a trial at `self.alpha` gave `φ` (and the scaled error `error`), or
+    /// `None` when the step is accepted there.
+    fn next_alpha(&mut self, phi: Real, error: Real) -> Option<Real> {
+        self.trials += 1;
+        let alpha = self.alpha;
+        if phi.abs() <= 0.1 * self.phi0.abs()
+            || (phi <= 0.0 && error <= 0.25 * self.error0)
+            || self.trials >= 12
+        {
+            return None;
+        }
+        if phi < 0.0 {
+            self.lo = (alpha, phi);
+        } else {
+            self.hi = Some((alpha, phi));
+        }
+        let next = match self.hi {
+            Some((ah, ph)) => {
+                let (al, pl) = self.lo;
+                let secant = al - pl * (ah - al) / (ph - pl);
+                let margin = 0.05 * (ah - al);
+                if secant.is_finite() {
+                    secant.clamp(al + margin, ah - margin)
+                } else {
+                    0.5 * (al + ah)
+                }
+            }
+            None if alpha < self.reach => (2.0 * alpha).min(self.reach),
+            // nothing along the direction resists within reach: take the step
+            None => return None,
+        };
+        self.alpha = next;
+        Some(next)
     }
 }

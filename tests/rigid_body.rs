@@ -176,3 +176,71 @@ fn two_condyles_free_to_rotate_share_the_force() -> Result<(), Box<dyn std::erro
     assert!((left + right - 4.0).abs() < 1e-9, "left {left}, right {right}");
     Ok(())
 }
+
+/// Friction against a moving rigid body: a cylinder pressed onto a clamped block with a
+/// constant force and dragged sideways by a prescribed translation far beyond the elastic
+/// stick range. The slip is measured relative to the cylinder (docs/model.md §10), so every
+/// loaded cell slips and the friction force on the block is the Tresca capacity `μ P` of the
+/// previous level's pressure, along the motion; dragged back, it changes sign. (Measuring the
+/// slip of the block's nodes alone would let them stick and carry almost no friction.)
+#[test]
+fn friction_follows_a_moving_rigid_partner() -> Result<(), Box<dyn std::error::Error>> {
+    let mut joint = block2d()?;
+    joint.clamp("block", "bottom")?;
+    let centre = Point::<2>::new(0.0, 3.0);
+    let drag = synovia::time::history::FnHistory::new(|t: f64| match t {
+        t if t <= 0.0 => 0.0,
+        t if t <= 2.0 => 0.05 * t,
+        t => 0.1 - 0.05 * (t - 2.0),
+    });
+    let cylinder = RigidBody::<2>::new("cylinder", centre)?.prescribe(0, drag)?.force(1, Constant(-20.0))?;
+    joint.add_rigid_body(cylinder)?;
+    let shape = Arc::new(SphereObstacle::new(centre, 2.0, false)?);
+    let mu = 0.2;
+    joint.contact_rigid_body("drag", "block", "top", "cylinder", shape, mu)?;
+    let mut session = joint.prepare()?;
+    session.solve_static(0.0)?;
+    let mut previous_normal = session.record().ok_or("no record")?.pairs[0].normal_force;
+    for (t, direction) in [(1.0, 1.0), (2.0, 1.0), (3.0, -1.0)] {
+        let report = session.step(t)?;
+        assert!(report.kkt < 1e-8, "t = {t}: KKT {}", report.kkt);
+        let rec = session.record().ok_or("no record")?;
+        let pair = &rec.pairs[0];
+        let rigid = &rec.rigid[0];
+        assert!(rigid.balance_error < 1e-9, "{rigid:?}");
+        assert!((rigid.dofs[0] - drag_at(t)).abs() < 1e-12, "{rigid:?}");
+        // every loaded cell slips: the friction force is the capacity μ P(t_{i−1}) (its vector
+        // sum a little below: the cylinder's normals fan out by up to 0.1 rad)
+        assert!(pair.stick_area == 0.0 && pair.slip_area > 0.0, "t = {t}: {pair:?}");
+        let capacity = mu * previous_normal;
+        assert!(
+            pair.tangential_force <= capacity * (1.0 + 1e-12) && pair.tangential_force > 0.995 * capacity,
+            "t = {t}: friction {} vs μ P = {capacity}",
+            pair.tangential_force
+        );
+        // on the block along the cylinder's motion, on the cylinder against it (the resultant
+        // also holds the horizontal part of the normal forces on the tilted cylinder surface)
+        assert!(pair.force[0] * direction > 0.9 * capacity, "t = {t}: {pair:?}");
+        assert!(rigid.reaction[0] * direction < -0.9 * capacity, "t = {t}: {rigid:?}");
+        // the dissipated work: the capacity times the slip, i.e. the drag of 0.05 less the block
+        // surface's own tangential displacement, which changes when the friction load comes on
+        // (t = 1) or reverses (t = 3) and not in steady sliding (t = 2)
+        let work = rec.friction_dissipation;
+        let steady = t == 2.0;
+        let low = if steady { 0.95 } else { 0.5 };
+        assert!(work > low * capacity * 0.05 && work < capacity * 0.05, "t = {t}: dissipation {work}");
+        // the cylinder is held at its force: the vertical resultant carries it
+        assert!((pair.force[1] + 20.0).abs() < 1e-8 * 20.0, "t = {t}: {pair:?}");
+        previous_normal = pair.normal_force;
+    }
+    assert_eq!(session.factorizations(), 1);
+    Ok(())
+}
+
+fn drag_at(t: f64) -> f64 {
+    if t <= 2.0 {
+        0.05 * t
+    } else {
+        0.1 - 0.05 * (t - 2.0)
+    }
+}

@@ -138,6 +138,7 @@ impl PairFrictionLaws {
 
 /// The slip speed `|[u'_t]|_r ≈ ‖(I − n_r n_rᵀ)([u^new](s_r) − [u^old](s_r))‖ / Δt` per contact node
 /// of `geometry` from two nodal displacement levels `[body][node]` and the time between them
+/// (relative to a moving partner: `[u^old]` is [`ContactGeometry::slip_origin`])
 /// (docs/model.md §3, §7). A node the displacements do not fit, or `Δt` not finite and positive,
 /// gives 0.
 pub fn slip_speeds<const D: usize>(
@@ -153,7 +154,7 @@ pub fn slip_speeds<const D: usize>(
             }
             let node = &geometry.nodes[r];
             let v = geometry.jump(r, new).unwrap_or_else(Vector::<D>::zeros)
-                - geometry.jump(r, old).unwrap_or_else(Vector::<D>::zeros);
+                - geometry.slip_origin(r, old).unwrap_or_else(Vector::<D>::zeros);
             let vt = v - node.normal * node.normal.dot(&v);
             vt.norm() / dt
         })

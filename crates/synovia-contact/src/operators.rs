@@ -377,6 +377,9 @@ pub struct ContactGeometry<const D: usize> {
     /// Placement of each body ([`ContactGeometry::new_placed`]); empty: every body where its
     /// mesh is.
     placements: Vec<BodyPlacement<D>>,
+    /// Motion of the partner's material point at each contact node since the slip origin
+    /// ([`ContactGeometry::set_partner_motion`]); empty: none.
+    partner_motion: Vec<Vector<D>>,
 }
 
 /// The friction operator for given slip bounds: constraints plus the contact node of each cell.
@@ -543,6 +546,47 @@ impl<const D: usize> ContactGeometry<D> {
         node.jump_mapped(displacement, |b, u| self.placement(b).to_global(u))
     }
 
+    /// Sets the motion `w_r` of the partner's material point at each contact node since the
+    /// slip origin (the previous level): for a rigid partner moved from pose `P_{i−1}` to `P_i`,
+    /// `w_r = P_i(P_{i−1}⁻¹(y_r)) − y_r` at the node's deformed position `y_r`. Incremental slip
+    /// (docs/model.md (3.9)) is then measured relative to the partner,
+    /// `[v_t] − ([u_t(t_{i−1})] + w_{r,t})` ([`ContactGeometry::slip_origin`]). An empty vector
+    /// removes it (partners at rest, the default).
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] unless there is one finite vector per contact node
+    /// (or none).
+    pub fn set_partner_motion(&mut self, motion: Vec<Vector<D>>) -> Result<(), ContactError> {
+        if !(motion.is_empty() || motion.len() == self.nodes.len())
+            || motion.iter().any(|w| w.iter().any(|v| !v.is_finite()))
+        {
+            return Err(ContactError::InvalidParameter(format!(
+                "partner motion: {} vectors (all finite) needed for {} contact nodes, {} given",
+                self.nodes.len(),
+                self.nodes.len(),
+                motion.len()
+            )));
+        }
+        self.partner_motion = motion;
+        Ok(())
+    }
+
+    /// The partner motion set by [`ContactGeometry::set_partner_motion`] (empty: none).
+    pub fn partner_motion(&self) -> &[Vector<D>] {
+        &self.partner_motion
+    }
+
+    /// The origin of the incremental slip at contact node `r`: the jump `[u](s_r)` of the
+    /// previous level's displacements plus the partner's motion since then (if set),
+    /// `[u_{i−1}](s_r) + w_r`. `None` if the displacements do not fit the node.
+    pub fn slip_origin(&self, r: usize, previous: &[Vec<Vector<D>>]) -> Option<Vector<D>> {
+        let j = self.jump(r, previous)?;
+        Some(match self.partner_motion.get(r) {
+            Some(w) => j + w,
+            None => j,
+        })
+    }
+
     fn build(
         model: &Model<D>,
         pairs: &[ContactPair<D>],
@@ -675,6 +719,7 @@ impl<const D: usize> ContactGeometry<D> {
             adjacency,
             placements: Vec::new(),
             report_splits: pairs.iter().map(|p| p.report_split.clone()).collect(),
+            partner_motion: Vec::new(),
         })
     }
 
@@ -820,7 +865,7 @@ impl<const D: usize> ContactGeometry<D> {
                 let (entries, lift) = self.relative_row(dofs, lifts, r, t);
                 rows.push_row(entries.into_iter().map(|(c, v)| (c, scale * v)));
                 let prev = match previous {
-                    Some(p) => t.dot(&self.jump(r, p).ok_or_else(|| {
+                    Some(p) => t.dot(&self.slip_origin(r, p).ok_or_else(|| {
                         ContactError::InvalidParameter(
                             "previous displacements do not fit the contact nodes".into(),
                         )

@@ -291,6 +291,15 @@ impl<const D: usize> StaticContact<D> {
         Ok(())
     }
 
+    /// Sets the partner motion of the contact nodes since the slip origin
+    /// ([`ContactGeometry::set_partner_motion`]: friction against a moving rigid partner).
+    ///
+    /// # Errors
+    /// As [`ContactGeometry::set_partner_motion`].
+    pub fn set_partner_motion(&mut self, motion: Vec<Vector<D>>) -> Result<(), ContactError> {
+        self.geometry.set_partner_motion(motion)
+    }
+
     /// Nested iteration for cold starts ([`crate::nested`]): coarsen the contact rows
     /// down to `min_rows` and use the coarse solutions as the warm start (default `Some(32)`);
     /// `None` starts every solve from `Λ = 0`.

@@ -956,7 +956,8 @@ fn relative_displacement<const D: usize>(
 /// The friction work of a step, `Σ_c g_c κ_c ‖T_cᵀ([u](s_c) − [u]_prev(s_c))‖` over the
 /// friction cells `c` of `result` (`g_c` = [`StaticContactResult::slip_bound`], `T_c` the
 /// tangent basis of the cell's contact node), with `[u]_prev` from the nodal displacements
-/// `previous` (`None`: the reference state, `[u]_prev = 0`). Equals `Λ_t · B_Ht ΔU ≥ 0` for a
+/// `previous` plus the partner's motion ([`ContactGeometry::slip_origin`]; `None`: the
+/// reference state, `[u]_prev = 0`). Equals `Λ_t · B_Ht ΔU ≥ 0` for a
 /// solution of the incremental Tresca problem.
 ///
 /// # Errors
@@ -972,7 +973,7 @@ pub fn friction_dissipation<const D: usize>(
         let node = geometry.nodes.get(r).ok_or_else(misfit)?;
         let mut du = relative_displacement(geometry, r, &result.displacement).ok_or_else(misfit)?;
         if let Some(p) = previous {
-            du -= relative_displacement(geometry, r, p).ok_or_else(misfit)?;
+            du -= geometry.slip_origin(r, p).ok_or_else(misfit)?;
         }
         let slip: Real = node.tangents.iter().take(D - 1).map(|t| t.dot(&du).powi(2)).sum::<Real>().sqrt();
         total += g * node.weight * slip;
