@@ -48,6 +48,7 @@ struct Pose {
     balance: f64,
     kkt: f64,
     contact_force: f64,
+    friction_force: f64,
     area: f64,
     peak: f64,
     medial: Side,
@@ -127,7 +128,17 @@ fn main() -> Result<(), Error> {
         .prescribe(5, column("knee_rot_r", 1.0)?)?; // column 7: rotation about z
     let measured_si = column("knee_sup_r", 1000.0)?;
     joint.add_rigid_body(femur)?;
-    joint.contact_rigid_body("femur-insert", "insert", "contact", "femur", shape, 0.0)?;
+    // `--friction μ`: Coulomb friction (frozen to Tresca per pose) against the moving femoral
+    // component, the slip measured relative to it (docs/model.md (10.5)); the poses are then
+    // quasi-static levels, each from the previous one
+    let friction: f64 = match std::env::args().skip_while(|a| a != "--friction").nth(1) {
+        Some(v) => v.parse()?,
+        None => 0.0,
+    };
+    if !(0.0..1.0).contains(&friction) {
+        return Err(format!("--friction takes a coefficient in [0, 1), got {friction}").into());
+    }
+    joint.contact_rigid_body("femur-insert", "insert", "contact", "femur", shape, friction)?;
     joint.search_distance("femur-insert", SEARCH_DISTANCE)?;
     // medial (−z, right knee) and lateral (+z) sides of the insert
     joint.split_pair_report(
@@ -175,7 +186,8 @@ fn main() -> Result<(), Error> {
     }
     for &i in &percents {
         let t = f64::from(i) / 100.0;
-        let report = session.solve_static(t)?;
+        let report =
+            if friction > 0.0 && !poses.is_empty() { session.step(t)? } else { session.solve_static(t)? };
         let record = session.record().ok_or("no record")?;
         let pair = &record.pairs[0];
         let rigid = &record.rigid[0];
@@ -195,6 +207,7 @@ fn main() -> Result<(), Error> {
             balance: rigid.balance_error,
             kkt: report.kkt,
             contact_force: pair.normal_force,
+            friction_force: pair.tangential_force,
             area: pair.contact_area,
             peak: pair.peak_pressure,
             medial: side("medial"),
@@ -221,7 +234,9 @@ fn main() -> Result<(), Error> {
             return Err(format!("pose {i}: force balance error {:.2e} > 1e-3", pose.balance).into());
         }
         if pose.kkt > 1e-8 {
-            return Err(format!("pose {i}: KKT residual {:.2e} > 1e-8", pose.kkt).into());
+            let detail = session.result().map(|r| format!("{:?}", r.kkt)).unwrap_or_default();
+            let detail = format!("{detail}; solver {}, fallback {:?}", record.solver, record.fallback);
+            return Err(format!("pose {i}: KKT residual {:.2e} > 1e-8 ({detail})", pose.kkt).into());
         }
         let result = session.result().ok_or("no result")?;
         let vtu =
@@ -237,7 +252,7 @@ fn main() -> Result<(), Error> {
     let max = |f: &dyn Fn(&Pose) -> f64| poses.iter().map(f).fold(0.0, f64::max);
     let peak = poses.iter().max_by(|a, b| a.peak.total_cmp(&b.peak)).ok_or("no poses")?;
     println!(
-        "{{\"example\":\"tkr3d\",\"mesh\":\"{mesh_file}\",\"poses\":{},\"dofs\":{dofs},\"max_force_balance_error\":{:.3e},\"max_kkt\":{:.3e},\"peak_pressure_mpa\":{:.3},\"peak_pressure_at_percent\":{:.0},\"max_contact_area_mm2\":{:.1},\"max_medial_force_n\":{:.1},\"max_lateral_force_n\":{:.1},\"setup_s\":{setup_s:.2},\"total_s\":{:.2}}}",
+        "{{\"example\":\"tkr3d\",\"mesh\":\"{mesh_file}\",\"poses\":{},\"dofs\":{dofs},\"max_force_balance_error\":{:.3e},\"max_kkt\":{:.3e},\"peak_pressure_mpa\":{:.3},\"peak_pressure_at_percent\":{:.0},\"max_contact_area_mm2\":{:.1},\"max_medial_force_n\":{:.1},\"max_lateral_force_n\":{:.1},\"friction\":{friction},\"max_friction_force_n\":{:.1},\"setup_s\":{setup_s:.2},\"total_s\":{:.2}}}",
         poses.len(),
         max(&|p| p.balance),
         max(&|p| p.kkt),
@@ -246,6 +261,7 @@ fn main() -> Result<(), Error> {
         max(&|p| p.area),
         max(&|p| p.medial.force),
         max(&|p| p.lateral.force),
+        max(&|p| p.friction_force),
         start.elapsed().as_secs_f64()
     );
     Ok(())
@@ -253,13 +269,13 @@ fn main() -> Result<(), Error> {
 
 fn csv_text(poses: &[Pose]) -> String {
     let mut s = String::from(
-        "cycle [%],axial_force [N],si_translation [mm],si_measured [mm],force_balance_error [-],kkt [-],contact_force [N],contact_area [mm^2],peak_pressure [MPa],medial_force [N],medial_area [mm^2],medial_peak_pressure [MPa],medial_cop_x [mm],medial_cop_z [mm],lateral_force [N],lateral_area [mm^2],lateral_peak_pressure [MPa],lateral_cop_x [mm],lateral_cop_z [mm],solves [-],seconds [s]\n",
+        "cycle [%],axial_force [N],si_translation [mm],si_measured [mm],force_balance_error [-],kkt [-],contact_force [N],friction_force [N],contact_area [mm^2],peak_pressure [MPa],medial_force [N],medial_area [mm^2],medial_peak_pressure [MPa],medial_cop_x [mm],medial_cop_z [mm],lateral_force [N],lateral_area [mm^2],lateral_peak_pressure [MPa],lateral_cop_x [mm],lateral_cop_z [mm],solves [-],seconds [s]\n",
     );
     let cop = |c: Option<[f64; 3]>, k: usize| c.map_or(String::new(), |c| format!("{:.4}", c[k]));
     for p in poses {
         let _ = writeln!(
             s,
-            "{},{},{},{},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             p.percent,
             p.load,
             p.si_mm,
@@ -267,6 +283,7 @@ fn csv_text(poses: &[Pose]) -> String {
             p.balance,
             p.kkt,
             p.contact_force,
+            p.friction_force,
             p.area,
             p.peak,
             p.medial.force,

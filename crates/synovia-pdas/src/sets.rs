@@ -347,10 +347,20 @@ impl<'p> State<'p> {
     }
 
     /// Scale of the normal NCP: `max_r max(|ν_r|, ρ_r (|y_r| + |d_r|))`.
+    /// The scale of the normal NCP terms `ν_r` and `ρ_r (y_r − d_r)`: their size over the loaded
+    /// rows (`ν_r ≠ 0`), or over every row before any is loaded. Unloaded rows far from the
+    /// contact have a large `ρ_r` (they hardly move under the loaded zone's forces) and gaps up
+    /// to the search distance; counted in the scale, they made the relative residual of a
+    /// slightly penetrating row nearer the contact look converged (measured: 1.9e-6 mm
+    /// penetration accepted at a tolerance of 1e-10 on the tkr3d insert).
     fn normal_scale(&self, nu: &[f64], y: &[f64]) -> f64 {
-        (0..self.m)
-            .map(|r| nu[r].abs().max(self.rho[r] * (y[r].abs() + self.g[r].abs())))
-            .fold(f64::MIN_POSITIVE, f64::max)
+        let term = |r: usize| nu[r].abs().max(self.rho[r] * (y[r].abs() + self.g[r].abs()));
+        let loaded = (0..self.m).filter(|&r| nu[r] != 0.0).map(term).fold(0.0, f64::max);
+        if loaded > 0.0 {
+            loaded
+        } else {
+            (0..self.m).map(term).fold(f64::MIN_POSITIVE, f64::max)
+        }
     }
 
     /// `𝒜_n = {r : ν_r + ρ_r (y_r − d_r) > 0}`; rows within the switching band keep `prev`.
