@@ -16,6 +16,8 @@
 //! cargo run --release --example tkr3d            # 1 mm articular mesh
 //! cargo run --release --example tkr3d -- --fine  # 0.5 mm
 //! cargo run --release --example tkr3d -- --fine --poses 13,50  # only these % of the cycle
+//! cargo run --release --example tkr3d -- --friction 0.04        # friction against the femur
+//! cargo run --release --example tkr3d -- --free-adduction --free-ml  # femur free in 2 more dofs
 //! ```
 
 use std::fmt::Write as _;
