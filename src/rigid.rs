@@ -36,13 +36,18 @@
 //! contact partners) and the prescribed displacements (tied parts). The force-controlled
 //! degrees of freedom are found by a Newton iteration on `r(q) = Q(q) + F` around the contact
 //! solve (a finite-difference Jacobian of the affine piece at the iterate, carried between levels
-//! with Broyden updates; bracketed secant steps for a single degree of freedom), in which the
+//! with Broyden updates; bracketed secant steps for a single degree of freedom, line searches
+//! on the level's potential `Π(q) = E(q) − F·q` for several, docs/model.md (10.3a)), in which the
 //! contact geometry is built at a pose and the gaps follow the motion to first order
 //! (`d_r(q) = d_r(q₀) + n_r · v_k(x_r) (q_k − q₀_k)`, the rows and the Schur columns kept); an
 //! iterate farther than the geometry tolerance from that pose gets the geometry rebuilt there
 //! (docs/model.md §10). The level is accepted
 //! when `|r_k| ≤ tolerance × scale` for every force-controlled degree of freedom
 //! ([`ForceControlParams`]).
+//!
+//! Friction against a rigid body measures the slip relative to it: at a quasi-static level the
+//! motion of the body's material point at each contact node since the last accepted pose is
+//! part of the slip origin (docs/model.md (10.5), [`ContactGeometry::set_partner_motion`]).
 //!
 //! [`JointModel::contact_rigid_body`]: crate::builder::JointModel::contact_rigid_body
 //! [`JointModel::tie_to_rigid_body`]: crate::builder::JointModel::tie_to_rigid_body
