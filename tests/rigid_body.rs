@@ -188,11 +188,7 @@ fn friction_follows_a_moving_rigid_partner() -> Result<(), Box<dyn std::error::E
     let mut joint = block2d()?;
     joint.clamp("block", "bottom")?;
     let centre = Point::<2>::new(0.0, 3.0);
-    let drag = synovia::time::history::FnHistory::new(|t: f64| match t {
-        t if t <= 0.0 => 0.0,
-        t if t <= 2.0 => 0.05 * t,
-        t => 0.1 - 0.05 * (t - 2.0),
-    });
+    let drag = synovia::time::history::FnHistory::new(drag_at);
     let cylinder = RigidBody::<2>::new("cylinder", centre)?.prescribe(0, drag)?.force(1, Constant(-20.0))?;
     joint.add_rigid_body(cylinder)?;
     let shape = Arc::new(SphereObstacle::new(centre, 2.0, false)?);
@@ -237,10 +233,12 @@ fn friction_follows_a_moving_rigid_partner() -> Result<(), Box<dyn std::error::E
     Ok(())
 }
 
+/// The cylinder's prescribed sideways translation: 0 until t = 0, out by 0.05 per unit time
+/// to 0.1 at t = 2, then back.
 fn drag_at(t: f64) -> f64 {
-    if t <= 2.0 {
-        0.05 * t
-    } else {
-        0.1 - 0.05 * (t - 2.0)
+    match t {
+        t if t <= 0.0 => 0.0,
+        t if t <= 2.0 => 0.05 * t,
+        t => 0.1 - 0.05 * (t - 2.0),
     }
 }

@@ -346,9 +346,9 @@ impl<'p> State<'p> {
         z
     }
 
-    /// Scale of the normal NCP: `max_r max(|ν_r|, ρ_r (|y_r| + |d_r|))`.
-    /// The scale of the normal NCP terms `ν_r` and `ρ_r (y_r − d_r)`: their size over the loaded
-    /// rows (`ν_r ≠ 0`), or over every row before any is loaded. Unloaded rows far from the
+    /// The scale of the normal NCP terms `ν_r` and `ρ_r (y_r − d_r)`,
+    /// `max_r max(|ν_r|, ρ_r (|y_r| + |d_r|))` over the loaded rows (`ν_r ≠ 0`), or over every
+    /// row before any is loaded. Unloaded rows far from the
     /// contact have a large `ρ_r` (they hardly move under the loaded zone's forces) and gaps up
     /// to the search distance; counted in the scale, they made the relative residual of a
     /// slightly penetrating row nearer the contact look converged (measured: 1.9e-6 mm

@@ -944,15 +944,6 @@ pub fn transfer_result<const D: usize>(
     out
 }
 
-/// `[u](s_r) = u^k(s_r) − u^l(s_r)` (or `u^k` for a rigid obstacle) of contact node `r`.
-fn relative_displacement<const D: usize>(
-    geometry: &ContactGeometry<D>,
-    r: usize,
-    displacement: &[Vec<Vector<D>>],
-) -> Option<Vector<D>> {
-    geometry.jump(r, displacement)
-}
-
 /// The friction work of a step, `Σ_c g_c κ_c ‖T_cᵀ([u](s_c) − [u]_prev(s_c))‖` over the
 /// friction cells `c` of `result` (`g_c` = [`StaticContactResult::slip_bound`], `T_c` the
 /// tangent basis of the cell's contact node), with `[u]_prev` from the nodal displacements
@@ -971,7 +962,7 @@ pub fn friction_dissipation<const D: usize>(
     let mut total = 0.0;
     for (&r, &g) in result.cell_node.iter().zip(&result.slip_bound) {
         let node = geometry.nodes.get(r).ok_or_else(misfit)?;
-        let mut du = relative_displacement(geometry, r, &result.displacement).ok_or_else(misfit)?;
+        let mut du = geometry.jump(r, &result.displacement).ok_or_else(misfit)?;
         if let Some(p) = previous {
             du -= geometry.slip_origin(r, p).ok_or_else(misfit)?;
         }
