@@ -41,6 +41,10 @@ const UHMWPE: (f64, f64) = (463.0, 0.46);
 /// inactive row (mm).
 const SEARCH_DISTANCE: f64 = 3.0;
 
+/// Rows with a larger gap (mm) are left out of each contact solve until they come into
+/// contact (`--screening-band 0`: every candidate in every solve).
+const SCREENING_BAND: f64 = 0.5;
+
 /// Figures of one pose.
 struct Pose {
     percent: f64,
@@ -169,6 +173,14 @@ fn main() -> Result<(), Error> {
             synovia::linalg::InterfaceBlockParams::default().with_max_dofs(0).with_screened_dofs(0),
         );
     }
+
+    // gap screening: each solve runs on the insert nodes within `band` of the femur and adds
+    // others only if they come into contact (exact; docs/tkr3d.md, performance)
+    let band: f64 = match std::env::args().skip_while(|a| a != "--screening-band").nth(1) {
+        Some(v) => v.parse()?,
+        None => SCREENING_BAND,
+    };
+    joint.screening_band((band > 0.0).then_some(band))?;
 
     let mut session = joint.prepare()?;
     let dofs = session.elastic_info().n_dofs;

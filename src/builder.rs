@@ -273,6 +273,7 @@ pub struct JointModel<const D: usize> {
     rigid_ties: Vec<(BodyId, String, usize)>,
     force_control: ForceControlParams,
     interface_block: synovia_linalg::InterfaceBlockParams,
+    screening_band: Option<Real>,
 }
 
 impl<const D: usize> fmt::Debug for JointModel<D> {
@@ -344,6 +345,7 @@ impl<const D: usize> JointModel<D> {
             rigid_ties: Vec::new(),
             force_control: ForceControlParams::default(),
             interface_block: synovia_linalg::InterfaceBlockParams::default(),
+            screening_band: None,
         }
     }
 
@@ -438,6 +440,31 @@ impl<const D: usize> JointModel<D> {
     pub fn interface_block(&mut self, params: synovia_linalg::InterfaceBlockParams) -> &mut Self {
         self.interface_block = params;
         self
+    }
+
+    /// Screens the contact rows of whole-factor solves by their gap: each solve runs on the
+    /// rows with gap at most `band` (model length unit) and adds the others only if they come
+    /// into contact ([`StaticContact::set_screening_band`]; exact, the result is the full
+    /// problem's). For a large candidate surface without a dense interface block, where the
+    /// cost of the interface follows its rows. `None` (default): no screening.
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for a band that is negative or not finite.
+    pub fn screening_band(&mut self, band: Option<Real>) -> Result<&mut Self, JointError> {
+        if let Some(b) = band {
+            if !(b.is_finite() && b >= 0.0) {
+                return Err(JointError::Invalid(format!(
+                    "screening band must be finite and non-negative, got {b}"
+                )));
+            }
+        }
+        self.screening_band = band;
+        Ok(self)
+    }
+
+    /// The screening band ([`JointModel::screening_band`]).
+    pub fn screening_band_value(&self) -> Option<Real> {
+        self.screening_band
     }
 
     /// The interface block parameters ([`JointModel::interface_block`]).
@@ -1119,6 +1146,7 @@ impl<const D: usize> JointModel<D> {
             self.interface_block,
         )?;
         contact.set_nested_iteration(self.nested);
+        contact.set_screening_band(self.screening_band)?;
         let n_dofs = contact.elastic().info().n_dofs;
         let mut stepper = QuasiStaticStepper::from_contact(&self.model, contact, self.quasistatic_params)?;
         for (pair, law) in &self.friction_laws {

@@ -673,6 +673,18 @@ impl RigidDriver {
             let r: Vec<Real> = unknowns.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
             let error = r.iter().zip(&scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
             tracing::debug!(t, solves, ?z, ?r, error, "force-control trial");
+            // pressed: a node of a pair with a force-controlled body carries a normal force
+            // (frozen Tresca friction holds with no normal force at all, so the reactions
+            // alone do not tell a body that lifted off from one that touches)
+            let owner = joint.pair_rigid_owner(&geometry);
+            let pressed = result.solution.lambda_n.iter().zip(&geometry.nodes).any(|(l, node)| {
+                *l > 0.0
+                    && owner
+                        .get(node.pair)
+                        .copied()
+                        .flatten()
+                        .is_some_and(|b| unknowns.iter().any(|&(ub, _)| ub == b))
+            });
             let converged = error <= params.tolerance;
             if best.as_ref().is_none_or(|(e, _)| error < *e) || converged {
                 best = Some((error, (record, result)));
@@ -681,7 +693,7 @@ impl RigidDriver {
                 break Ok(geometry);
             }
             // not touching: move to first contact along the applied forces
-            let touching = reactions.iter().flatten().any(|v| *v != 0.0)
+            let touching = pressed
                 || unknowns.iter().any(|&(b, _)| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b));
             if !touching {
                 match self.approach(joint, &unknowns, &target, &z, &linear, length) {

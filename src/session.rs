@@ -119,6 +119,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
                 joint.interface_block_params(),
             )?;
             contact.set_nested_iteration(nested);
+            contact.set_screening_band(joint.screening_band_value())?;
             let mut stepper = QuasiStaticStepper::from_contact(model, contact, quasistatic_params)?;
             for (pair, law) in joint.pair_friction_laws() {
                 stepper.set_friction_law(pair, law.clone())?;

@@ -33,6 +33,8 @@ pub struct StaticContact<const D: usize> {
     elastic: ElasticSolver<D>,
     geometry: ContactGeometry<D>,
     nested_min_rows: Option<usize>,
+    /// Gap screening of whole-factor solves ([`StaticContact::set_screening_band`]).
+    screening_band: Option<Real>,
     /// What the solves reuse: columns of `S` kept between solves on the same geometry, the
     /// recycled load solves `A⁻¹ F` ([`SolveContext`], with its memory budget).
     context: SolveContext,
@@ -95,6 +97,7 @@ impl<const D: usize> StaticContact<D> {
             elastic,
             geometry,
             nested_min_rows: Some(32),
+            screening_band: None,
             context: SolveContext::new(),
             caller_matrix: false,
         })
@@ -161,6 +164,7 @@ impl<const D: usize> StaticContact<D> {
             elastic,
             geometry,
             nested_min_rows: Some(32),
+            screening_band: None,
             context: SolveContext::new(),
             caller_matrix: true,
         })
@@ -305,6 +309,28 @@ impl<const D: usize> StaticContact<D> {
     /// `None` starts every solve from `Λ = 0`.
     pub fn set_nested_iteration(&mut self, min_rows: Option<usize>) {
         self.nested_min_rows = min_rows;
+    }
+
+    /// Gap screening of the contact rows when the factor has no dense interface block for them
+    /// (e.g. [`InterfaceBlockParams::max_dofs`] = 0 on a large candidate surface): each solve
+    /// runs on the rows whose gap `d_r` is at most `band` (plus the rows of friction cells and
+    /// those loaded in the warm start), checks the other rows with the computed displacement
+    /// and adds those that penetrate, warm-started, until none does — the result is the one
+    /// of the full problem, at a cost that follows the rows near contact instead of the
+    /// candidate surface. `None` (default): every row takes part in every solve.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] for a band that is negative or not finite.
+    pub fn set_screening_band(&mut self, band: Option<Real>) -> Result<(), ContactError> {
+        if let Some(b) = band {
+            if !(b.is_finite() && b >= 0.0) {
+                return Err(ContactError::InvalidParameter(format!(
+                    "screening band must be finite and non-negative, got {b}"
+                )));
+            }
+        }
+        self.screening_band = band;
+        Ok(())
     }
 
     /// `(reused, solved)`: solves whose `A⁻¹ F` came from the recycled load subspace and
@@ -590,7 +616,16 @@ impl<const D: usize> StaticContact<D> {
             _ => Ok(None),
         };
         let m = problem.n_normal();
-        let Some(mut candidate) = self.trailing_rows(problem.normal) else {
+        let screened = self.trailing_rows(problem.normal).or_else(|| {
+            let band = self.screening_band?;
+            let near: Vec<bool> = problem.normal.gap.iter().map(|&d| d <= band).collect();
+            (!near.iter().all(|&b| b)).then(|| {
+                // the sub-problems draw on the unit solves of all candidate rows
+                problem.operator.reserve_interface(problem.rows(), context.row_solves());
+                near
+            })
+        });
+        let Some(mut candidate) = screened else {
             let coarse = nested(problem, &self.geometry.adjacency)?;
             let start = warm.or(coarse.as_ref().map(|(w, _)| w));
             let solution =

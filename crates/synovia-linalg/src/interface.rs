@@ -31,6 +31,8 @@ struct BlockSolves {
     block: usize,
     solves: HashMap<u64, StoredSolve>,
     bytes: usize,
+    /// Counts the uses of the store (the age of a kept solve is the tick of its last use).
+    tick: u64,
     /// Whole-factor unit solves: the dofs they are restricted to (sorted).
     support: Arc<Vec<usize>>,
     /// The last interface rows' entries as `(position in support, value)`, with the rows'
@@ -44,7 +46,9 @@ type RowPositions = Arc<Vec<Vec<(usize, f64)>>>;
 #[derive(Debug)]
 struct StoredSolve {
     direction: Vec<(usize, f64)>,
-    solve: Vec<f64>,
+    solve: Arc<Vec<f64>>,
+    /// The store's tick when it was last kept or used.
+    last_use: u64,
 }
 
 impl StoredSolve {
@@ -147,28 +151,49 @@ impl BlockSolveStore {
     }
     /// The solve of `row` (`s x_d` from the kept `x_d`), if its direction is kept.
     fn get(&self, block: usize, row: &RowDirection) -> Option<Vec<f64>> {
-        let store = self.lock();
+        self.get_shared(block, row).map(|(s, x)| x.iter().map(|v| s * v).collect())
+    }
+    /// The kept `x_d` of `row`'s direction with the row's scale `s` (its solve is `s x_d`),
+    /// shared rather than copied.
+    fn get_shared(&self, block: usize, row: &RowDirection) -> Option<(f64, Arc<Vec<f64>>)> {
+        let mut store = self.lock();
         if store.block != block {
             return None;
         }
-        let kept = store.solves.get(&row.key).filter(|k| row.matches(&k.direction))?;
-        Some(kept.solve.iter().map(|x| row.scale * x).collect())
+        store.tick += 1;
+        let tick = store.tick;
+        let kept = store.solves.get_mut(&row.key).filter(|k| row.matches(&k.direction))?;
+        kept.last_use = tick;
+        Some((row.scale, kept.solve.clone()))
     }
     /// Keeps the solve `x` of `row` as `x_d = x / s`.
     fn put(&self, block: usize, row: &RowDirection, x: &[f64]) {
-        let stored = StoredSolve {
+        let mut stored = StoredSolve {
             direction: row.direction.clone(),
-            solve: x.iter().map(|v| v / row.scale).collect(),
+            solve: Arc::new(x.iter().map(|v| v / row.scale).collect()),
+            last_use: 0,
         };
         let bytes = stored.bytes();
         let mut store = self.lock();
         if store.block != block {
             *store = BlockSolves { block, ..Default::default() };
         } else if store.bytes + bytes > self.budget_bytes {
-            let support = store.support.clone();
-            let row_positions = store.row_positions.take();
-            *store = BlockSolves { block, support, row_positions, ..Default::default() };
+            // the least recently used solves go, down to three quarters of the budget (a
+            // contact zone that travels over a large surface keeps the solves of where it is)
+            let mut ages: Vec<(u64, u64)> = store.solves.iter().map(|(k, v)| (v.last_use, *k)).collect();
+            ages.sort_unstable();
+            let target = (self.budget_bytes / 4 * 3).saturating_sub(bytes);
+            for (_, key) in ages {
+                if store.bytes <= target {
+                    break;
+                }
+                if let Some(old) = store.solves.remove(&key) {
+                    store.bytes -= old.bytes().min(store.bytes);
+                }
+            }
         }
+        store.tick += 1;
+        stored.last_use = store.tick;
         if bytes <= self.budget_bytes {
             if let Some(old) = store.solves.insert(row.key, stored) {
                 store.bytes -= old.bytes().min(store.bytes);
@@ -437,15 +462,11 @@ fn whole_factor_unit_columns(
     columns: &mut [Option<Vec<f64>>],
     kept: &BlockSolveStore,
 ) -> Result<usize, LinalgError> {
-    use std::hash::{Hash, Hasher};
     let n = op.n();
     if rows.ncols() != n {
         return Err(LinalgError::Length { what: "interface rows (columns)", expected: n, got: rows.ncols() });
     }
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    (op.factor() as *const CholeskySolver as usize).hash(&mut h);
-    n.hash(&mut h);
-    let id = h.finish() as usize;
+    let id = whole_factor_id(op);
     let fingerprint = rows.fingerprint();
     let (support, row_positions) = match kept.unit_rows(id, fingerprint) {
         Some(kept_rows) => kept_rows,
@@ -486,7 +507,9 @@ fn whole_factor_unit_columns(
     dofs.sort_unstable();
     dofs.dedup();
     let unit_dirs: Vec<RowDirection> = dofs.iter().map(|&p| RowDirection::new(&[(p, 1.0)])).collect();
-    let mut units: Vec<Option<Vec<f64>>> = unit_dirs.iter().map(|d| kept.get(id, d)).collect();
+    // unit directions have scale 1: the kept solves are used as they are
+    let mut units: Vec<Option<Arc<Vec<f64>>>> =
+        unit_dirs.iter().map(|d| kept.get_shared(id, d).map(|(_, x)| x)).collect();
     let absent: Vec<usize> = (0..dofs.len()).filter(|&u| units[u].is_none()).collect();
     if !absent.is_empty() {
         let computed = in_two_halves(&absent, true, |list| {
@@ -508,24 +531,50 @@ fn whole_factor_unit_columns(
         solved += computed.len();
         for (u, x) in computed {
             kept.put(id, &unit_dirs[u], &x);
-            units[u] = Some(x);
+            units[u] = Some(Arc::new(x));
         }
     }
     for &j in &few {
-        // x_j = Σ v x_p on the interface dofs, then S_ij = c_i · x_j
-        let mut x = vec![0.0; support.len()];
-        for &(k, v) in &row_positions[j] {
-            let Ok(u) = dofs.binary_search(&support[k]) else { continue };
-            if let Some(unit) = &units[u] {
-                for (xi, ui) in x.iter_mut().zip(unit) {
-                    *xi += v * ui;
-                }
-            }
-        }
-        let col = row_positions.iter().map(|row| row.iter().map(|&(k, w)| w * x[k]).sum()).collect();
+        // S_ij = Σ_{(q,w) ∈ c_i} w Σ_{(p,v) ∈ c_j} v x_p[q]: work per column follows the rows,
+        // not the interface dofs the unit solves are kept on
+        let parts: Vec<(&[f64], f64)> = row_positions[j]
+            .iter()
+            .filter_map(|&(k, v)| {
+                let u = dofs.binary_search(&support[k]).ok()?;
+                units[u].as_deref().map(|unit| (unit.as_slice(), v))
+            })
+            .collect();
+        let col = row_positions
+            .iter()
+            .map(|row| {
+                row.iter().map(|&(k, w)| w * parts.iter().map(|&(unit, v)| v * unit[k]).sum::<f64>()).sum()
+            })
+            .collect();
         columns[j] = Some(col);
     }
     Ok(solved)
+}
+
+/// The key of the whole-factor unit solves of `op` in a [`BlockSolveStore`].
+fn whole_factor_id(op: &CholeskyOperator<'_>) -> usize {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    (op.factor() as *const CholeskySolver as usize).hash(&mut h);
+    op.n().hash(&mut h);
+    h.finish() as usize
+}
+
+/// [`FactorisedOperator::reserve_interface`] of the Cholesky back-end: the kept whole-factor
+/// unit solves are restricted to a support that covers the dofs of every row of `rows`
+/// (nothing to do with a trailing block, whose solves are kept per block).
+pub(crate) fn reserve_unit_support(op: &CholeskyOperator<'_>, rows: RowStack<'_>, kept: &BlockSolveStore) {
+    if rows.ncols() != op.n() || !kept.unit_solves() || trailing_rows(op.factor(), rows).is_some() {
+        return;
+    }
+    let mut dofs: Vec<usize> = (0..rows.n_rows()).flat_map(|r| rows.row(r).map(|(p, _)| p)).collect();
+    dofs.sort_unstable();
+    dofs.dedup();
+    kept.unit_support(whole_factor_id(op), &dofs);
 }
 
 /// The trailing-block solves `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` (in trailing positions) of the rows
@@ -735,5 +784,62 @@ mod tests {
         op.view().interface_columns(RowStack::new(&rows, None), &all, &mut columns, &small).expect("columns");
         check(&rows, &columns);
         assert!(small.bytes() <= 8);
+    }
+
+    /// A store over its budget drops its least recently used solves (down to three quarters
+    /// of the budget), not all of them: of three unit solves used in the order 1, 2, 0, a
+    /// fourth one pushes out 1 and then 2, and 0 stays.
+    #[test]
+    fn a_full_store_drops_the_least_recently_used_solves() {
+        let row = |p: usize| RowDirection::new(&[(p, 1.0)]);
+        let x = vec![1.0; 100];
+        let one = StoredSolve { direction: vec![(0, 1.0)], solve: Arc::new(x.clone()), last_use: 0 }.bytes();
+        let store = BlockSolveStore::with_budget(3 * one);
+        for p in 0..3 {
+            store.put(7, &row(p), &x);
+        }
+        assert!(store.get(7, &row(2)).is_some() && store.get(7, &row(0)).is_some());
+        store.put(7, &row(3), &x);
+        assert_eq!(store.len(), 2);
+        assert!(store.get(7, &row(0)).is_some() && store.get(7, &row(3)).is_some(), "recent solves kept");
+        assert!(store.get(7, &row(1)).is_none() && store.get(7, &row(2)).is_none(), "older ones dropped");
+        assert!(store.bytes() <= 3 * one);
+    }
+
+    /// Interfaces on subsets of reserved rows keep the store's unit solves: after
+    /// `reserve_interface` with all rows, a subset and then another subset solve only the
+    /// unit solves they have not met, and the columns equal fresh solves.
+    #[test]
+    fn reserved_rows_keep_unit_solves_across_subsets() {
+        let n = 120;
+        let op = SparseCholesky::new(tridiagonal(n), &Ordering::Amd).expect("factor");
+        let rows_of = |nodes: &[usize]| {
+            let mut rows = SparseRows::new(n);
+            for &node in nodes {
+                rows.push_row([(3 * node, 0.6), (3 * node + 1, 0.8)]);
+            }
+            rows
+        };
+        let store = BlockSolveStore::default();
+        store.set_unit_solves(true);
+        op.view().reserve_interface(RowStack::new(&rows_of(&[2, 9, 17, 30]), None), &store);
+        let mut solves = Vec::new();
+        for nodes in [&[2usize, 9][..], &[9, 30][..], &[2, 30][..]] {
+            let rows = rows_of(nodes);
+            let mut columns = vec![None; rows.nrows()];
+            let all: Vec<usize> = (0..rows.nrows()).collect();
+            solves.push(
+                op.view()
+                    .interface_columns(RowStack::new(&rows, None), &all, &mut columns, &store)
+                    .expect("columns"),
+            );
+            let reference = reference_columns(&op, &rows);
+            for (j, col) in columns.iter().enumerate() {
+                for (a, b) in col.as_ref().expect("column").iter().zip(&reference[j]) {
+                    assert!((a - b).abs() <= 1e-13, "{a} vs {b}");
+                }
+            }
+        }
+        assert_eq!(solves, vec![4, 2, 0], "unit solves per call");
     }
 }

@@ -96,6 +96,14 @@ pub trait FactorisedOperator: Send + Sync + fmt::Debug {
         }
         Ok(solved)
     }
+    /// Announces that the interfaces of the coming solves take their rows from `rows` (e.g.
+    /// the sub-problems of a screened solve, each on some of the candidate rows): a back-end
+    /// that keeps row solves restricted to the interface dofs in `kept` sizes them for all of
+    /// `rows` at once, so that interfaces on other subsets reuse them instead of emptying the
+    /// store. Default: nothing.
+    fn reserve_interface(&self, rows: RowStack<'_>, kept: &BlockSolveStore) {
+        let _ = (rows, kept);
+    }
     /// `true` if [`FactorisedOperator::interface_columns`] of these rows uses a dense block of
     /// the factor instead of whole solves (reported by the solvers; default `false`).
     fn dense_interface_block(&self, rows: RowStack<'_>) -> bool {
@@ -249,6 +257,9 @@ impl FactorisedOperator for CholeskyOperator<'_> {
     ) -> Result<usize, LinalgError> {
         crate::interface::cholesky_interface_columns(self, rows, wanted, columns, kept)
     }
+    fn reserve_interface(&self, rows: RowStack<'_>, kept: &BlockSolveStore) {
+        crate::interface::reserve_unit_support(self, rows, kept);
+    }
     fn dense_interface_block(&self, rows: RowStack<'_>) -> bool {
         crate::interface::trailing_rows(self.factor, rows).is_some()
     }
@@ -313,6 +324,9 @@ impl FactorisedOperator for SparseCholesky {
         kept: &BlockSolveStore,
     ) -> Result<usize, LinalgError> {
         self.view().interface_columns(rows, wanted, columns, kept)
+    }
+    fn reserve_interface(&self, rows: RowStack<'_>, kept: &BlockSolveStore) {
+        self.view().reserve_interface(rows, kept);
     }
     fn dense_interface_block(&self, rows: RowStack<'_>) -> bool {
         self.view().dense_interface_block(rows)

@@ -649,6 +649,14 @@ pub(crate) fn finish(
     report.slip = slip;
     report.linear_solves = state.iface.solves();
     report.time_s = start.elapsed().as_secs_f64();
+    tracing::debug!(
+        solves = report.linear_solves,
+        solve_s = state.iface.solve_seconds(),
+        rows = state.iface.n_rows(),
+        iterations = report.iterations,
+        time_s = report.time_s,
+        "pdas finished"
+    );
     Ok(ContactSolution { u, lambda_n, lambda_t, report })
 }
 
