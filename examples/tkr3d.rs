@@ -8,7 +8,8 @@
 //! each of the 101 frames of the fluoroscopic gait cycle: five coordinates prescribed from the
 //! kinematics file (`x_insert = R x_femur + t`, `R = R_z R_x R_y`), the superior–inferior
 //! translation force-controlled with the ISO 14243-1 axial force and started from the measured
-//! one. Per pose: medial and lateral contact force, contact area, peak pressure and centre of
+//! one; lubricated Coulomb friction (μ = 0.04) against the moving femoral component. Per
+//! pose: medial and lateral contact force, contact area, peak pressure and centre of
 //! pressure. Writes `out/tkr3d/` (PVD series of the contact state, CSV, SVG plots) and prints
 //! one JSON line.
 //!
@@ -16,7 +17,7 @@
 //! cargo run --release --example tkr3d            # 1 mm articular mesh
 //! cargo run --release --example tkr3d -- --fine  # 0.5 mm
 //! cargo run --release --example tkr3d -- --fine --poses 13,50  # only these % of the cycle
-//! cargo run --release --example tkr3d -- --friction 0.04        # friction against the femur
+//! cargo run --release --example tkr3d -- --friction 0             # frictionless
 //! cargo run --release --example tkr3d -- --free-adduction --free-ml  # femur free in 2 more dofs
 //! ```
 
@@ -41,6 +42,9 @@ const UHMWPE: (f64, f64) = (463.0, 0.46);
 /// inactive row (mm).
 const SEARCH_DISTANCE: f64 = 3.0;
 
+/// Coulomb coefficient of lubricated CoCr–UHMWPE (0.04–0.1 in pin-on-plate tests at these
+/// pressures; docs/tkr3d.md).
+const FRICTION: f64 = 0.04;
 /// Rows with a larger gap (mm) are left out of each contact solve until they come into
 /// contact (`--screening-band 0`: every candidate in every solve).
 const SCREENING_BAND: f64 = 0.5;
@@ -134,12 +138,13 @@ fn main() -> Result<(), Error> {
         .prescribe(5, column("knee_rot_r", 1.0)?)?; // column 7: rotation about z
     let measured_si = column("knee_sup_r", 1000.0)?;
     joint.add_rigid_body(femur)?;
-    // `--friction μ`: Coulomb friction (frozen to Tresca per pose) against the moving femoral
-    // component, the slip measured relative to it (docs/model.md (10.5)); the poses are then
-    // quasi-static levels, each from the previous one
+    // lubricated CoCr–UHMWPE friction (`--friction μ`, default 0.04): Coulomb friction
+    // (frozen to Tresca per pose) against the moving femoral component, the slip measured
+    // relative to it (docs/model.md (10.5)); the poses are quasi-static levels, each from the
+    // previous one (`--friction 0`: frictionless, each pose a static solve)
     let friction: f64 = match std::env::args().skip_while(|a| a != "--friction").nth(1) {
         Some(v) => v.parse()?,
-        None => 0.0,
+        None => FRICTION,
     };
     if !(0.0..1.0).contains(&friction) {
         return Err(format!("--friction takes a coefficient in [0, 1), got {friction}").into());

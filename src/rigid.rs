@@ -462,6 +462,11 @@ impl<const D: usize> RigidBody<D> {
     }
 }
 
+/// Largest motion of the force-controlled coordinates from the pose the contact geometry was
+/// built at (relative to the model size) for which trials run on its first-order gaps
+/// (docs/model.md (10.4)); beyond it the geometry is rebuilt before the trial.
+const LINEAR_REACH: Real = 2e-3;
+
 /// Parameters of the force-control iteration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ForceControlParams {
@@ -651,14 +656,27 @@ impl RigidDriver {
         let mut previous: Option<(Vec<Real>, Vec<Real>, Real)> = None;
         // several unknowns: the line search under way
         let mut line: Option<LineSearch> = None;
+        // converged on first-order gaps: rebuild the geometry at `z` and solve again
+        let mut confirm = false;
         stepper.set_record_strain_energy(false);
         let outcome = loop {
             if solves >= params.max_solves {
                 break Err(self.no_convergence(joint, &unknowns, &best, solves, t));
             }
-            // the geometry at the pose `z` once it moved beyond the tolerance from the pose it
-            // was built at: the gaps of `linear` are exact to first order only
-            if posed_pairs && moved(&z, &linear.base) > geometry_tolerance {
+            // the geometry is rebuilt at the pose `z` when the iteration has converged on the
+            // first-order gaps of `linear` away from the pose they were built at (to confirm
+            // it on the exact geometry), or when it moved so far that first order is no guide;
+            // in between, trials run on the first-order gaps (docs/model.md (10.4))
+            let away = moved(&z, &linear.base);
+            if posed_pairs && away > geometry_tolerance && (confirm || away > LINEAR_REACH * length) {
+                if confirm {
+                    // the residual on the exact geometry differs a little from the first-order
+                    // one: brackets and secants of the first-order trials do not carry over
+                    bracket = Bracket::default();
+                    previous = None;
+                    line = None;
+                    confirm = false;
+                }
                 // (errors leave the loop by `break`, so the stepper records energies again)
                 match self.linearise(joint, stepper, &unknowns, &z, posed_pairs) {
                     Ok(built) => (geometry, linear) = built,
@@ -685,8 +703,14 @@ impl RigidDriver {
                         .flatten()
                         .is_some_and(|b| unknowns.iter().any(|&(ub, _)| ub == b))
             });
+            // a trial on first-order gaps away from their pose is not a solution of the level
+            let exact = !posed_pairs || moved(&z, &linear.base) <= geometry_tolerance;
+            if error <= params.tolerance && !exact {
+                confirm = true;
+                continue;
+            }
             let converged = error <= params.tolerance;
-            if best.as_ref().is_none_or(|(e, _)| error < *e) || converged {
+            if exact && (best.as_ref().is_none_or(|(e, _)| error < *e) || converged) {
                 best = Some((error, (record, result)));
             }
             if converged {

@@ -234,3 +234,86 @@ fn semi_coercive_screening_adds_rows_that_come_into_contact() {
     assert!(added > 0 && screened.normal.proximal_iterations >= 1);
     assert_matches(&screened, &reference);
 }
+
+/// A run without a dense interface block (`max_dofs = 0`: whole-factor solves), the rows
+/// screened by their gap (`StaticContact::set_screening_band`), with `unit_solves` on (the
+/// columns of `S` from kept unit solves, as for a moving rigid partner) or off.
+fn run_banded<const D: usize>(
+    model: &Model<D>,
+    pairs: &[ContactPair<D>],
+    band: f64,
+    unit_solves: bool,
+    shift: f64,
+    reference: &Run<D>,
+) -> Run<D> {
+    let solver = by_name("pdas").expect("solver");
+    let block = synovia::linalg::InterfaceBlockParams::default().with_max_dofs(0).with_screened_dofs(0);
+    let mut sc = StaticContact::with_interface_block(model, pairs, ElasticParams::default(), block)
+        .expect("factorise");
+    assert!(sc.elastic().cholesky().trailing().is_none(), "no interface block");
+    sc.set_screening_band(Some(band)).expect("band");
+    if unit_solves {
+        sc.context().clear_moved_rows();
+    }
+    let normal = sc.solve(model, 0.0, solver.as_ref(), None, None, None).expect("normal solve");
+    let base = &reference.normal;
+    let gc = sc.geometry().slip_bounds_from_pressure(&base.solution.lambda_n);
+    let tresca = sc
+        .solve(model, shift, solver.as_ref(), Some(&gc), Some(&base.displacement), None)
+        .expect("Tresca solve");
+    let resolve = sc
+        .solve(
+            model,
+            1.5 * shift,
+            solver.as_ref(),
+            Some(&gc),
+            Some(&base.displacement),
+            Some(&tresca.solution),
+        )
+        .expect("warm re-solve");
+    Run { sc, normal, tresca, resolve }
+}
+
+/// Gap screening of whole-factor solves (the tkr3d insert's path, docs/tkr3d.md): a band that
+/// holds the contact zone, and a band of zero (only the touching rows at first) whose rows
+/// that come into contact are added, both with and without kept unit solves, equal the
+/// unscreened solution and satisfy the KKT conditions of the full problem.
+#[test]
+fn gap_band_screening_of_whole_factor_solves_is_exact() {
+    let (model, pairs, shift) = hemisphere();
+    let reference = run(&model, &pairs, usize::MAX, shift, None);
+    let contact = in_contact(&reference.normal);
+    let gaps: Vec<f64> = reference.sc.geometry().nodes.iter().map(|n| n.gap).collect();
+    let widest = contact.iter().map(|&r| gaps[r]).fold(0.0_f64, f64::max);
+    let rows = gaps.len();
+    for (band, unit_solves) in [(2.0 * widest, true), (0.0, true), (0.0, false)] {
+        let screened = run_banded(&model, &pairs, band, unit_solves, shift, &reference);
+        let outside: Vec<usize> = contact.iter().copied().filter(|&r| gaps[r] > band).collect();
+        let near = gaps.iter().filter(|&&d| d <= band).count();
+        println!(
+            "band {band:.3e} (unit solves {unit_solves}): {near} of {rows} rows near, {} rows in contact from outside the band",
+            outside.len()
+        );
+        assert!(near < rows, "the band must leave rows out");
+        if band == 0.0 {
+            assert!(!outside.is_empty(), "rows outside the band must come into contact");
+        } else {
+            assert!(outside.is_empty());
+        }
+        assert_matches(&screened, &reference);
+    }
+}
+
+/// A screening band that is negative or not finite is a typed error naming the value.
+#[test]
+fn a_bad_screening_band_is_refused() {
+    let (model, pairs, _) = hemisphere();
+    let mut sc = StaticContact::new(&model, &pairs, ElasticParams::default()).expect("factorise");
+    for band in [-1.0, f64::NAN, f64::INFINITY] {
+        let e = sc.set_screening_band(Some(band)).expect_err("refused");
+        assert!(e.to_string().contains("screening band"), "{e}");
+    }
+    let mut joint = synovia::prelude::JointModel::<3>::new();
+    assert!(joint.screening_band(Some(-0.5)).is_err());
+    assert!(joint.screening_band(Some(0.5)).is_ok() && joint.screening_band_value() == Some(0.5));
+}
