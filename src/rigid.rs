@@ -663,12 +663,16 @@ impl RigidDriver {
             if solves >= params.max_solves {
                 break Err(self.no_convergence(joint, &unknowns, &best, solves, t));
             }
-            // the geometry is rebuilt at the pose `z` when the iteration has converged on the
-            // first-order gaps of `linear` away from the pose they were built at (to confirm
-            // it on the exact geometry), or when it moved so far that first order is no guide;
-            // in between, trials run on the first-order gaps (docs/model.md (10.4))
+            // one unknown: the geometry is rebuilt at the pose `z` when the iteration has
+            // converged on the first-order gaps of `linear` away from the pose they were built
+            // at (to confirm it on the exact geometry), or when it moved so far that first
+            // order is no guide; in between, trials run on the first-order gaps (docs/model.md
+            // (10.4)). Several unknowns (line searches on the potential, whose bracketing
+            // does not survive a change of geometry): rebuilt at every move beyond the
+            // tolerance.
             let away = moved(&z, &linear.base);
-            if posed_pairs && away > geometry_tolerance && (confirm || away > LINEAR_REACH * length) {
+            let first_order = unknowns.len() == 1 && !confirm && away <= LINEAR_REACH * length;
+            if posed_pairs && away > geometry_tolerance && !first_order {
                 if confirm {
                     // the residual on the exact geometry differs a little from the first-order
                     // one: brackets and secants of the first-order trials do not carry over
