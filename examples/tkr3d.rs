@@ -166,7 +166,7 @@ fn main() -> Result<(), Error> {
         // (168 N) sits near 1e-10 of the scale, so equilibrium is asked to 1e-8 (the
         // acceptance bound of the main job is 1e-3)
         control.fresh_jacobian = true;
-        control.max_solves = 200;
+        control.max_solves = 500;
         control.tolerance = 1e-8;
     }
     joint.force_control(control);

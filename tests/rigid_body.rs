@@ -242,3 +242,41 @@ fn drag_at(t: f64) -> f64 {
         t => 0.1 - 0.05 * (t - 2.0),
     }
 }
+
+/// A force-controlled body whose predictor starts a frictional level lifted off its partner:
+/// the friction frozen from the previous level (Tresca, with the slip bounds of that level's
+/// pressure) still gives reactions, but no normal force holds the body, so it is moved back
+/// into contact along its force (not taken for a touching body with no stiffness, which had
+/// made the secant jump or the level fail as unresisted).
+#[test]
+fn a_lifted_start_with_frozen_friction_returns_to_contact() -> Result<(), Box<dyn std::error::Error>> {
+    let mut joint = block2d()?;
+    joint.clamp("block", "bottom")?;
+    let centre = Point::<2>::new(0.0, 3.0);
+    let drag = synovia::time::history::FnHistory::new(drag_at);
+    // the guess of the vertical coordinate jumps 0.5 up at t = 1: the level starts lifted off
+    let lift = synovia::time::history::FnHistory::new(|t: f64| if t < 0.5 { 0.0 } else { 0.5 });
+    let cylinder = RigidBody::<2>::new("cylinder", centre)?.prescribe(0, drag)?.force_with_guess(
+        1,
+        Constant(-20.0),
+        lift,
+    )?;
+    joint.add_rigid_body(cylinder)?;
+    let shape = Arc::new(SphereObstacle::new(centre, 2.0, false)?);
+    joint.contact_rigid_body("drag", "block", "top", "cylinder", shape, 0.2)?;
+    let mut session = joint.prepare()?;
+    session.solve_static(0.0)?;
+    let seated = session.record().ok_or("no record")?.rigid[0].dofs[1];
+    let report = session.step(1.0)?;
+    let rec = session.record().ok_or("no record")?;
+    let rigid = &rec.rigid[0];
+    println!("seated at {seated:.6}, after the lifted start {:.6}, {} solves", rigid.dofs[1], rigid.solves);
+    assert!(report.kkt < 1e-8, "KKT {}", report.kkt);
+    assert!(rigid.balance_error < 1e-9, "{rigid:?}");
+    assert!((rigid.dofs[1] - seated).abs() < 0.05, "back in contact: {} vs {seated}", rigid.dofs[1]);
+    assert!((rec.pairs[0].force[1] + 20.0).abs() < 1e-8 * 20.0, "{:?}", rec.pairs[0]);
+    // the approach along the force and a few secant steps (measured 8; 19 when the friction
+    // reactions counted as contact and the first steps saw no vertical stiffness)
+    assert!(rigid.solves <= 12, "{} solves", rigid.solves);
+    Ok(())
+}
