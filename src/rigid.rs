@@ -55,6 +55,7 @@
 
 use std::fmt;
 use std::sync::{Arc, RwLock};
+use synovia_time::results::{cross3 as cross, embed3 as embed};
 
 use synovia_contact::operators::SignedDistance;
 use synovia_mesh::math::{Point, Real, Tensor, Vector};
@@ -551,19 +552,6 @@ impl LinearGaps {
 
 /// A force system: its resultant and its moment about the origin (3 components each).
 type ForceSystem = ([Real; 3], [Real; 3]);
-
-/// A vector of dimension `D` embedded in 3D.
-fn embed<const D: usize>(v: &Vector<D>) -> [Real; 3] {
-    let mut out = [0.0; 3];
-    for (o, x) in out.iter_mut().zip(v.iter()) {
-        *o = *x;
-    }
-    out
-}
-
-fn cross(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-}
 
 impl RigidDriver {
     pub(crate) fn new<const D: usize>(joint: &JointModel<D>) -> Self {

@@ -84,8 +84,20 @@ pub fn empty_pair_records<const D: usize>(geometry: &ContactGeometry<D>) -> Vec<
 
 /// `x × f` of two vectors of dimension `D` embedded in 3D.
 fn moment_of<const D: usize>(x: &Vector<D>, f: &Vector<D>) -> [Real; 3] {
-    let e = |v: &Vector<D>| [v[0], v[1], if D > 2 { v[2] } else { 0.0 }];
-    let (a, b) = (e(x), e(f));
+    cross3(embed3(x), embed3(f))
+}
+
+/// A 2D or 3D vector as a 3D one (2D: `z = 0`), for moments and rotations of both dimensions.
+pub fn embed3<const D: usize>(v: &Vector<D>) -> [Real; 3] {
+    let mut out = [0.0; 3];
+    for (o, x) in out.iter_mut().zip(v.iter()) {
+        *o = *x;
+    }
+    out
+}
+
+/// `a × b`.
+pub fn cross3(a: [Real; 3], b: [Real; 3]) -> [Real; 3] {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
