@@ -28,10 +28,21 @@ fn run<const D: usize>(
     shift: f64,
     reference: Option<&Run<D>>,
 ) -> Run<D> {
-    let solver = by_name("pdas").expect("solver");
     let block = synovia::linalg::InterfaceBlockParams::default().with_max_dofs(max_trailing_dofs);
     let sc = StaticContact::with_interface_block(model, pairs, ElasticParams::default(), block)
         .expect("factorise");
+    three_solves(sc, model, shift, reference)
+}
+
+/// The three solves of a [`Run`] on `sc` (slip bounds and slip origin from the reference's
+/// normal solve when given, else from its own).
+fn three_solves<const D: usize>(
+    sc: StaticContact<D>,
+    model: &Model<D>,
+    shift: f64,
+    reference: Option<&Run<D>>,
+) -> Run<D> {
+    let solver = by_name("pdas").expect("solver");
     let normal = sc.solve(model, 0.0, solver.as_ref(), None, None, None).expect("normal solve");
     let base = reference.map_or(&normal, |r| &r.normal);
     let gc = sc.geometry().slip_bounds_from_pressure(&base.solution.lambda_n);
@@ -246,7 +257,6 @@ fn run_banded<const D: usize>(
     shift: f64,
     reference: &Run<D>,
 ) -> Run<D> {
-    let solver = by_name("pdas").expect("solver");
     let block = synovia::linalg::InterfaceBlockParams::default().with_max_dofs(0).with_screened_dofs(0);
     let mut sc = StaticContact::with_interface_block(model, pairs, ElasticParams::default(), block)
         .expect("factorise");
@@ -255,23 +265,7 @@ fn run_banded<const D: usize>(
     if unit_solves {
         sc.context().clear_moved_rows();
     }
-    let normal = sc.solve(model, 0.0, solver.as_ref(), None, None, None).expect("normal solve");
-    let base = &reference.normal;
-    let gc = sc.geometry().slip_bounds_from_pressure(&base.solution.lambda_n);
-    let tresca = sc
-        .solve(model, shift, solver.as_ref(), Some(&gc), Some(&base.displacement), None)
-        .expect("Tresca solve");
-    let resolve = sc
-        .solve(
-            model,
-            1.5 * shift,
-            solver.as_ref(),
-            Some(&gc),
-            Some(&base.displacement),
-            Some(&tresca.solution),
-        )
-        .expect("warm re-solve");
-    Run { sc, normal, tresca, resolve }
+    three_solves(sc, model, shift, Some(reference))
 }
 
 /// Gap screening of whole-factor solves (the tkr3d insert's path, docs/tkr3d.md): a band that

@@ -627,6 +627,22 @@ mod tests {
         a
     }
 
+    /// Every column of `S` of `rows` through the Cholesky back-end with `store`, and the
+    /// number of solves it took.
+    fn all_columns(
+        op: &SparseCholesky,
+        rows: &SparseRows,
+        store: &BlockSolveStore,
+    ) -> (Vec<Option<Vec<f64>>>, usize) {
+        let mut columns = vec![None; rows.nrows()];
+        let all: Vec<usize> = (0..rows.nrows()).collect();
+        let solved = op
+            .view()
+            .interface_columns(RowStack::new(rows, None), &all, &mut columns, store)
+            .expect("columns");
+        (columns, solved)
+    }
+
     /// `S = C A⁻¹ Cᵀ` by dense whole solves, the reference.
     fn reference_columns(op: &SparseCholesky, rows: &SparseRows) -> Vec<Vec<f64>> {
         (0..rows.nrows())
@@ -763,13 +779,8 @@ mod tests {
         let mut solves = Vec::new();
         for angle in [0.3, 0.5, 0.0, 0.7] {
             let rows = node_rows(angle);
-            let mut columns = vec![None; rows.nrows()];
-            let all: Vec<usize> = (0..rows.nrows()).collect();
-            solves.push(
-                op.view()
-                    .interface_columns(RowStack::new(&rows, None), &all, &mut columns, &store)
-                    .expect("columns"),
-            );
+            let (columns, solved) = all_columns(&op, &rows, &store);
+            solves.push(solved);
             check(&rows, &columns);
         }
         // 12 unit solves and the long row at first, then only the long row
@@ -826,13 +837,8 @@ mod tests {
         let mut solves = Vec::new();
         for nodes in [&[2usize, 9][..], &[9, 30][..], &[2, 30][..]] {
             let rows = rows_of(nodes);
-            let mut columns = vec![None; rows.nrows()];
-            let all: Vec<usize> = (0..rows.nrows()).collect();
-            solves.push(
-                op.view()
-                    .interface_columns(RowStack::new(&rows, None), &all, &mut columns, &store)
-                    .expect("columns"),
-            );
+            let (columns, solved) = all_columns(&op, &rows, &store);
+            solves.push(solved);
             let reference = reference_columns(&op, &rows);
             for (j, col) in columns.iter().enumerate() {
                 for (a, b) in col.as_ref().expect("column").iter().zip(&reference[j]) {
