@@ -103,6 +103,7 @@ tolerance = 1e-9
 max_iterations = 50
 rho_scale = 2.0
 nested_iteration = 0
+screening_band = 0.25
 ordering = "amd"
 load_degree = 3
 
@@ -289,6 +290,12 @@ fn semantic_errors_name_key_and_position() {
         assert!(SMALL.contains(from), "{from}");
         SMALL.replacen(from, to, 1)
     };
+    assert_error(
+        &with("type = \"static\"\n", "type = \"static\"\n[solver]\nscreening_band = -0.5\n"),
+        "solver.screening_band",
+        "-0.5",
+        "screening band",
+    );
     assert_error(
         &with("cells = [2, 2] }", "cells = [2, 2], radius = 1.0 }"),
         "body[0].mesh.radius",

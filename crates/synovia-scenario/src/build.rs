@@ -1614,6 +1614,11 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
         let base = synovia::linalg::InterfaceBlockParams::default();
         joint.interface_block(base.with_max_dofs(v).with_screened_dofs(base.screened_dofs.min(v)));
     }
+    if let Some(b) = &s.screening_band {
+        joint
+            .screening_band(Some(*b.get_ref()))
+            .map_err(|e| cx.err(key(k, "screening_band"), b.span(), e.to_string()))?;
+    }
     let mut elastic = ElasticParams::default();
     if let Some(o) = &s.ordering {
         elastic.ordering = match o.get_ref().as_str() {

@@ -617,6 +617,9 @@ pub struct SolverSpec {
     /// Largest number of contact dofs ordered last as a dense interface block (default 8000;
     /// 0: none, whole-factor solves of the active rows).
     pub interface_block_dofs: Option<Sp<usize>>,
+    /// Gap screening of whole-factor solves (length): each solve runs on the contact rows with
+    /// gap at most this and adds the others that come into contact (exact).
+    pub screening_band: Option<Sp<f64>>,
 }
 
 /// The analysis (flat table; `type` says which keys apply).
