@@ -18,6 +18,7 @@
 //! cargo run --release --example tkr3d -- --fine  # 0.5 mm
 //! cargo run --release --example tkr3d -- --fine --poses 13,50  # only these % of the cycle
 //! cargo run --release --example tkr3d -- --friction 0             # frictionless
+//! cargo run --release --example tkr3d -- --balance-tolerance 1e-8  # force balance (default 1e-10)
 //! cargo run --release --example tkr3d -- --free-adduction --free-ml  # femur free in 2 more dofs
 //! ```
 
@@ -160,6 +161,9 @@ fn main() -> Result<(), Error> {
     let mut control = synovia::rigid::ForceControlParams::default();
     if let Some(tol) = std::env::args().skip_while(|a| a != "--geometry-tolerance").nth(1) {
         control.geometry_tolerance = tol.parse()?;
+    }
+    if let Some(tol) = std::env::args().skip_while(|a| a != "--balance-tolerance").nth(1) {
+        control.tolerance = tol.parse()?;
     }
     if free_adduction || free_ml {
         // several unknowns, one of them a moment: the rounding of the reactions in swing
