@@ -449,15 +449,10 @@ impl<const D: usize> JointModel<D> {
     /// cost of the interface follows its rows. `None` (default): no screening.
     ///
     /// # Errors
-    /// [`JointError::Invalid`] for a band that is negative or not finite.
+    /// [`JointError::Contact`] for a band that is negative or not finite
+    /// ([`synovia_contact::static_contact::check_screening_band`]).
     pub fn screening_band(&mut self, band: Option<Real>) -> Result<&mut Self, JointError> {
-        if let Some(b) = band {
-            if !(b.is_finite() && b >= 0.0) {
-                return Err(JointError::Invalid(format!(
-                    "screening band must be finite and non-negative, got {b}"
-                )));
-            }
-        }
+        synovia_contact::static_contact::check_screening_band(band)?;
         self.screening_band = band;
         Ok(self)
     }

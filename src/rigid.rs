@@ -646,6 +646,8 @@ impl RigidDriver {
         let mut line: Option<LineSearch> = None;
         // converged on first-order gaps: rebuild the geometry at `z` and solve again
         let mut confirm = false;
+        // the rigid body of each pair (by pair name: the same for every rebuilt geometry)
+        let owner = joint.pair_rigid_owner(&geometry);
         stepper.set_record_strain_energy(false);
         let outcome = loop {
             if solves >= params.max_solves {
@@ -686,7 +688,6 @@ impl RigidDriver {
             // pressed: a node of a pair with a force-controlled body carries a normal force
             // (frozen Tresca friction holds with no normal force at all, so the reactions
             // alone do not tell a body that lifted off from one that touches)
-            let owner = joint.pair_rigid_owner(&geometry);
             let pressed = result.solution.lambda_n.iter().zip(&geometry.nodes).any(|(l, node)| {
                 *l > 0.0
                     && owner

@@ -322,13 +322,7 @@ impl<const D: usize> StaticContact<D> {
     /// # Errors
     /// [`ContactError::InvalidParameter`] for a band that is negative or not finite.
     pub fn set_screening_band(&mut self, band: Option<Real>) -> Result<(), ContactError> {
-        if let Some(b) = band {
-            if !(b.is_finite() && b >= 0.0) {
-                return Err(ContactError::InvalidParameter(format!(
-                    "screening band must be finite and non-negative, got {b}"
-                )));
-            }
-        }
+        check_screening_band(band)?;
         self.screening_band = band;
         Ok(())
     }
@@ -819,6 +813,20 @@ pub fn interface_ordering<const D: usize>(
         let groups: Vec<std::ops::Range<usize>> =
             interface.iter().map(|&(b, i)| dofs.node_dofs(b, i)).collect();
         Ok(block.ordering(base, &groups, dofs.n_dofs()))
+    }
+}
+
+/// `Ok` for a screening band ([`StaticContact::set_screening_band`]) that is `None` or finite
+/// and non-negative.
+///
+/// # Errors
+/// [`ContactError::InvalidParameter`] naming the band otherwise.
+pub fn check_screening_band(band: Option<Real>) -> Result<(), ContactError> {
+    match band {
+        Some(b) if !(b.is_finite() && b >= 0.0) => Err(ContactError::InvalidParameter(format!(
+            "screening band must be finite and non-negative, got {b}"
+        ))),
+        _ => Ok(()),
     }
 }
 

@@ -473,12 +473,9 @@ fn whole_factor_unit_columns(
         None => {
             let row_entries: Vec<Vec<(usize, f64)>> =
                 (0..rows.n_rows()).map(|r| rows.row(r).collect()).collect();
-            let mut dofs_of_rows: Vec<usize> = row_entries.iter().flatten().map(|&(p, _)| p).collect();
-            dofs_of_rows.sort_unstable();
-            dofs_of_rows.dedup();
             // the store's dofs (a superset of these rows' dofs: rows whose normals gain or lose
             // a zero component, coarse levels of a nested iteration)
-            let support = kept.unit_support(id, &dofs_of_rows);
+            let support = kept.unit_support(id, &dofs_of(&row_entries));
             let positions: RowPositions = Arc::new(
                 row_entries
                     .iter()
@@ -571,10 +568,16 @@ pub(crate) fn reserve_unit_support(op: &CholeskyOperator<'_>, rows: RowStack<'_>
     if rows.ncols() != op.n() || !kept.unit_solves() || trailing_rows(op.factor(), rows).is_some() {
         return;
     }
-    let mut dofs: Vec<usize> = (0..rows.n_rows()).flat_map(|r| rows.row(r).map(|(p, _)| p)).collect();
+    let row_entries: Vec<Vec<(usize, f64)>> = (0..rows.n_rows()).map(|r| rows.row(r).collect()).collect();
+    kept.unit_support(whole_factor_id(op), &dofs_of(&row_entries));
+}
+
+/// The dofs of rows given by their `(dof, value)` entries, sorted, without repeats.
+fn dofs_of(row_entries: &[Vec<(usize, f64)>]) -> Vec<usize> {
+    let mut dofs: Vec<usize> = row_entries.iter().flatten().map(|&(p, _)| p).collect();
     dofs.sort_unstable();
     dofs.dedup();
-    kept.unit_support(whole_factor_id(op), &dofs);
+    dofs
 }
 
 /// The trailing-block solves `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` (in trailing positions) of the rows
