@@ -20,6 +20,7 @@
 //! cargo run --release --example tkr3d -- --friction 0             # frictionless
 //! cargo run --release --example tkr3d -- --balance-tolerance 1e-8  # force balance (default 1e-10)
 //! cargo run --release --example tkr3d -- --free-adduction --free-ml  # femur free in 2 more dofs
+//! cargo run --release --example tkr3d -- --contact-min-ny -0.3  # also the steep flanks as candidates
 //! ```
 
 use std::fmt::Write as _;
@@ -104,8 +105,16 @@ fn main() -> Result<(), Error> {
     joint.add_gmsh_bodies(format!("{DATA}/mesh/{mesh_file}"), |_| Some(uhmwpe.clone().into()))?;
     joint.clamp("insert", "tray")?;
     // the contact candidates: every upward-facing facet above the tray (the meshes' `articular`
-    // part starts at y = 6 mm and misses the bottom of the dishes, at 5.9 mm; docs/meshing.md)
-    joint.define_part("insert", "contact", |x, n| n[1] > 0.5 && x[1] > 1.0)?;
+    // part starts at y = 6 mm and misses the bottom of the dishes, at 5.9 mm; docs/meshing.md);
+    // `--contact-min-ny c`: facets with `n_y > c` (default 0.5, at most 60° from horizontal)
+    let min_ny: f64 = match std::env::args().skip_while(|a| a != "--contact-min-ny").nth(1) {
+        Some(v) => v.parse()?,
+        None => 0.5,
+    };
+    if !(-1.0..1.0).contains(&min_ny) {
+        return Err(format!("--contact-min-ny takes a normal component in [-1, 1), got {min_ny}").into());
+    }
+    joint.define_part("insert", "contact", move |x, n| n[1] > min_ny && x[1] > 1.0)?;
 
     // the femoral component: rigid, bounded by its closed surface (metres → mm)
     let femur_surface = read_stl(format!("{DATA}/femoral_component.stl"))?.scaled(1000.0)?;
