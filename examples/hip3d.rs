@@ -37,7 +37,7 @@ fn main() -> Result<(), KneeError> {
     // load levels (cycle fractions): heel strike, loading, first peak, mid-stance, second peak,
     // push-off, toe-off, swing
     let times = [0.0, 0.05, 0.15, 0.30, 0.48, 0.55, 0.62, 0.80];
-    let mut series = TimeSeriesWriter::new(&out, "hip3d", Encoding::Base64)?;
+    let mut series = TimeSeriesWriter::new(&out, "hip3d", Encoding::Zlib)?;
     println!(
         "| level | cycle % | F (N) | F/BW | contact (N) | shear (N) | balance err | peak p (MPa) | mean p (MPa) | area (mm²) | active | δ (mm) | solves | KKT | s |"
     );
@@ -67,7 +67,7 @@ fn main() -> Result<(), KneeError> {
         if !res.kkt.satisfied(1e-8) {
             return Err(format!("level {i}: KKT violated: {:?}", res.kkt).into());
         }
-        let vtu = synovia::output::contact_vtu(&model.model, model.contact.geometry(), res, Encoding::Base64)?;
+        let vtu = synovia::output::contact_vtu(&model.model, model.contact.geometry(), res, Encoding::Zlib)?;
         series.write_step(s.time, &vtu)?;
         i += 1;
         Ok(())

@@ -106,7 +106,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // ## Step 6: write results
     let path = std::path::Path::new(&out).join("tibial_plateau.vtu");
-    synovia::output::contact_vtu(&model, geo, &res, Encoding::Base64)?.write(&path)?;
+    synovia::output::contact_vtu(&model, geo, &res, Encoding::Zlib)?.write(&path)?;
     println!(
         "wrote {} (open in ParaView; colour by contact_pressure, Warp By Vector on displacement)",
         path.display()

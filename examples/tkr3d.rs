@@ -21,6 +21,7 @@
 //! cargo run --release --example tkr3d -- --balance-tolerance 1e-8  # force balance (default 1e-10)
 //! cargo run --release --example tkr3d -- --free-adduction --free-ml  # femur free in 2 more dofs
 //! cargo run --release --example tkr3d -- --contact-min-ny -0.3  # also the steep flanks as candidates
+//! cargo run --release --example tkr3d -- --stress  # VTU files also with stress and strain tensors
 //! ```
 
 use std::fmt::Write as _;
@@ -90,6 +91,7 @@ fn main() -> Result<(), Error> {
     let fine = std::env::args().any(|a| a == "--fine");
     let free_adduction = std::env::args().any(|a| a == "--free-adduction");
     let free_ml = std::env::args().any(|a| a == "--free-ml");
+    let stress = std::env::args().any(|a| a == "--stress");
     let out = std::env::args().skip_while(|a| a != "--out").nth(1).unwrap_or_else(|| {
         if fine {
             "out/tkr3d_fine".into()
@@ -204,7 +206,7 @@ fn main() -> Result<(), Error> {
     let dofs = session.elastic_info().n_dofs;
     let setup_s = start.elapsed().as_secs_f64();
     std::fs::create_dir_all(&out)?;
-    let mut series = TimeSeriesWriter::new(&out, "tkr3d", Encoding::Base64)?;
+    let mut series = TimeSeriesWriter::new(&out, "tkr3d", Encoding::Zlib)?;
     let mut poses = Vec::new();
     println!("| cycle % | F (N) | SI (mm) | SI measured (mm) | balance | KKT | medial (N) | lateral (N) | area (mm²) | peak p (MPa) | solves | s |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
@@ -271,8 +273,12 @@ fn main() -> Result<(), Error> {
             return Err(format!("pose {i}: KKT residual {:.2e} > 1e-8 ({detail})", pose.kkt).into());
         }
         let result = session.result().ok_or("no result")?;
-        let vtu =
-            synovia::output::contact_vtu(session.model(), session.geometry(), result, Encoding::Base64)?;
+        // the contact state (`--stress`: also the stress and strain fields, docs/output.md)
+        let vtu = if stress {
+            synovia::output::contact_vtu(session.model(), session.geometry(), result, Encoding::Zlib)?
+        } else {
+            synovia::output::contact_state_vtu(session.model(), session.geometry(), result, Encoding::Zlib)?
+        };
         series.write_step(t, &vtu)?;
         poses.push(pose);
     }

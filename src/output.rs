@@ -1,15 +1,16 @@
-//! Writing solutions for ParaView: one VTU piece per body with the displacement, the stress
-//! tensor, von Mises and principal stresses, and the recovered nodal stress.
+//! Writing solutions for ParaView (and any VTK or meshio reader): every body in one VTU piece
+//! with the displacement, the contact fields, and the stress and strain fields of
+//! [`solid_fields`] (stress and strain tensors, principal and von Mises stresses, the
+//! recovered nodal stress).
 
 use synovia_fem::{BodyFields, ElasticSolution, Model};
-use synovia_io::{Encoding, Field, FieldLocation, IoError, VtuWriter};
-use synovia_mesh::math::Tensor;
+use synovia_io::{Encoding, Field, IoError, VtuWriter};
+use synovia_time::solid_fields::solid_fields;
 
-use synovia_fem::element::stress_tensor;
-
-/// A [`VtuWriter`] holding every body of `model` with the fields of `solution`:
-/// point `displacement` (vector), `von_mises_nodal`; cell `stress` (tensor), `von_mises`,
-/// `principal_stress` (3 values, descending), `strain_energy_density`.
+/// A [`VtuWriter`] holding every body of `model` with the fields of `solution`: point
+/// `displacement` and the fields of [`solid_fields`] computed from `fields` (point
+/// `von_mises_nodal`, `stress_nodal`; cell `stress`, `strain`, `von_mises`,
+/// `principal_stress`, `strain_energy_density`).
 pub fn elastic_vtu<const D: usize>(
     model: &Model<D>,
     solution: &ElasticSolution<D>,
@@ -18,26 +19,15 @@ pub fn elastic_vtu<const D: usize>(
 ) -> Result<VtuWriter, IoError> {
     let mut w = VtuWriter::new(encoding);
     for (bi, body) in model.bodies().iter().enumerate() {
-        let f = &fields[bi];
-        let stress: Vec<Tensor<D>> = f.cell_stress.iter().map(|s| stress_tensor::<D>(s)).collect();
-        let energy: Vec<f64> = f
-            .cell_strain
-            .iter()
-            .zip(&f.cell_stress)
-            .map(|(e, s)| 0.5 * e.iter().zip(s).map(|(a, b)| a * b).sum::<f64>())
-            .collect();
-        let principal: Vec<f64> = f.cell_principal.iter().flat_map(|p| p.iter().copied()).collect();
-        w.add_piece(
-            &body.mesh,
-            vec![
-                Field::point_vectors("displacement", &solution.displacement[bi]),
-                Field::point_scalars("von_mises_nodal", f.nodal_von_mises.clone()),
-                Field::cell_tensors("stress", &stress),
-                Field::cell_scalars("von_mises", f.cell_von_mises.clone()),
-                Field::new("principal_stress", FieldLocation::Cell, 3, principal),
-                Field::cell_scalars("strain_energy_density", energy),
-            ],
-        )?;
+        let (Some(f), Some(u)) = (fields.get(bi), solution.displacement.get(bi)) else {
+            return Err(IoError::InvalidField {
+                name: "displacement".into(),
+                reason: format!("no solution or fields for body {bi}"),
+            });
+        };
+        let mut all = vec![Field::point_vectors("displacement", u)];
+        all.extend(solid_fields::<D>(f, |v| *v));
+        w.add_piece(&body.mesh, all)?;
     }
     Ok(w)
 }
@@ -45,16 +35,46 @@ pub fn elastic_vtu<const D: usize>(
 /// A [`VtuWriter`] with every body of `model` and the contact state of `result`: point fields
 /// `displacement`, `contact_pressure` (`Λ_n` at the contact nodes of body `k`, 0 elsewhere),
 /// `contact_active` (1 where `Λ_n > 0`), `friction_traction` (the tangential traction
-/// `−g_c Λ_t T` at the nodes of friction cells) and `stick` (1 sticking, −1 slipping, 0 none).
+/// `−g_c Λ_t T` at the nodes of friction cells) and `stick` (1 sticking, −1 slipping, 0 none),
+/// and the stress and strain fields of [`solid_fields`].
 ///
 /// Bodies placed by the geometry ([`synovia_contact::operators::ContactGeometry::new_placed`])
 /// are written where they are placed, with their displacements turned from the body frame
-/// into space (`R u`).
+/// into space (`R u`) and their tensors likewise (`R T Rᵀ`).
+///
+/// # Errors
+/// [`IoError`] from the writer, and [`IoError::InvalidField`] when `result` does not fit
+/// `model` (its stresses cannot be computed).
 pub fn contact_vtu<const D: usize>(
     model: &Model<D>,
     geometry: &synovia_contact::operators::ContactGeometry<D>,
     result: &synovia_contact::StaticContactResult<D>,
     encoding: Encoding,
+) -> Result<VtuWriter, IoError> {
+    solution_vtu(model, geometry, result, encoding, true)
+}
+
+/// [`contact_vtu`] without the stress and strain fields: the displacement and the contact state
+/// only, for long series where the contact is what is looked at (a gait cycle's files are
+/// 5–7× smaller: `docs/output.md`).
+///
+/// # Errors
+/// [`IoError`] from the writer.
+pub fn contact_state_vtu<const D: usize>(
+    model: &Model<D>,
+    geometry: &synovia_contact::operators::ContactGeometry<D>,
+    result: &synovia_contact::StaticContactResult<D>,
+    encoding: Encoding,
+) -> Result<VtuWriter, IoError> {
+    solution_vtu(model, geometry, result, encoding, false)
+}
+
+fn solution_vtu<const D: usize>(
+    model: &Model<D>,
+    geometry: &synovia_contact::operators::ContactGeometry<D>,
+    result: &synovia_contact::StaticContactResult<D>,
+    encoding: Encoding,
+    with_solid_fields: bool,
 ) -> Result<VtuWriter, IoError> {
     use synovia_mesh::math::Vector;
     let nb = model.bodies().len();
@@ -86,6 +106,12 @@ pub fn contact_vtu<const D: usize>(
             stick[b][i] = if ln < 1.0 - 1e-6 { 1.0 } else { -1.0 };
         }
     }
+    let solid = if with_solid_fields {
+        synovia_fem::post::body_fields(model, &result.displacement)
+            .map_err(|e| IoError::InvalidField { name: "stress".into(), reason: e.to_string() })?
+    } else {
+        Vec::new()
+    };
     let mut w = VtuWriter::new(encoding);
     for (bi, body) in model.bodies().iter().enumerate() {
         let placement = geometry.placement(synovia_fem::BodyId(bi));
@@ -98,16 +124,17 @@ pub fn contact_vtu<const D: usize>(
             placed = m;
             (&placed, result.displacement[bi].iter().map(|u| placement.to_global(u)).collect())
         };
-        w.add_piece(
-            mesh,
-            vec![
-                Field::point_vectors("displacement", &displacement),
-                Field::point_scalars("contact_pressure", pressure[bi].clone()),
-                Field::point_scalars("contact_active", active[bi].clone()),
-                Field::point_vectors("friction_traction", &traction[bi]),
-                Field::point_scalars("stick", stick[bi].clone()),
-            ],
-        )?;
+        let mut all = vec![
+            Field::point_vectors("displacement", &displacement),
+            Field::point_scalars("contact_pressure", pressure[bi].clone()),
+            Field::point_scalars("contact_active", active[bi].clone()),
+            Field::point_vectors("friction_traction", &traction[bi]),
+            Field::point_scalars("stick", stick[bi].clone()),
+        ];
+        if let Some(f) = solid.get(bi) {
+            all.extend(solid_fields::<D>(f, |v| placement.to_global(v)));
+        }
+        w.add_piece(mesh, all)?;
     }
     Ok(w)
 }

@@ -162,7 +162,7 @@ fn vtu_output_of_a_solution_reads_back() {
     let dir = std::env::temp_dir().join(format!("synovia-foundation-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("dir");
     let path = dir.join("beam.vtu");
-    synovia::output::elastic_vtu(&model, &sol, &fields, synovia::io::Encoding::Base64)
+    synovia::output::elastic_vtu(&model, &sol, &fields, synovia::io::Encoding::Zlib)
         .expect("writer")
         .write(&path)
         .expect("write");

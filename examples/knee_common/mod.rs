@@ -19,7 +19,7 @@ pub fn run_cycle(
 ) -> Result<(Vec<KneeStep>, usize, TimeSeriesWriter), KneeError> {
     let solver = synovia::solvers::by_name("pdas")?;
     let times = cycle_times(n);
-    let mut series = TimeSeriesWriter::new(out, name, Encoding::Base64)?;
+    let mut series = TimeSeriesWriter::new(out, name, Encoding::Zlib)?;
     let mut dofs = 0;
     println!(
         "| step | cycle % | flexion ° | F (N) | P (N/mm) | contact (N/mm) | balance err | peak p (MPa) | contact length (mm) | δ (mm) | solves | KKT | s |"
@@ -50,7 +50,7 @@ pub fn run_cycle(
         if !pose.result.kkt.satisfied(1e-8) {
             return Err(format!("step {i}: KKT violated: {:?}", pose.result.kkt).into());
         }
-        let vtu = synovia::output::contact_vtu(pose.model, pose.contact.geometry(), &pose.result, Encoding::Base64)?;
+        let vtu = synovia::output::contact_state_vtu(pose.model, pose.contact.geometry(), &pose.result, Encoding::Zlib)?;
         series.write_step(s.time, &vtu)?;
         i += 1;
         Ok(())

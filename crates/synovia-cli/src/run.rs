@@ -529,12 +529,10 @@ fn run_dim<const D: usize>(
         }
         let vtu = if plan.vtu_every > 0 && (index % plan.vtu_every == 0 || index + 1 == view.n_steps) {
             if writer.is_none() {
-                writer = Some(QuasiStaticOutput::with_encoding(
-                    folder.dir(),
-                    &name,
-                    view.geometry,
-                    plan.encoding,
-                )?);
+                writer = Some(
+                    QuasiStaticOutput::with_encoding(folder.dir(), &name, view.geometry, plan.encoding)?
+                        .with_solid_fields(plan.stress),
+                );
             }
             match writer.as_mut() {
                 Some(w) => {

@@ -4,12 +4,14 @@
 //! tool) in the VTK XML formats, a reader of the same files for round-trip tests and
 //! verification, and a reader of Gmsh meshes.
 //!
-//! * [`VtuWriter`] / [`write_vtu`]: one `.vtu` file (VTK XML `UnstructuredGrid`) holding one
-//!   `<Piece>` per body, with point and cell [`Field`]s.
+//! * [`VtuWriter`] / [`write_vtu`]: one `.vtu` file (VTK XML `UnstructuredGrid`) holding all
+//!   bodies in one `<Piece>` (told apart by the point and cell field `body`), with point and
+//!   cell [`Field`]s, zlib-compressed by default.
 //! * [`PvdWriter`]: a `.pvd` collection listing `.vtu` files with their times (a time series).
 //! * [`TimeSeriesWriter`]: writes `DIR/NAME_0000.vtu`, `DIR/NAME_0001.vtu`, … and rewrites
 //!   `DIR/NAME.pvd` after every step, so an interrupted run still leaves a readable series.
-//! * [`read_vtu`], [`parse_vtu`], [`read_pvd`]: read back exactly what the writers write.
+//! * [`read_vtu`], [`parse_vtu`], [`read_pvd`]: read back exactly what the writers write
+//!   (split into bodies again).
 //! * [`gmsh`]: input of [Gmsh](https://gmsh.info) `.msh` meshes (MSH 4.1 and 2.2, ASCII or
 //!   binary): [`read_msh`] parses a file, [`GmshMesh::bodies`] turns its physical groups into
 //!   one synovia [`Mesh`](synovia_mesh::Mesh) per body with named boundary parts (see the
@@ -23,8 +25,8 @@
 //!
 //! ## File layout
 //!
-//! A `.vtu` file written by [`VtuWriter`] looks like this (one `<Piece>` per body, in the
-//! order the bodies were added):
+//! A `.vtu` file written by [`VtuWriter`] looks like this (shown with [`Encoding::Ascii`]; all
+//! bodies in one `<Piece>`, their points and cells in the order the bodies were added):
 //!
 //! ```xml
 //! <?xml version="1.0"?>
@@ -35,6 +37,7 @@
 //!         <DataArray type="Float64" Name="displacement" NumberOfComponents="3" format="ascii">
 //!           …one tuple per point…
 //!         </DataArray>
+//!         <DataArray type="Int32" Name="body" format="ascii">0 0 0 0</DataArray>
 //!       </PointData>
 //!       <CellData>
 //!         <DataArray type="Float64" Name="stress" NumberOfComponents="9" format="ascii">…</DataArray>
@@ -61,13 +64,17 @@
 //!   `<CellData>` with `NumberOfComponents` = its component count; 2-component fields are
 //!   padded to 3 (`z = 0`) so ParaView treats them as vectors; 9 components are a row-major
 //!   `3 × 3` tensor ([`Field::cell_tensors`] pads 2D tensors).
-//! * **`body`**: the writer always adds an `Int32` cell field named `"body"` holding the piece
-//!   index (0 for the first body added). Callers must not pass a cell field of that name.
-//! * **Encodings** ([`Encoding`]): `format="ascii"` writes `f64` values in Rust's shortest
-//!   round-trip form (`{:e}`, e.g. `1.25e-3`), so they read back bit-exactly;
-//!   `format="binary"` (the default) writes, per array, the base64 encoding of a
-//!   little-endian `UInt32` byte count followed by the raw little-endian values, also exact and
-//!   about three times smaller. No compression, no appended data.
+//! * **`body`**: the writer always adds an `Int32` point field and an `Int32` cell field named
+//!   `"body"` holding the body index (0 for the first body added). Callers must not pass a
+//!   field of that name. One piece rather than one per body so that every reader gets every
+//!   body: meshio 5.3 keeps only the last piece of a file (its issue #1444).
+//! * **Encodings** ([`Encoding`]): [`Encoding::Zlib`] (the default) writes `format="binary"`
+//!   with `compressor="vtkZLibDataCompressor"` and `header_type="UInt64"`: per array the base64
+//!   of the block header and the base64 of the zlib-compressed 32 KiB blocks, VTK's own layout;
+//!   `format="ascii"` writes `f64` values in Rust's shortest round-trip form (`{:e}`, e.g.
+//!   `1.25e-3`); [`Encoding::Base64`] writes, per array, the base64 encoding of a little-endian
+//!   `UInt32` byte count followed by the raw little-endian values. All three are exact. No
+//!   appended data.
 //!
 //! A `.pvd` collection lists the files of a time series:
 //!

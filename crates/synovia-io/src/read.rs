@@ -12,12 +12,15 @@ use synovia_mesh::{Mesh, Point};
 use crate::error::IoError;
 use crate::field::{Field, FieldLocation};
 use crate::util::{attributes, element_name};
-use crate::vtu::{VTK_TETRA, VTK_TRIANGLE};
+use crate::vtu::{BODY_FIELD, VTK_TETRA, VTK_TRIANGLE};
 
-/// The contents of a `.vtu` file: its pieces in file order.
+/// The contents of a `.vtu` file: its bodies in file order.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct VtuData {
-    /// One entry per `<Piece>` (per body, for files written by [`crate::VtuWriter`]).
+    /// One entry per body. A `<Piece>` carrying the point and cell fields `"body"` (as
+    /// [`crate::VtuWriter`] writes every file: all bodies in one piece) is split back into its
+    /// bodies, each with its own points (renumbered from 0), cells and field values; the point
+    /// field `"body"` is dropped, the cell field kept. Any other piece is one entry as it is.
     pub pieces: Vec<VtuPiece>,
 }
 
@@ -90,8 +93,9 @@ impl VtuPiece {
     }
 }
 
-/// Reads a `.vtu` file written by [`crate::VtuWriter`] (ASCII or inline base64 binary, either
-/// byte order, `UInt32` or `UInt64` headers, no compression, no appended data).
+/// Reads a `.vtu` file written by [`crate::VtuWriter`] (ASCII, inline base64 binary or
+/// inline zlib-compressed binary, either byte order, `UInt32` or `UInt64` headers, no appended
+/// data), split into bodies ([`VtuData::pieces`]).
 ///
 /// # Errors
 /// [`IoError::Io`] when the file cannot be read; [`IoError::Parse`] (with a message and, for
@@ -147,6 +151,8 @@ struct PieceBuilder {
 struct Header {
     big_endian: bool,
     header_bytes: usize,
+    /// `compressor="vtkZLibDataCompressor"`: binary arrays are zlib blocks.
+    zlib: bool,
 }
 
 struct Parser {
@@ -161,7 +167,7 @@ fn parse_vtu_document(xml: &str) -> Result<VtuData, String> {
     let mut reader = Reader::from_str(xml);
     let mut p = Parser {
         stack: Vec::new(),
-        header: Header { big_endian: false, header_bytes: 4 },
+        header: Header { big_endian: false, header_bytes: 4, zlib: false },
         pieces: Vec::new(),
         piece: None,
         array: None,
@@ -221,7 +227,86 @@ fn parse_vtu_document(xml: &str) -> Result<VtuData, String> {
             _ => {}
         }
     }
-    Ok(VtuData { pieces: p.pieces })
+    let mut pieces = Vec::with_capacity(p.pieces.len());
+    for (index, piece) in p.pieces.into_iter().enumerate() {
+        pieces.extend(split_bodies(piece).map_err(|m| format!("piece {index}: {m}"))?);
+    }
+    Ok(VtuData { pieces })
+}
+
+/// The bodies of a piece with point and cell fields [`BODY_FIELD`] (else the piece itself).
+fn split_bodies(mut piece: VtuPiece) -> Result<Vec<VtuPiece>, String> {
+    let (Some(pi), Some(ci)) = (
+        piece.point_data.iter().position(|f| f.name == BODY_FIELD && f.components == 1),
+        piece.cell_data.iter().position(|f| f.name == BODY_FIELD && f.components == 1),
+    ) else {
+        return Ok(vec![piece]);
+    };
+    let ids = |f: &Field, what: &str| -> Result<Vec<usize>, String> {
+        f.values
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| {
+                // body indices are small non-negative integers stored exactly
+                if v >= 0.0 && v.fract() == 0.0 && v < 1e9 {
+                    Ok(v as usize)
+                } else {
+                    Err(format!("{what} {i} has body index {v}, not a non-negative integer"))
+                }
+            })
+            .collect()
+    };
+    let point_body = ids(&piece.point_data.remove(pi), "point")?;
+    let cell_body = ids(&piece.cell_data[ci], "cell")?;
+    let n_bodies = point_body.iter().chain(&cell_body).map(|&b| b + 1).max().unwrap_or(0);
+    // every body has a point, so the count is bounded by the file's size
+    if n_bodies > point_body.len() {
+        return Err(format!("body index {} with only {} points", n_bodies - 1, point_body.len()));
+    }
+    let mut local = vec![0_usize; point_body.len()];
+    let mut counts = vec![0_usize; n_bodies];
+    for (p, &b) in point_body.iter().enumerate() {
+        local[p] = counts[b];
+        counts[b] += 1;
+    }
+    let mut bodies: Vec<VtuPiece> = (0..n_bodies)
+        .map(|_| VtuPiece {
+            point_data: piece
+                .point_data
+                .iter()
+                .map(|f| Field::new(f.name.clone(), f.location, f.components, Vec::new()))
+                .collect(),
+            cell_data: piece
+                .cell_data
+                .iter()
+                .map(|f| Field::new(f.name.clone(), f.location, f.components, Vec::new()))
+                .collect(),
+            ..VtuPiece::default()
+        })
+        .collect();
+    for (p, &b) in point_body.iter().enumerate() {
+        let body = &mut bodies[b];
+        body.points.push(piece.points[p]);
+        for (out, f) in body.point_data.iter_mut().zip(&piece.point_data) {
+            out.values.extend_from_slice(&f.values[p * f.components..(p + 1) * f.components]);
+        }
+    }
+    for (c, &b) in cell_body.iter().enumerate() {
+        let nodes = piece.cell(c).ok_or_else(|| format!("cell {c} is out of range"))?;
+        let body = &mut bodies[b];
+        for &n in nodes {
+            if point_body[n] != b {
+                return Err(format!("cell {c} of body {b} uses point {n} of body {}", point_body[n]));
+            }
+            body.connectivity.push(local[n]);
+        }
+        body.offsets.push(body.connectivity.len());
+        body.types.push(piece.types[c]);
+        for (out, f) in body.cell_data.iter_mut().zip(&piece.cell_data) {
+            out.values.extend_from_slice(&f.values[c * f.components..(c + 1) * f.components]);
+        }
+    }
+    Ok(bodies)
 }
 
 impl Parser {
@@ -242,9 +327,15 @@ impl Parser {
                         "VTKFile type is {ty:?}, expected \"UnstructuredGrid\" (a .vtu file)"
                     ));
                 }
-                if attrs.contains_key("compressor") {
-                    return Err("compressed data is not supported".into());
-                }
+                self.header.zlib = match attrs.get("compressor").map(String::as_str) {
+                    None => false,
+                    Some("vtkZLibDataCompressor") => true,
+                    Some(other) => {
+                        return Err(format!(
+                            "compressor {other:?} is not supported (only vtkZLibDataCompressor)"
+                        ))
+                    }
+                };
                 self.header.big_endian = match attrs.get("byte_order").map(String::as_str) {
                     None | Some("LittleEndian") => false,
                     Some("BigEndian") => true,
@@ -475,12 +566,78 @@ fn decode(a: &RawArray, header: Header) -> Result<Values, String> {
             }
         }
         Some("binary") => {
-            let bytes = decode_base64(&a.text, header)?;
+            let bytes =
+                if header.zlib { decode_zlib(&a.text, header)? } else { decode_base64(&a.text, header)? };
             binary_values(&bytes, ty, header.big_endian)
         }
         Some("appended") => Err("appended data is not supported".into()),
         other => Err(format!("unsupported format {other:?}")),
     }
+}
+
+/// An unsigned integer of the file's header type from `bytes` (4 or 8 of them).
+fn header_uint(bytes: &[u8], header: Header) -> Result<u64, String> {
+    match header.header_bytes {
+        8 => {
+            let a: [u8; 8] = bytes.try_into().map_err(|_| "bad binary header")?;
+            Ok(if header.big_endian { u64::from_be_bytes(a) } else { u64::from_le_bytes(a) })
+        }
+        _ => {
+            let a: [u8; 4] = bytes.try_into().map_err(|_| "bad binary header")?;
+            Ok(u64::from(if header.big_endian { u32::from_be_bytes(a) } else { u32::from_le_bytes(a) }))
+        }
+    }
+}
+
+/// Payload of a zlib-compressed inline array (VTK's layout): the base64 of the header
+/// `[blocks, block size, last partial block size (0: full), compressed sizes…]`, then the
+/// base64 of the compressed blocks; each block is inflated and checked against its size.
+fn decode_zlib(text: &str, header: Header) -> Result<Vec<u8>, String> {
+    use std::io::Read;
+    let compact: String = text.split_ascii_whitespace().collect();
+    let hb = header.header_bytes;
+    let chars = |bytes: usize| bytes.div_ceil(3).saturating_mul(4);
+    let invalid = |e: base64::DecodeError| format!("invalid base64 in the compression header: {e}");
+    let first = compact.get(..chars(hb)).ok_or("compressed data shorter than its header")?;
+    let first = STANDARD.decode(first).map_err(invalid)?;
+    let blocks = usize::try_from(header_uint(first.get(..hb).ok_or("bad compression header")?, header)?)
+        .map_err(|_| "too many blocks")?;
+    let header_len = blocks.checked_add(3).and_then(|n| n.checked_mul(hb)).ok_or("too many blocks")?;
+    if chars(header_len) > compact.len() {
+        return Err(format!("the compression header announces {blocks} blocks, more than the data holds"));
+    }
+    let (head, body) = compact.split_at(chars(header_len));
+    let head = STANDARD.decode(head).map_err(invalid)?;
+    let body = STANDARD.decode(body).map_err(|e| format!("invalid base64 in the compressed data: {e}"))?;
+    let item = |i: usize| -> Result<usize, String> {
+        let v = header_uint(head.get(i * hb..(i + 1) * hb).ok_or("bad compression header")?, header)?;
+        usize::try_from(v).map_err(|_| "size in the compression header too large".to_string())
+    };
+    let (block_size, last) = (item(1)?, item(2)?);
+    if last > block_size {
+        return Err(format!("last block of {last} bytes is larger than the block size {block_size}"));
+    }
+    let mut out = Vec::new();
+    let mut start = 0_usize;
+    for b in 0..blocks {
+        let size = item(3 + b)?;
+        let end = start.checked_add(size).filter(|&e| e <= body.len()).ok_or_else(|| {
+            format!("compressed block {b} ends past the data ({} bytes; truncated?)", body.len())
+        })?;
+        let want = if b + 1 == blocks && last > 0 { last } else { block_size };
+        let before = out.len();
+        let mut inflate = flate2::read::ZlibDecoder::new(&body[start..end])
+            .take(u64::try_from(want).unwrap_or(u64::MAX).saturating_add(1));
+        inflate.read_to_end(&mut out).map_err(|e| format!("compressed block {b}: {e}"))?;
+        if out.len() - before != want {
+            return Err(format!(
+                "compressed block {b} inflates to {} bytes, its header announces {want}",
+                out.len() - before
+            ));
+        }
+        start = end;
+    }
+    Ok(out)
 }
 
 /// Base64 payload of a binary inline array, without its byte-count header.

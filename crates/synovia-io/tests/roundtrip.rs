@@ -144,7 +144,7 @@ fn roundtrip_2d_both_encodings() -> TestResult {
     let dir = scratch("rt2d");
     let mesh = grid_2d(4);
     let fields = fields_2d(&mesh);
-    for encoding in [Encoding::Ascii, Encoding::Base64] {
+    for encoding in [Encoding::Ascii, Encoding::Base64, Encoding::Zlib] {
         let path = dir.join(format!("grid_{encoding:?}.vtu"));
         VtuWriter::new(encoding).add_piece(&mesh, fields.clone())?.write(&path)?;
         let data = read_vtu(&path)?;
@@ -169,6 +169,7 @@ fn roundtrip_2d_both_encodings() -> TestResult {
         assert!(text.contains(match encoding {
             Encoding::Ascii => r#"format="ascii""#,
             Encoding::Base64 => r#"format="binary""#,
+            Encoding::Zlib => r#"compressor="vtkZLibDataCompressor""#,
         }));
     }
     let _ = std::fs::remove_dir_all(&dir);
@@ -181,7 +182,7 @@ fn roundtrip_3d_both_encodings() -> TestResult {
     let mesh = kuhn_cube();
     assert_eq!(mesh.n_cells(), 6);
     let fields = fields_3d(&mesh);
-    for encoding in [Encoding::Ascii, Encoding::Base64] {
+    for encoding in [Encoding::Ascii, Encoding::Base64, Encoding::Zlib] {
         let path = dir.join(format!("cube_{encoding:?}.vtu"));
         VtuWriter::new(encoding).add_piece(&mesh, fields.clone())?.write(&path)?;
         let piece = &read_vtu(&path)?.pieces[0];
@@ -191,10 +192,10 @@ fn roundtrip_3d_both_encodings() -> TestResult {
         }
         assert_eq!(piece.to_mesh::<3>()?, mesh);
     }
-    // The convenience writer produces the same document as an explicit base64 writer.
+    // The convenience writer produces the same document as an explicit zlib writer.
     let path = dir.join("convenience.vtu");
     write_vtu(&path, &mesh, &fields)?;
-    let explicit = VtuWriter::new(Encoding::Base64).add_piece(&mesh, fields.clone())?.to_xml_string();
+    let explicit = VtuWriter::new(Encoding::Zlib).add_piece(&mesh, fields.clone())?.to_xml_string();
     assert_eq!(std::fs::read_to_string(&path)?, explicit);
     assert_eq!(parse_vtu(&explicit)?, read_vtu(&path)?);
     let _ = std::fs::remove_dir_all(&dir);
@@ -238,12 +239,17 @@ fn two_pieces_in_one_file() -> TestResult {
         Field::cell_scalars("p", (0..cube.n_cells()).map(|c| -(c as f64)).collect()),
         Field::point_vectors("u", &cube.nodes().iter().map(|x| x * 2.0).collect::<Vec<_>>()),
     ];
-    for encoding in [Encoding::Ascii, Encoding::Base64] {
+    for encoding in [Encoding::Ascii, Encoding::Base64, Encoding::Zlib] {
         let path = dir.join("two.vtu");
         let mut w = VtuWriter::new(encoding);
         w.add_piece(&square, square_fields.clone())?.add_piece(&cube, cube_fields.clone())?;
         assert_eq!(w.n_pieces(), 2);
         w.write(&path)?;
+        // one <Piece> holding both bodies, so that readers taking one piece get every cell
+        let text = std::fs::read_to_string(&path)?;
+        assert_eq!(text.matches("<Piece ").count(), 1);
+        let (np, nc) = (square.n_nodes() + cube.n_nodes(), square.n_cells() + cube.n_cells());
+        assert!(text.contains(&format!(r#"NumberOfPoints="{np}" NumberOfCells="{nc}""#)), "{np} {nc}");
         let data = read_vtu(&path)?;
         assert_eq!(data.pieces.len(), 2);
         assert_geometry(&data.pieces[0], &square, VTK_TRIANGLE);
@@ -516,5 +522,92 @@ fn reads_foreign_variants() -> TestResult {
     assert_eq!(piece.cell_field("id").map(|f| f.values.clone()), Some(vec![42.0]));
     let mesh = piece.to_mesh::<2>()?;
     assert_eq!(mesh.measure(), 0.5);
+    Ok(())
+}
+
+#[test]
+fn zlib_arrays_of_many_blocks_read_back_exactly_and_smaller() -> TestResult {
+    // 10 201 nodes: the displacement is 245 KB, eight 32 KiB blocks with a partial last one
+    let mesh = grid_2d(100);
+    let fields = fields_2d(&mesh);
+    let smooth: Vec<f64> = mesh.nodes().iter().map(|x| (x[0] * 3.0).sin() * x[1]).collect();
+    let mut all = fields.clone();
+    all.push(Field::point_scalars("smooth", smooth));
+    let zlib = VtuWriter::new(Encoding::Zlib).add_piece(&mesh, all.clone())?.to_xml_string();
+    let base64 = VtuWriter::new(Encoding::Base64).add_piece(&mesh, all.clone())?.to_xml_string();
+    let piece = &parse_vtu(&zlib)?.pieces[0];
+    assert_geometry(piece, &mesh, VTK_TRIANGLE);
+    for f in &all {
+        assert_field(piece, f);
+    }
+    assert_eq!(parse_vtu(&zlib)?, parse_vtu(&base64)?);
+    assert!(zlib.len() < base64.len(), "{} vs {}", zlib.len(), base64.len());
+    Ok(())
+}
+
+#[test]
+fn corrupt_zlib_arrays_are_parse_errors() -> TestResult {
+    let mesh = grid_2d(30);
+    let xml = VtuWriter::new(Encoding::Zlib).add_piece(&mesh, fields_2d(&mesh))?.to_xml_string();
+    // the first data array's base64 text
+    let start = xml.find(r#"format="binary">"#).ok_or("no binary array")? + r#"format="binary">"#.len();
+    let end = start + xml[start..].find("</DataArray>").ok_or("unterminated")?;
+    let text = xml[start..end].trim();
+    let cases = [
+        ("truncated", text[..text.len() / 2].to_string()),
+        ("empty", String::new()),
+        ("bad base64", format!("{}!!!!", &text[..text.len() - 4])),
+        // a header announcing 2^32 blocks
+        ("huge header", format!("AAAAAAEAAAA={}", &text[12..])),
+        // a block flipped in the middle of the compressed data
+        ("garbled", {
+            let mut t = text.as_bytes().to_vec();
+            let k = t.len() - 40;
+            t[k] = if t[k] == b'A' { b'B' } else { b'A' };
+            String::from_utf8(t)?
+        }),
+    ];
+    for (what, bad) in cases {
+        let doc = format!("{}{}{}", &xml[..start], bad, &xml[end..]);
+        let err = parse_vtu(&doc).err().ok_or(format!("{what}: accepted"))?;
+        assert!(matches!(err, IoError::Parse { .. }), "{what}: {err}");
+    }
+    let unknown = xml.replace("vtkZLibDataCompressor", "vtkLZ4DataCompressor");
+    let err = parse_vtu(&unknown).err().ok_or("lz4 accepted")?;
+    assert!(err.to_string().contains("vtkLZ4DataCompressor"), "{err}");
+    Ok(())
+}
+
+#[test]
+fn body_is_a_reserved_point_and_cell_field() -> TestResult {
+    let mesh = grid_2d(1);
+    for field in [
+        Field::point_scalars(BODY_FIELD, vec![0.0; mesh.n_nodes()]),
+        Field::cell_scalars(BODY_FIELD, vec![0.0; mesh.n_cells()]),
+    ] {
+        let err = VtuWriter::new(Encoding::Zlib).add_piece(&mesh, vec![field]).err().ok_or("accepted")?;
+        assert!(matches!(err, IoError::InvalidField { .. }), "{err}");
+    }
+    Ok(())
+}
+
+#[test]
+fn inconsistent_body_arrays_are_parse_errors() -> TestResult {
+    let mesh = grid_2d(1);
+    let xml = VtuWriter::new(Encoding::Ascii)
+        .add_piece(&mesh, vec![Field::point_scalars("s", vec![1.0; mesh.n_nodes()])])?
+        .to_xml_string();
+    // the point array comes first (PointData before CellData)
+    let point_body = "<DataArray type=\"Int32\" Name=\"body\" format=\"ascii\">\n          0 0 0 0";
+    assert!(xml.contains(point_body), "{xml}");
+    for (what, values) in [
+        ("a huge body index", "0 0 0 999999999"),
+        ("a negative body index", "0 0 0 -1"),
+        ("a cell across bodies", "0 0 0 1"),
+    ] {
+        let doc = xml.replace(point_body, &point_body.replace("0 0 0 0", values));
+        let err = parse_vtu(&doc).err().ok_or(format!("{what}: accepted"))?;
+        assert!(matches!(err, IoError::Parse { .. }), "{what}: {err}");
+    }
     Ok(())
 }

@@ -347,7 +347,7 @@ pub fn hertz2d_write(
     let solve_s = t0.elapsed().as_secs_f64();
     let geo = sc.geometry();
     if let Some(path) = vtu {
-        synovia::output::contact_vtu(&model, geo, &res, synovia_io::Encoding::Base64)
+        synovia::output::contact_vtu(&model, geo, &res, synovia_io::Encoding::Zlib)
             .and_then(|w| w.write(path))
             .map_err(|e| ContactError::InvalidParameter(format!("writing {}: {e}", path.display())))?;
     }

@@ -59,6 +59,8 @@ pub struct OutputPlan {
     pub vtu_every: usize,
     /// VTU encoding.
     pub encoding: Encoding,
+    /// `output.stress`: the `.vtu` files carry the stress and strain fields (default `true`).
+    pub stress: bool,
 }
 
 type R<T> = Result<T, ScenarioError>;
@@ -1783,7 +1785,7 @@ fn quasi_and_dynamic_params<const D: usize>(
 }
 
 fn output(cx: &Cx<'_>, o: Option<&Sp<OutputSpec>>) -> R<OutputPlan> {
-    let mut plan = OutputPlan { dir: None, vtu_every: 1, encoding: Encoding::Base64 };
+    let mut plan = OutputPlan { dir: None, vtu_every: 1, encoding: Encoding::Zlib, stress: true };
     let Some(o) = o else { return Ok(plan) };
     let s = o.get_ref();
     if let Some(d) = &s.dir {
@@ -1795,15 +1797,19 @@ fn output(cx: &Cx<'_>, o: Option<&Sp<OutputSpec>>) -> R<OutputPlan> {
     if let Some(v) = &s.vtu_every {
         plan.vtu_every = *v.get_ref();
     }
+    if let Some(v) = &s.stress {
+        plan.stress = *v.get_ref();
+    }
     if let Some(e) = &s.encoding {
         plan.encoding = match e.get_ref().as_str() {
+            "zlib" => Encoding::Zlib,
             "binary" | "base64" => Encoding::Base64,
             "ascii" => Encoding::Ascii,
             other => {
                 return Err(cx.err(
                     "output.encoding",
                     e.span(),
-                    format!("encoding is `binary` or `ascii`, got `{other}`"),
+                    format!("encoding is `zlib`, `binary` or `ascii`, got `{other}`"),
                 ))
             }
         };

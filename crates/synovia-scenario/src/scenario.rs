@@ -653,6 +653,7 @@ pub struct OutputSpec {
     pub dir: Option<Sp<String>>,
     pub vtu_every: Option<Sp<usize>>,
     pub encoding: Option<Sp<String>>,
+    pub stress: Option<Sp<bool>>,
 }
 
 // ---------------------------------------------------------------------------------------------

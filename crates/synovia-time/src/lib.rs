@@ -11,6 +11,7 @@ pub mod error;
 pub mod history;
 pub mod quasistatic;
 pub mod results;
+pub mod solid_fields;
 pub mod table;
 
 pub use error::TimeError;
