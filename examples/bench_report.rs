@@ -18,7 +18,16 @@
 //!   [`cycle_times`]`(steps)` poses ([`Knee2d::run`]: the femur in its body frame, one
 //!   factorisation for the cycle); `time_s` = the whole cycle including that factorisation,
 //!   `elastic_s` = one elastic factorisation + solve of the model (the stiffness is the same in
-//!   every pose).
+//!   every pose);
+//! - `pose_resolve_3d`: the `tkr3d` knee replacement ([`Tkr3d`], 1 mm insert mesh, 42 063
+//!   DOFs) re-solved for new poses of the rigid femoral component on one factorisation, as a
+//!   navigation tool would: all six degrees of freedom prescribed (the superior–inferior
+//!   translation at the values a force-controlled frictionless pass found, so each pose carries
+//!   the ISO 14243-1 load), 100 poses over the cycle after a first one; frictionless
+//!   (`JointSession::solve_static`, warm-started from the previous pose) and with μ = 0.04
+//!   (`JointSession::step`, quasi-static levels); `time_s` = the frictionless poses,
+//!   `time_per_pose_ms`, `friction_time_per_pose_ms`, `ratio` = time per pose / `elastic_s`,
+//!   `max_force_error` (the contact force against the ISO load).
 //!
 //! Sizes at scale 1 (the defaults): 2D Hertz level 14 (169 120 DOFs), 3D hemisphere level 17
 //! (≈ 270k DOFs, extrapolated: 79 686 at level 15, ≈ × 1.85 per level), 100 knee poses of the
@@ -47,12 +56,14 @@ use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::ContactPair;
 use synovia::prelude::*;
 use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
-use synovia_models::knee2d::{cycle_times, Knee2d};
+use synovia_models::knee2d::{cycle_times, iso14243_axial_force, Knee2d};
+use synovia_models::tkr3d::{Superior, Tkr3d};
 
 mod bench_common;
 use bench_common::{parse_args, peak_rss_bytes, spawn_case, Invocation, Res};
 
-const CASES: [&str; 4] = ["hertz2d_tresca", "resolve_new_loads", "hemisphere3d_friction", "knee2d_gait"];
+const CASES: [&str; 5] =
+    ["hertz2d_tresca", "resolve_new_loads", "hemisphere3d_friction", "knee2d_gait", "pose_resolve_3d"];
 const MU: Real = 0.3;
 
 /// Refinement levels at `scale`: `base` minus `round(log2(1 / scale))`.
@@ -205,6 +216,60 @@ fn knee_case(scale: f64) -> Res<Value> {
     }))
 }
 
+fn pose_resolve_case(scale: f64) -> Res<Value> {
+    let poses = ((100.0 * scale).round() as usize).max(4);
+    let times: Vec<Real> = (0..=poses).map(|i| i as Real / poses as Real).collect();
+    // pass 1 (not timed): the superior–inferior translations that carry the ISO load
+    let found = Tkr3d { friction: 0.0, ..Tkr3d::default() };
+    let joint = found.joint_model()?;
+    let mut session = joint.prepare()?;
+    let mut si = Vec::with_capacity(times.len());
+    for &t in &times {
+        session.solve_static(t)?;
+        let record = session.record().ok_or("no record")?;
+        si.push((t, record.rigid.first().ok_or("no rigid body")?.dofs[1]));
+    }
+    drop(session);
+    let si: std::sync::Arc<dyn synovia::time::history::LoadHistory> =
+        std::sync::Arc::new(synovia::time::history::PiecewiseLinear::new(&si)?);
+    let load = iso14243_axial_force()?;
+    let mut out = json!({});
+    for friction in [0.0, synovia_models::tkr3d::FRICTION] {
+        let prescribed = Tkr3d { friction, superior: Superior::Prescribed(si.clone()), ..Tkr3d::default() };
+        let joint = prescribed.joint_model()?;
+        let t_setup = Instant::now();
+        let mut session = joint.prepare()?;
+        session.solve_static(times[0])?;
+        let setup_s = t_setup.elapsed().as_secs_f64();
+        let (mut force_error, mut kkt) = (0.0_f64, 0.0_f64);
+        let t0 = Instant::now();
+        for &t in &times[1..] {
+            let report = if friction > 0.0 { session.step(t)? } else { session.solve_static(t)? };
+            let record = session.record().ok_or("no record")?;
+            let f = record.rigid.first().ok_or("no rigid body")?.force[1];
+            force_error = force_error.max((f - load.value(t)).abs() / load.value(t));
+            kkt = kkt.max(report.kkt);
+        }
+        let per_pose = t0.elapsed().as_secs_f64() / (times.len() - 1) as f64;
+        let key = if friction > 0.0 { "friction_" } else { "" };
+        out[format!("{key}time_per_pose_ms")] = json!(1e3 * per_pose);
+        out[format!("{key}setup_s")] = json!(setup_s);
+        out[format!("{key}max_force_error")] = json!(force_error);
+        out[format!("{key}max_kkt")] = json!(kkt);
+        if friction == 0.0 {
+            out["time_s"] = json!(per_pose);
+            out["dofs"] = json!(session.elastic_info().n_dofs);
+            out["candidate_nodes"] = json!(session.geometry().len());
+        }
+    }
+    let joint = found.joint_model()?;
+    let (elastic_s, elastic_runs) = elastic_time(joint.model())?;
+    out["elastic_s"] = json!(elastic_s);
+    out["elastic_runs"] = json!(elastic_runs);
+    out["poses"] = json!(times.len() - 1);
+    Ok(out)
+}
+
 /// Child mode: run one case and print its JSON record on stdout.
 fn child(case: &str, scale: f64) -> Res<()> {
     let mut v = match case {
@@ -212,6 +277,7 @@ fn child(case: &str, scale: f64) -> Res<()> {
         "resolve_new_loads" => hertz2d_case(scale, true)?,
         "hemisphere3d_friction" => hemisphere_case(scale)?,
         "knee2d_gait" => knee_case(scale)?,
+        "pose_resolve_3d" => pose_resolve_case(scale)?,
         other => return Err(format!("unknown case `{other}` ({})", CASES.join(", ")).into()),
     };
     let (t, e) = (v["time_s"].as_f64().unwrap_or(f64::NAN), v["elastic_s"].as_f64().unwrap_or(f64::NAN));

@@ -25,32 +25,14 @@
 //! ```
 
 use std::fmt::Write as _;
-use std::sync::Arc;
 use std::time::Instant;
 
 use plotters::prelude::*;
-use synovia::contact_ops::operators::SignedDistance;
-use synovia::io::{read_stl, Encoding, TimeSeriesWriter};
+use synovia::io::{Encoding, TimeSeriesWriter};
 use synovia::prelude::*;
-use synovia::rigid::RigidBody;
-use synovia::time::table::Table;
-use synovia_models::knee2d::iso14243_axial_force;
+use synovia_models::tkr3d::Tkr3d;
 
 type Error = Box<dyn std::error::Error>;
-
-const DATA: &str = "data/tka-grand-challenge-dm";
-/// UHMWPE, as in the OpenSim-JAM model of subject DM (Halloran et al. 2005): E (MPa), ν.
-const UHMWPE: (f64, f64) = (463.0, 0.46);
-/// Contact candidates: insert nodes farther than this from the femoral component keep an
-/// inactive row (mm).
-const SEARCH_DISTANCE: f64 = 3.0;
-
-/// Coulomb coefficient of lubricated CoCr–UHMWPE (0.04–0.1 in pin-on-plate tests at these
-/// pressures; docs/tkr3d.md).
-const FRICTION: f64 = 0.04;
-/// Rows with a larger gap (mm) are left out of each contact solve until they come into
-/// contact (`--screening-band 0`: every candidate in every solve).
-const SCREENING_BAND: f64 = 0.5;
 
 /// Figures of one pose.
 struct Pose {
@@ -99,108 +81,42 @@ fn main() -> Result<(), Error> {
             "out/tkr3d".into()
         }
     });
-    let mesh_file = if fine { "tibial_insert_h05.msh.gz" } else { "tibial_insert_h1.msh" };
-
-    // the insert
-    let mut joint = JointModel::<3>::new();
-    let uhmwpe = isotropic(UHMWPE.0, UHMWPE.1)?;
-    joint.add_gmsh_bodies(format!("{DATA}/mesh/{mesh_file}"), |_| Some(uhmwpe.clone().into()))?;
-    joint.clamp("insert", "tray")?;
-    // the contact candidates: every upward-facing facet above the tray (the meshes' `articular`
-    // part starts at y = 6 mm and misses the bottom of the dishes, at 5.9 mm; docs/meshing.md);
-    // `--contact-min-ny c`: facets with `n_y > c` (default 0.5, at most 60° from horizontal)
-    let min_ny: f64 = match std::env::args().skip_while(|a| a != "--contact-min-ny").nth(1) {
-        Some(v) => v.parse()?,
-        None => 0.5,
-    };
-    if !(-1.0..1.0).contains(&min_ny) {
-        return Err(format!("--contact-min-ny takes a normal component in [-1, 1), got {min_ny}").into());
+    // the model (synovia_models::tkr3d); the options of this example set its fields
+    let mut model = Tkr3d { fine, free_ml, free_adduction, ..Tkr3d::default() };
+    // `--contact-min-ny c`: candidate facets with `n_y > c` (default 0.5, at most 60° from
+    // horizontal)
+    if let Some(v) = std::env::args().skip_while(|a| a != "--contact-min-ny").nth(1) {
+        model.contact_min_ny = v.parse()?;
     }
-    joint.define_part("insert", "contact", move |x, n| n[1] > min_ny && x[1] > 1.0)?;
-
-    // the femoral component: rigid, bounded by its closed surface (metres → mm)
-    let femur_surface = read_stl(format!("{DATA}/femoral_component.stl"))?.scaled(1000.0)?;
-    let shape: Arc<dyn SignedDistance<3>> = Arc::new(SurfaceObstacle::solid(femur_surface)?);
-
-    // the pose over the cycle: time = fraction of the cycle (the table's time is in percent)
-    let table = Table::read(format!("{DATA}/fluoroscopic_gait_kinematics.sto"))?;
-    let column = |name: &str, factor: f64| table.history(name, factor, 0.01);
-    let force = iso14243_axial_force().map_err(|e| e.to_string())?;
-    let down = synovia::time::history::FnHistory::new(move |t| -force.value(t));
-    let femur = RigidBody::<3>::new("femur", Point::<3>::zeros())?
-        .with_rotation_order("zxy")?
-        .prescribe(0, column("knee_ant_r", 1000.0)?)?
-        .force_with_guess(1, down, column("knee_sup_r", 1000.0)?)?;
-    // column 4: the medial–lateral translation, prescribed as measured; with `--free-ml` free
-    // under zero force (a load-controlled knee simulator leaves it free)
-    let femur = if free_ml {
-        femur.force_with_guess(2, Constant(0.0), column("knee_lat_r", 1000.0)?)?
-    } else {
-        femur.prescribe(2, column("knee_lat_r", 1000.0)?)?
-    };
-    // column 5: ab/adduction (rotation about the anterior axis), prescribed as measured; with
-    // `--free-adduction` free under zero moment about the femoral origin (docs/tkr3d.md)
-    let femur = if free_adduction {
-        femur.force_with_guess(3, Constant(0.0), column("knee_flex_r", 1.0)?)?
-    } else {
-        femur.prescribe(3, column("knee_flex_r", 1.0)?)?
-    };
-    let femur = femur
-        .prescribe(4, column("knee_add_r", 1.0)?)? // column 6: rotation about y
-        .prescribe(5, column("knee_rot_r", 1.0)?)?; // column 7: rotation about z
-    let measured_si = column("knee_sup_r", 1000.0)?;
-    joint.add_rigid_body(femur)?;
-    // lubricated CoCr–UHMWPE friction (`--friction μ`, default 0.04): Coulomb friction
-    // (frozen to Tresca per pose) against the moving femoral component, the slip measured
-    // relative to it (docs/model.md (10.5)); the poses are quasi-static levels, each from the
-    // previous one (`--friction 0`: frictionless, each pose a static solve)
-    let friction: f64 = match std::env::args().skip_while(|a| a != "--friction").nth(1) {
-        Some(v) => v.parse()?,
-        None => FRICTION,
-    };
-    if !(0.0..1.0).contains(&friction) {
-        return Err(format!("--friction takes a coefficient in [0, 1), got {friction}").into());
+    // lubricated CoCr–UHMWPE friction (`--friction μ`, default 0.04): the poses are
+    // quasi-static levels, each from the previous one (`--friction 0`: frictionless, each pose
+    // a static solve)
+    if let Some(v) = std::env::args().skip_while(|a| a != "--friction").nth(1) {
+        model.friction = v.parse()?;
     }
-    joint.contact_rigid_body("femur-insert", "insert", "contact", "femur", shape, friction)?;
-    joint.search_distance("femur-insert", SEARCH_DISTANCE)?;
-    // medial (−z, right knee) and lateral (+z) sides of the insert
-    joint.split_pair_report(
-        "femur-insert",
-        synovia::contact_ops::operators::PairSplit::new("lateral", "medial", [0.0; 3], [0.0, 0.0, 1.0])?,
-    )?;
-    joint.solver("pdas-fallback")?;
-    let mut control = synovia::rigid::ForceControlParams::default();
+    let friction = model.friction;
     if let Some(tol) = std::env::args().skip_while(|a| a != "--geometry-tolerance").nth(1) {
-        control.geometry_tolerance = tol.parse()?;
+        model.control.geometry_tolerance = tol.parse()?;
     }
     if let Some(tol) = std::env::args().skip_while(|a| a != "--balance-tolerance").nth(1) {
-        control.tolerance = tol.parse()?;
+        model.control.tolerance = tol.parse()?;
     }
     if free_adduction || free_ml {
         // several unknowns, one of them a moment: the rounding of the reactions in swing
         // (168 N) sits near 1e-10 of the scale, so equilibrium is asked to 1e-8 (the
         // acceptance bound of the main job is 1e-3)
-        control.fresh_jacobian = true;
-        control.max_solves = 500;
-        control.tolerance = 1e-8;
+        model.control.fresh_jacobian = true;
+        model.control.max_solves = 500;
+        model.control.tolerance = 1e-8;
     }
-    joint.force_control(control);
-    // the candidate surface is large and the contact patches move: whole-factor solves of the
-    // active rows instead of a dense interface block (docs/tkr3d.md, performance)
-    if std::env::args().any(|a| a == "--dense-interface") {
-    } else {
-        joint.interface_block(
-            synovia::linalg::InterfaceBlockParams::default().with_max_dofs(0).with_screened_dofs(0),
-        );
+    model.dense_interface = std::env::args().any(|a| a == "--dense-interface");
+    // `--screening-band 0`: every candidate in every solve
+    if let Some(v) = std::env::args().skip_while(|a| a != "--screening-band").nth(1) {
+        let band: f64 = v.parse()?;
+        model.screening_band = (band > 0.0).then_some(band);
     }
-
-    // gap screening: each solve runs on the insert nodes within `band` of the femur and adds
-    // others only if they come into contact (exact; docs/tkr3d.md, performance)
-    let band: f64 = match std::env::args().skip_while(|a| a != "--screening-band").nth(1) {
-        Some(v) => v.parse()?,
-        None => SCREENING_BAND,
-    };
-    joint.screening_band((band > 0.0).then_some(band))?;
+    let joint = model.joint_model()?;
+    let measured_si = model.measured_si()?;
 
     let mut session = joint.prepare()?;
     let dofs = session.elastic_info().n_dofs;
@@ -285,12 +201,13 @@ fn main() -> Result<(), Error> {
     std::fs::write(format!("{out}/tkr3d.csv"), csv_text(&poses))?;
     plot_forces(&poses, &format!("{out}/force_split.svg"))?;
     plot_peak(&poses, &format!("{out}/peak_pressure.svg"))?;
-    plot_centres(&poses, &format!("{out}/centre_of_pressure.svg"))?;
+    plot_centres(&poses, &model.data_dir, &format!("{out}/centre_of_pressure.svg"))?;
 
     let max = |f: &dyn Fn(&Pose) -> f64| poses.iter().map(f).fold(0.0, f64::max);
     let peak = poses.iter().max_by(|a, b| a.peak.total_cmp(&b.peak)).ok_or("no poses")?;
     println!(
-        "{{\"example\":\"tkr3d\",\"mesh\":\"{mesh_file}\",\"poses\":{},\"dofs\":{dofs},\"max_force_balance_error\":{:.3e},\"max_kkt\":{:.3e},\"peak_pressure_mpa\":{:.3},\"peak_pressure_at_percent\":{:.0},\"max_contact_area_mm2\":{:.1},\"max_medial_force_n\":{:.1},\"max_lateral_force_n\":{:.1},\"friction\":{friction},\"max_friction_force_n\":{:.1},\"setup_s\":{setup_s:.2},\"total_s\":{:.2}}}",
+        "{{\"example\":\"tkr3d\",\"mesh\":\"{}\",\"poses\":{},\"dofs\":{dofs},\"max_force_balance_error\":{:.3e},\"max_kkt\":{:.3e},\"peak_pressure_mpa\":{:.3},\"peak_pressure_at_percent\":{:.0},\"max_contact_area_mm2\":{:.1},\"max_medial_force_n\":{:.1},\"max_lateral_force_n\":{:.1},\"friction\":{friction},\"max_friction_force_n\":{:.1},\"setup_s\":{setup_s:.2},\"total_s\":{:.2}}}",
+        model.mesh_file(),
         poses.len(),
         max(&|p| p.balance),
         max(&|p| p.kkt),
@@ -389,8 +306,8 @@ fn plot_lines(
 
 /// The centre-of-pressure paths of both condyles, drawn on the outline of the insert's
 /// articular surface (top view: z medio-lateral across, x anterior up).
-fn plot_centres(poses: &[Pose], path: &str) -> Result<(), Error> {
-    let outline = read_stl(format!("{DATA}/tibial_insert_contact.stl"))?.scaled(1000.0)?;
+fn plot_centres(poses: &[Pose], data_dir: &std::path::Path, path: &str) -> Result<(), Error> {
+    let outline = synovia::io::read_stl(data_dir.join("tibial_insert_contact.stl"))?.scaled(1000.0)?;
     let root = SVGBackend::new(path, (640, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let mut chart = ChartBuilder::on(&root)

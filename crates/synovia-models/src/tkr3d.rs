@@ -1,0 +1,270 @@
+//! The `tkr3d` model: the total knee replacement of the Grand Challenge subject DM (Fregly et
+//! al. 2012) over one measured gait cycle (`docs/tkr3d.md`).
+//!
+//! The UHMWPE tibial insert (P1 tetrahedra meshed from its STL, its tray face clamped) against
+//! the rigid femoral component bounded by its closed STL surface, posed from the fluoroscopic
+//! kinematics; the superior–inferior translation force-controlled by the ISO 14243-1 axial
+//! force (or prescribed, [`Superior::Prescribed`]), optionally the medial–lateral translation
+//! and the ab/adduction freed under zero force / moment. Time is the fraction of the cycle
+//! (0…1). [`Tkr3d::joint_model`] builds the [`JointModel`]; the `tkr3d` example runs it and
+//! the `bench_report` case `pose_resolve_3d` re-solves it for new poses.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use synovia::builder::{JointError, JointModel};
+use synovia::contact_ops::operators::{PairSplit, SignedDistance};
+use synovia::rigid::{ForceControlParams, RigidBody};
+use synovia_contact::SurfaceObstacle;
+use synovia_io::read_stl;
+use synovia_material::isotropic;
+use synovia_mesh::math::{Point, Real};
+use synovia_mesh::SurfaceError;
+use synovia_time::history::{Constant, FnHistory, LoadHistory, PiecewiseLinear};
+use synovia_time::table::{Table, TableError};
+
+use crate::knee2d::iso14243_axial_force;
+
+/// What can go wrong building the model: the joint (data files, meshes, options), the
+/// kinematics table, the femoral surface.
+#[derive(Debug)]
+pub enum Tkr3dError {
+    /// Building the joint model.
+    Joint(JointError),
+    /// Reading or using the kinematics table.
+    Table(TableError),
+    /// The femoral component's surface.
+    Surface(SurfaceError),
+}
+
+impl std::fmt::Display for Tkr3dError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Tkr3dError::Joint(e) => write!(f, "tkr3d model: {e}"),
+            Tkr3dError::Table(e) => write!(f, "tkr3d kinematics: {e}"),
+            Tkr3dError::Surface(e) => write!(f, "tkr3d femoral surface: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for Tkr3dError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Tkr3dError::Joint(e) => Some(e),
+            Tkr3dError::Table(e) => Some(e),
+            Tkr3dError::Surface(e) => Some(e),
+        }
+    }
+}
+
+macro_rules! from_error {
+    ($($variant:ident($t:ty)),*) => {$(
+        impl From<$t> for Tkr3dError {
+            fn from(e: $t) -> Self {
+                Tkr3dError::$variant(e)
+            }
+        }
+    )*};
+}
+from_error!(Joint(JointError), Table(TableError), Surface(SurfaceError));
+
+// the errors a joint model wraps, through it
+macro_rules! from_joint_error {
+    ($($t:ty),*) => {$(
+        impl From<$t> for Tkr3dError {
+            fn from(e: $t) -> Self {
+                Tkr3dError::Joint(JointError::from(e))
+            }
+        }
+    )*};
+}
+from_joint_error!(
+    synovia_io::IoError,
+    synovia_contact::ContactError,
+    synovia_material::MaterialError,
+    synovia_mesh::MeshError,
+    synovia_time::TimeError
+);
+
+/// UHMWPE, as in the OpenSim-JAM model of subject DM (Halloran et al. 2005): E (MPa), ν.
+pub const UHMWPE: (Real, Real) = (463.0, 0.46);
+/// Contact candidates: insert nodes farther than this from the femoral component keep an
+/// inactive row (mm).
+pub const SEARCH_DISTANCE: Real = 3.0;
+/// Coulomb coefficient of lubricated CoCr–UHMWPE (0.04–0.1 in pin-on-plate tests at these
+/// pressures; `docs/tkr3d.md`).
+pub const FRICTION: Real = 0.04;
+/// Rows with a larger gap (mm) are left out of each contact solve until they come into contact.
+pub const SCREENING_BAND: Real = 0.5;
+
+/// How the femur's superior–inferior translation (degree of freedom 1) is set.
+#[derive(Debug, Clone)]
+pub enum Superior {
+    /// Force-controlled by the ISO 14243-1 axial force, starting from the measured translation.
+    IsoForce,
+    /// Prescribed (mm, over the cycle fraction), e.g. the translations a force-controlled run
+    /// found, for re-solving poses without the force iteration.
+    Prescribed(Arc<dyn LoadHistory>),
+}
+
+/// Options of the model (the defaults are the main job's).
+#[derive(Debug, Clone)]
+pub struct Tkr3d {
+    /// Folder with the data (`femoral_component.stl`, `fluoroscopic_gait_kinematics.sto`,
+    /// `mesh/`); default `data/tka-grand-challenge-dm` relative to the working directory.
+    pub data_dir: PathBuf,
+    /// The 0.5 mm articular mesh (`tibial_insert_h05.msh.gz`) instead of the 1 mm one.
+    pub fine: bool,
+    /// Coulomb coefficient against the femoral component (0: frictionless).
+    pub friction: Real,
+    /// Medial–lateral translation free under zero force instead of prescribed.
+    pub free_ml: bool,
+    /// Ab/adduction free under zero moment instead of prescribed.
+    pub free_adduction: bool,
+    /// Contact candidates: boundary facets above the tray with `n_y` above this (0.5: at most
+    /// 60° from horizontal).
+    pub contact_min_ny: Real,
+    /// Gap screening band (mm; `None`: every candidate in every solve).
+    pub screening_band: Option<Real>,
+    /// A dense interface block instead of whole-factor solves of the active rows.
+    pub dense_interface: bool,
+    /// The superior–inferior degree of freedom.
+    pub superior: Superior,
+    /// Force-control parameters (tolerances; with freed degrees of freedom the example uses
+    /// fresh Jacobians, 500 solves and 1e-8).
+    pub control: ForceControlParams,
+}
+
+impl Default for Tkr3d {
+    fn default() -> Self {
+        Self {
+            data_dir: PathBuf::from("data/tka-grand-challenge-dm"),
+            fine: false,
+            friction: FRICTION,
+            free_ml: false,
+            free_adduction: false,
+            contact_min_ny: 0.5,
+            screening_band: Some(SCREENING_BAND),
+            dense_interface: false,
+            superior: Superior::IsoForce,
+            control: ForceControlParams::default(),
+        }
+    }
+}
+
+impl Tkr3d {
+    /// The mesh file of the insert in `data_dir/mesh/`.
+    pub fn mesh_file(&self) -> &'static str {
+        if self.fine {
+            "tibial_insert_h05.msh.gz"
+        } else {
+            "tibial_insert_h1.msh"
+        }
+    }
+
+    /// The measured superior–inferior translation of the femur (mm) over the cycle fraction.
+    ///
+    /// # Errors
+    /// [`Tkr3dError::Table`] when the kinematics table cannot be read.
+    pub fn measured_si(&self) -> Result<PiecewiseLinear, Tkr3dError> {
+        Ok(self.kinematics()?.history("knee_sup_r", 1000.0, 0.01)?)
+    }
+
+    fn kinematics(&self) -> Result<Table, Tkr3dError> {
+        Ok(Table::read(self.data_dir.join("fluoroscopic_gait_kinematics.sto"))?)
+    }
+
+    /// Builds the joint: the insert (UHMWPE, tray clamped, contact part `contact` by geometry),
+    /// the femur `femur` (rigid, rotation order `zxy`, degrees of freedom 0–5: anterior,
+    /// superior, lateral translation (mm), rotations about x, y, z (rad) from the table's
+    /// `knee_ant_r`, `knee_sup_r`, `knee_lat_r`, `knee_flex_r`, `knee_add_r`, `knee_rot_r`), the
+    /// pair `femur-insert` split into `lateral` (+z) and `medial`, solver `pdas-fallback`.
+    ///
+    /// # Errors
+    /// [`Tkr3dError`] for missing or bad data files and invalid options (`contact_min_ny`
+    /// outside `[−1, 1)`, `friction` outside `[0, 1)`, a negative screening band).
+    pub fn joint_model(&self) -> Result<JointModel<3>, Tkr3dError> {
+        if !(-1.0..1.0).contains(&self.contact_min_ny) {
+            return Err(JointError::Invalid(format!(
+                "contact_min_ny must be in [-1, 1), got {}",
+                self.contact_min_ny
+            ))
+            .into());
+        }
+        if !(0.0..1.0).contains(&self.friction) {
+            return Err(
+                JointError::Invalid(format!("friction must be in [0, 1), got {}", self.friction)).into()
+            );
+        }
+        let mut joint = JointModel::<3>::new();
+        let uhmwpe = isotropic(UHMWPE.0, UHMWPE.1)?;
+        joint.add_gmsh_bodies(self.data_dir.join("mesh").join(self.mesh_file()), |_| {
+            Some(uhmwpe.clone().into())
+        })?;
+        joint.clamp("insert", "tray")?;
+        // the contact candidates: every upward-facing facet above the tray (the meshes'
+        // `articular` part starts at y = 6 mm and misses the bottom of the dishes, at 5.9 mm;
+        // docs/meshing.md)
+        let min_ny = self.contact_min_ny;
+        joint.define_part("insert", "contact", move |x, n| n[1] > min_ny && x[1] > 1.0)?;
+
+        // the femoral component: rigid, bounded by its closed surface (metres → mm)
+        let femur_surface = read_stl(self.data_dir.join("femoral_component.stl"))?.scaled(1000.0)?;
+        let shape: Arc<dyn SignedDistance<3>> = Arc::new(SurfaceObstacle::solid(femur_surface)?);
+
+        // the pose over the cycle: time = fraction of the cycle (the table's time is in percent)
+        let table = self.kinematics()?;
+        let column = |name: &str, factor: Real| table.history(name, factor, 0.01);
+        let femur = RigidBody::<3>::new("femur", Point::<3>::zeros())?
+            .with_rotation_order("zxy")?
+            .prescribe(0, column("knee_ant_r", 1000.0)?)?;
+        let femur = match &self.superior {
+            Superior::IsoForce => {
+                let force = iso14243_axial_force().map_err(|e| JointError::Invalid(e.to_string()))?;
+                let down = FnHistory::new(move |t| -force.value(t));
+                femur.force_with_guess(1, down, column("knee_sup_r", 1000.0)?)?
+            }
+            Superior::Prescribed(si) => femur.prescribe(1, si.clone())?,
+        };
+        // column 4: the medial–lateral translation, prescribed as measured or free under zero
+        // force (a load-controlled knee simulator leaves it free)
+        let femur = if self.free_ml {
+            femur.force_with_guess(2, Constant(0.0), column("knee_lat_r", 1000.0)?)?
+        } else {
+            femur.prescribe(2, column("knee_lat_r", 1000.0)?)?
+        };
+        // column 5: ab/adduction (rotation about the anterior axis), prescribed as measured or
+        // free under zero moment about the femoral origin (docs/tkr3d.md)
+        let femur = if self.free_adduction {
+            femur.force_with_guess(3, Constant(0.0), column("knee_flex_r", 1.0)?)?
+        } else {
+            femur.prescribe(3, column("knee_flex_r", 1.0)?)?
+        };
+        let femur = femur
+            .prescribe(4, column("knee_add_r", 1.0)?)? // column 6: rotation about y
+            .prescribe(5, column("knee_rot_r", 1.0)?)?; // column 7: rotation about z
+        joint.add_rigid_body(femur)?;
+        // Coulomb friction (frozen to Tresca per pose) against the moving femoral component,
+        // the slip measured relative to it (docs/model.md (10.5))
+        joint.contact_rigid_body("femur-insert", "insert", "contact", "femur", shape, self.friction)?;
+        joint.search_distance("femur-insert", SEARCH_DISTANCE)?;
+        // medial (−z, right knee) and lateral (+z) sides of the insert
+        joint.split_pair_report(
+            "femur-insert",
+            PairSplit::new("lateral", "medial", [0.0; 3], [0.0, 0.0, 1.0])?,
+        )?;
+        joint.solver("pdas-fallback")?;
+        joint.force_control(self.control);
+        // the candidate surface is large and the contact patches move: whole-factor solves of
+        // the active rows instead of a dense interface block (docs/tkr3d.md, performance)
+        if !self.dense_interface {
+            joint.interface_block(
+                synovia::linalg::InterfaceBlockParams::default().with_max_dofs(0).with_screened_dofs(0),
+            );
+        }
+        // gap screening: each solve runs on the insert nodes within the band of the femur and
+        // adds others only if they come into contact (exact; docs/tkr3d.md, performance)
+        joint.screening_band(self.screening_band)?;
+        Ok(joint)
+    }
+}

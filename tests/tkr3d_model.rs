@@ -1,0 +1,65 @@
+//! The `tkr3d` model as a library function (`synovia_models::tkr3d`): one pose of the main job
+//! reaches the ISO 14243-1 load with the KKT conditions met, a prescribed superior–inferior
+//! translation reproduces it, and bad options or data are typed errors.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use synovia_models::knee2d::iso14243_axial_force;
+use synovia_models::tkr3d::{Superior, Tkr3d, Tkr3dError};
+use synovia_time::history::{Constant, LoadHistory};
+
+fn data_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/tka-grand-challenge-dm")
+}
+
+#[test]
+fn a_force_controlled_pose_carries_the_iso_load_and_a_prescribed_one_reproduces_it() {
+    let t = 0.13; // the first peak of the ISO axial force, 2 600 N
+    let load = iso14243_axial_force().expect("ISO force").value(t);
+    let model = Tkr3d { data_dir: data_dir(), friction: 0.0, ..Tkr3d::default() };
+    let joint = model.joint_model().expect("model");
+    let mut session = joint.prepare().expect("prepare");
+    let report = session.solve_static(t).expect("pose");
+    assert!(report.kkt <= 1e-8, "KKT {:e}", report.kkt);
+    let record = session.record().expect("record").clone();
+    let femur = &record.rigid[0];
+    assert!(femur.balance_error <= 1e-8, "balance {:e}", femur.balance_error);
+    // the resultant on the femur equals the applied load (ISO force downward on the femur)
+    assert!((femur.force[1] - load).abs() <= 1e-6 * load, "{} vs {load}", femur.force[1]);
+    let pair = &record.pairs[0];
+    let sides: f64 = pair.sides.iter().map(|s| s.normal_force).sum();
+    assert!((sides - pair.normal_force).abs() <= 1e-9 * pair.normal_force);
+    let si = femur.dofs[1];
+    drop(session);
+
+    // the same pose with the translation prescribed at the value found: the same load
+    let prescribed = Tkr3d {
+        superior: Superior::Prescribed(Arc::new(Constant(si)) as Arc<dyn LoadHistory>),
+        ..model.clone()
+    };
+    let joint = prescribed.joint_model().expect("model");
+    let mut session = joint.prepare().expect("prepare");
+    let report = session.solve_static(t).expect("pose");
+    assert!(report.kkt <= 1e-8, "KKT {:e}", report.kkt);
+    let again = &session.record().expect("record").rigid[0];
+    assert_eq!(again.dofs[1], si);
+    assert!((again.force[1] - load).abs() <= 1e-6 * load, "{} vs {load}", again.force[1]);
+}
+
+#[test]
+fn bad_options_and_missing_data_are_typed_errors() {
+    for model in [
+        Tkr3d { data_dir: data_dir(), contact_min_ny: 2.0, ..Tkr3d::default() },
+        Tkr3d { data_dir: data_dir(), contact_min_ny: f64::NAN, ..Tkr3d::default() },
+        Tkr3d { data_dir: data_dir(), friction: 1.5, ..Tkr3d::default() },
+        Tkr3d { data_dir: data_dir(), screening_band: Some(-1.0), ..Tkr3d::default() },
+    ] {
+        let err = model.joint_model().expect_err("accepted");
+        assert!(matches!(err, Tkr3dError::Joint(_)), "{err}");
+    }
+    let missing = Tkr3d { data_dir: PathBuf::from("/nonexistent/tka"), ..Tkr3d::default() };
+    let err = missing.joint_model().expect_err("accepted");
+    assert!(err.to_string().contains("/nonexistent/tka"), "{err}");
+    assert!(matches!(missing.measured_si(), Err(Tkr3dError::Table(_))));
+}
