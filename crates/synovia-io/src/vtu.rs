@@ -214,26 +214,8 @@ impl VtuWriter {
             v
         };
         writeln!(w, r#"    <Piece NumberOfPoints="{n_points}" NumberOfCells="{n_cells}">"#)?;
-        writeln!(w, "      <PointData>")?;
-        if let Some(first) = self.pieces.first() {
-            for (j, f) in first.point_data.iter().enumerate() {
-                let parts: Vec<&[f64]> =
-                    self.pieces.iter().map(|p| p.point_data[j].values.as_slice()).collect();
-                self.write_array(w, &f.name, f.components, &parts)?;
-            }
-        }
-        self.write_array(w, BODY_FIELD, 1, &[&body_of(Piece::n_points)])?;
-        writeln!(w, "      </PointData>")?;
-        writeln!(w, "      <CellData>")?;
-        if let Some(first) = self.pieces.first() {
-            for (j, f) in first.cell_data.iter().enumerate() {
-                let parts: Vec<&[f64]> =
-                    self.pieces.iter().map(|p| p.cell_data[j].values.as_slice()).collect();
-                self.write_array(w, &f.name, f.components, &parts)?;
-            }
-        }
-        self.write_array(w, BODY_FIELD, 1, &[&body_of(Piece::n_cells)])?;
-        writeln!(w, "      </CellData>")?;
+        self.write_data(w, "PointData", |p| &p.point_data, &body_of(Piece::n_points))?;
+        self.write_data(w, "CellData", |p| &p.cell_data, &body_of(Piece::n_cells))?;
         writeln!(w, "      <Points>")?;
         let points: Vec<&[f64]> = self.pieces.iter().map(|p| p.points.as_slice()).collect();
         self.write_array(w, "Points", 3, &points)?;
@@ -256,6 +238,27 @@ impl VtuWriter {
         self.write_array(w, "types", 1, &[&types])?;
         writeln!(w, "      </Cells>")?;
         writeln!(w, "    </Piece>")
+    }
+
+    /// A `<PointData>` / `<CellData>` section: each field of the bodies (`fields_of`) over all
+    /// of them, then the `body` array.
+    fn write_data<W: Write>(
+        &self,
+        w: &mut W,
+        section: &str,
+        fields_of: fn(&Piece) -> &Vec<Field>,
+        body: &[i32],
+    ) -> io::Result<()> {
+        writeln!(w, "      <{section}>")?;
+        if let Some(first) = self.pieces.first() {
+            for (j, f) in fields_of(first).iter().enumerate() {
+                let parts: Vec<&[f64]> =
+                    self.pieces.iter().map(|p| fields_of(p)[j].values.as_slice()).collect();
+                self.write_array(w, &f.name, f.components, &parts)?;
+            }
+        }
+        self.write_array(w, BODY_FIELD, 1, &[body])?;
+        writeln!(w, "      </{section}>")
     }
 
     /// One `<DataArray>` holding the values of `parts` one after the other.
