@@ -233,6 +233,7 @@ fn pose_resolve_case(scale: f64) -> Res<Value> {
     let si: std::sync::Arc<dyn synovia::time::history::LoadHistory> =
         std::sync::Arc::new(synovia::time::history::PiecewiseLinear::new(&si)?);
     let load = iso14243_axial_force()?;
+    tracing::info!("pose_resolve_3d: prescribed poses");
     let mut out = json!({});
     for friction in [0.0, synovia_models::tkr3d::FRICTION] {
         let prescribed = Tkr3d { friction, superior: Superior::Prescribed(si.clone()), ..Tkr3d::default() };
@@ -270,8 +271,17 @@ fn pose_resolve_case(scale: f64) -> Res<Value> {
     Ok(out)
 }
 
-/// Child mode: run one case and print its JSON record on stdout.
+/// Child mode: run one case and print its JSON record on stdout (with `SYNOVIA_TRACE` set, the
+/// library's debug spans with their times go to stderr).
 fn child(case: &str, scale: f64) -> Res<()> {
+    if std::env::var_os("SYNOVIA_TRACE").is_some() {
+        tracing_subscriber::fmt()
+            .with_max_level(tracing::Level::DEBUG)
+            .with_span_events(tracing_subscriber::fmt::format::FmtSpan::CLOSE)
+            .with_ansi(false)
+            .with_writer(std::io::stderr)
+            .init();
+    }
     let mut v = match case {
         "hertz2d_tresca" => hertz2d_case(scale, false)?,
         "resolve_new_loads" => hertz2d_case(scale, true)?,

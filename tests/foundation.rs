@@ -60,6 +60,10 @@ fn strain_energy_equals_half_the_work_of_the_loads() {
     // and ½ uᵀ K u
     let quad = 0.5 * solver.stiffness().quadratic_form(&sol.reduced);
     assert!((quad - energy).abs() < 1e-10 * energy);
+    // the energy alone (what the step records compute) is the same
+    let total = synovia::fem::post::total_strain_energy(&model, &sol.displacement).expect("energy");
+    assert!((total - energy).abs() < 1e-12 * energy, "{total} vs {energy}");
+    assert!(synovia::fem::post::total_strain_energy(&model, &[]).is_err());
     // von Mises and principal stresses are consistent: σ_vm² = ½ Σ (σ_i − σ_j)²
     for (vm, p) in fields[0].cell_von_mises.iter().zip(&fields[0].cell_principal) {
         let v2 = 0.5 * ((p[0] - p[1]).powi(2) + (p[1] - p[2]).powi(2) + (p[2] - p[0]).powi(2));

@@ -67,11 +67,65 @@ pub fn principal_stresses(voigt: &[Real], sigma_zz: Real) -> [Real; 3] {
 ///
 /// # Errors
 /// As [`body_fields`].
+///
+/// Computes only the energy (no stresses kept, no principal stresses, no nodal recovery):
+/// quasi-static and dynamic records call it at every step.
+#[tracing::instrument(level = "debug", skip_all)]
 pub fn total_strain_energy<const D: usize>(
     model: &Model<D>,
     displacement: &[Vec<Vector<D>>],
 ) -> Result<Real, FemError> {
-    Ok(body_fields(model, displacement)?.iter().map(|f| f.strain_energy).sum())
+    check_displacement(model, displacement)?;
+    let mut energy = 0.0;
+    let mut ue = vec![0.0; D * (D + 1)];
+    for (body, u) in model.bodies().iter().zip(displacement) {
+        for c in 0..body.mesh.n_cells() {
+            let geo = cell_geometry(body, c)?;
+            for (a, &n) in body.mesh.cell(c).iter().enumerate() {
+                for i in 0..D {
+                    ue[D * a + i] = u[n][i];
+                }
+            }
+            let eps = DVector::from_vec(voigt_strain::<D>(&geo.displacement_gradient(&ue)));
+            energy += geo.measure * body.material.energy_density(&eps);
+        }
+    }
+    Ok(energy)
+}
+
+/// One displacement per body and per node of it.
+fn check_displacement<const D: usize>(
+    model: &Model<D>,
+    displacement: &[Vec<Vector<D>>],
+) -> Result<(), FemError> {
+    if displacement.len() != model.bodies().len() {
+        return Err(FemError::Length {
+            what: "displacement bodies",
+            expected: model.bodies().len(),
+            got: displacement.len(),
+        });
+    }
+    for (body, u) in model.bodies().iter().zip(displacement) {
+        if u.len() != body.mesh.n_nodes() {
+            return Err(FemError::Length {
+                what: "body displacement",
+                expected: body.mesh.n_nodes(),
+                got: u.len(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The geometry of cell `c` of `body` (an error for a degenerate cell).
+fn cell_geometry<const D: usize>(
+    body: &crate::model::Body<D>,
+    c: usize,
+) -> Result<SimplexGeometry<D>, FemError> {
+    SimplexGeometry::<D>::new(&body.mesh.cell_points(c)).ok_or_else(|| FemError::Mesh {
+        body: body.name.clone(),
+        source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
+    })
 }
 
 /// Computes the fields of every body from nodal displacements (`displacement[body][node]`).
@@ -80,20 +134,9 @@ pub fn body_fields<const D: usize>(
     model: &Model<D>,
     displacement: &[Vec<Vector<D>>],
 ) -> Result<Vec<BodyFields>, FemError> {
+    check_displacement(model, displacement)?;
     let mut out = Vec::with_capacity(model.bodies().len());
-    for (bi, body) in model.bodies().iter().enumerate() {
-        let u = displacement.get(bi).ok_or(FemError::Length {
-            what: "displacement bodies",
-            expected: model.bodies().len(),
-            got: displacement.len(),
-        })?;
-        if u.len() != body.mesh.n_nodes() {
-            return Err(FemError::Length {
-                what: "body displacement",
-                expected: body.mesh.n_nodes(),
-                got: u.len(),
-            });
-        }
+    for (body, u) in model.bodies().iter().zip(displacement) {
         let nc = body.mesh.n_cells();
         let mut f = BodyFields {
             cell_strain: Vec::with_capacity(nc),
@@ -111,10 +154,7 @@ pub fn body_fields<const D: usize>(
         let mut weight = vec![0.0; body.mesh.n_nodes()];
         let mut ue = vec![0.0; D * (D + 1)];
         for c in 0..nc {
-            let geo = SimplexGeometry::<D>::new(&body.mesh.cell_points(c)).ok_or_else(|| FemError::Mesh {
-                body: body.name.clone(),
-                source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
-            })?;
+            let geo = cell_geometry(body, c)?;
             for (a, &n) in body.mesh.cell(c).iter().enumerate() {
                 for i in 0..D {
                     ue[D * a + i] = u[n][i];
