@@ -202,6 +202,9 @@ pub struct RigidBody<const D: usize> {
     pub(crate) controls: Vec<DofControl>,
     pub(crate) order: [usize; 3],
     pub(crate) pose: SharedPose<D>,
+    /// The input of [`RigidBody::prescribe_pose`] and the degrees of freedom it still drives
+    /// (re-made for a new rotation order).
+    pose_input: Option<(PoseInput<D>, Vec<bool>)>,
 }
 
 /// Names of the degrees of freedom (2D and 3D).
@@ -219,6 +222,176 @@ fn axis_rotation(axis: usize, angle: Real) -> Tensor<3> {
         0 => Tensor::<3>::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c),
         1 => Tensor::<3>::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c),
         _ => Tensor::<3>::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0),
+    }
+}
+
+/// The angles `[q_x, q_y, q_z]` with `R = Π_{a ∈ order} R_a(q_a)` (the rotation order of a
+/// [`RigidBody`], e.g. `[2, 0, 1]` for `R_z R_x R_y`): for the Tait–Bryan order `(i, j, k)` of
+/// parity `ε` (+1 for `xyz`, `yzx`, `zxy`, −1 otherwise),
+///
+/// ```text
+/// q_j = asin(ε R_ik),   q_i = atan2(−ε R_jk, R_kk),   q_k = atan2(−ε R_ij, R_ii),
+/// ```
+///
+/// with `q_i, q_k ∈ (−π, π]`, `q_j ∈ [−π/2, π/2]` (at `q_j = ±π/2` the split between `q_i` and
+/// `q_k` is one of many, the rotation the same).
+pub fn euler_angles(rotation: &Tensor<3>, order: [usize; 3]) -> [Real; 3] {
+    let [i, j, k] = order;
+    let eps = if (j + 3 - i) % 3 == 1 { 1.0 } else { -1.0 };
+    let mut q = [0.0; 3];
+    q[j] = (eps * rotation[(i, k)]).clamp(-1.0, 1.0).asin();
+    q[i] = (-eps * rotation[(j, k)]).atan2(rotation[(k, k)]);
+    q[k] = (-eps * rotation[(i, j)]).atan2(rotation[(i, i)]);
+    q
+}
+
+/// A pose set from outside between solves — a navigation tracker's frame — for a rigid body
+/// whose degrees of freedom it prescribes ([`RigidBody::prescribe_pose`]): the translation of
+/// the body's reference point and its rotation, given as a unit quaternion, an axis and an
+/// angle, or a rotation matrix (3D), or an angle (2D). Clones share the pose: keep one, set it
+/// before each [`JointSession`](crate::session::JointSession) solve.
+#[derive(Debug, Clone)]
+pub struct PoseInput<const D: usize>(Arc<RwLock<(Vector<3>, Tensor<3>)>>);
+
+impl<const D: usize> Default for PoseInput<D> {
+    fn default() -> Self {
+        Self(Arc::new(RwLock::new((Vector::<3>::zeros(), Tensor::<3>::identity()))))
+    }
+}
+
+impl<const D: usize> PoseInput<D> {
+    /// The identity pose (no translation, no rotation).
+    pub fn new() -> Self {
+        Self::default()
+    }
+    fn get(&self) -> (Vector<3>, Tensor<3>) {
+        match self.0.read() {
+            Ok(p) => *p,
+            Err(e) => *e.into_inner(),
+        }
+    }
+    fn put(&self, translation: Vector<3>, rotation: Tensor<3>) {
+        match self.0.write() {
+            Ok(mut p) => *p = (translation, rotation),
+            Err(e) => *e.into_inner() = (translation, rotation),
+        }
+    }
+    /// The rotation angles of the current pose for a body with rotation `order`
+    /// ([`euler_angles`]; 2D: `[0, 0, θ]`).
+    pub fn angles(&self, order: [usize; 3]) -> [Real; 3] {
+        euler_angles(&self.get().1, order)
+    }
+    /// The current translation (`z = 0` in 2D).
+    pub fn translation(&self) -> [Real; 3] {
+        let t = self.get().0;
+        [t[0], t[1], t[2]]
+    }
+}
+
+fn finite(what: &str, values: &[Real]) -> Result<(), JointError> {
+    if values.iter().all(|v| v.is_finite()) {
+        Ok(())
+    } else {
+        Err(JointError::Invalid(format!("pose: {what} {values:?} is not finite")))
+    }
+}
+
+impl PoseInput<3> {
+    /// Sets the translation `t` and the rotation of the unit quaternion `q = [w, x, y, z]`
+    /// (normalised here: `R = I + 2w [v]ₓ + 2 [v]ₓ²` with `v = (x, y, z)`).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for non-finite values or a zero quaternion; the pose is unchanged.
+    pub fn set_quaternion(&self, translation: [Real; 3], q: [Real; 4]) -> Result<(), JointError> {
+        finite("translation", &translation)?;
+        finite("quaternion", &q)?;
+        let norm = q.iter().map(|v| v * v).sum::<Real>().sqrt();
+        if norm <= 1e-12 {
+            return Err(JointError::Invalid(format!("pose: quaternion {q:?} has no direction")));
+        }
+        let unit =
+            nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]));
+        self.put(Vector::<3>::from(translation), unit.to_rotation_matrix().into_inner());
+        Ok(())
+    }
+    /// Sets the translation `t` and the rotation by `angle` (rad, right-handed) about `axis`
+    /// (normalised here; Rodrigues: `R = I + sin θ [n]ₓ + (1 − cos θ) [n]ₓ²`).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for non-finite values or a zero axis; the pose is unchanged.
+    pub fn set_axis_angle(
+        &self,
+        translation: [Real; 3],
+        axis: [Real; 3],
+        angle: Real,
+    ) -> Result<(), JointError> {
+        finite("translation", &translation)?;
+        finite("axis", &axis)?;
+        finite("angle", &[angle])?;
+        let axis = Vector::<3>::from(axis);
+        let Some(n) = nalgebra::Unit::try_new(axis, 1e-12) else {
+            return Err(JointError::Invalid(format!("pose: rotation axis {axis:?} has no direction")));
+        };
+        self.put(
+            Vector::<3>::from(translation),
+            nalgebra::Rotation3::from_axis_angle(&n, angle).into_inner(),
+        );
+        Ok(())
+    }
+    /// Sets the translation `t` and the rotation matrix `R` (row-major), which must be a
+    /// rotation to 1e-9 (`RᵀR = I`, `det R = 1`).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for non-finite values or a matrix that is not a rotation.
+    pub fn set_rotation_matrix(
+        &self,
+        translation: [Real; 3],
+        rotation: [[Real; 3]; 3],
+    ) -> Result<(), JointError> {
+        finite("translation", &translation)?;
+        finite("rotation", rotation.as_flattened())?;
+        let r = Tensor::<3>::from_fn(|i, j| rotation[i][j]);
+        let defect = (r.transpose() * r - Tensor::<3>::identity()).abs().max();
+        if defect > 1e-9 || (r.determinant() - 1.0).abs() > 1e-9 {
+            return Err(JointError::Invalid(format!(
+                "pose: {rotation:?} is not a rotation (|RᵀR − I| = {defect:.1e}, det = {})",
+                r.determinant()
+            )));
+        }
+        self.put(Vector::<3>::from(translation), r);
+        Ok(())
+    }
+}
+
+impl PoseInput<2> {
+    /// Sets the translation `t` and the rotation angle (rad, counter-clockwise).
+    ///
+    /// # Errors
+    /// [`JointError::Invalid`] for non-finite values; the pose is unchanged.
+    pub fn set(&self, translation: [Real; 2], angle: Real) -> Result<(), JointError> {
+        finite("translation", &translation)?;
+        finite("angle", &[angle])?;
+        self.put(Vector::<3>::new(translation[0], translation[1], 0.0), axis_rotation(2, angle));
+        Ok(())
+    }
+}
+
+/// One degree of freedom of a [`PoseInput`] as a history (the same at every time: the pose is
+/// whatever was set last).
+#[derive(Debug)]
+struct PoseDof<const D: usize> {
+    input: PoseInput<D>,
+    /// 0–2: translation component; 3–5: angle about x, y, z.
+    component: usize,
+    order: [usize; 3],
+}
+
+impl<const D: usize> LoadHistory for PoseDof<D> {
+    fn value(&self, _t: Real) -> Real {
+        match self.component {
+            c @ 0..=2 => self.input.translation()[c],
+            c => self.input.angles(self.order)[c - 3],
+        }
     }
 }
 
@@ -246,6 +419,7 @@ impl<const D: usize> RigidBody<D> {
             controls: vec![DofControl::Prescribed(zero); rigid_dofs(D)],
             order: [2, 0, 1],
             pose: SharedPose::new(RigidPose::identity(centre)),
+            pose_input: None,
         })
     }
 
@@ -292,6 +466,40 @@ impl<const D: usize> RigidBody<D> {
         })
     }
 
+    /// Prescribes every degree of freedom by `input`, the pose a caller sets between solves
+    /// (a navigation tracker: [`PoseInput::set_quaternion`], [`PoseInput::set_axis_angle`],
+    /// [`PoseInput::set_rotation_matrix`]; 2D [`PoseInput::set`]). The rotation is turned into
+    /// the body's angles for its rotation order ([`euler_angles`], also after a later
+    /// [`RigidBody::with_rotation_order`]), so records report them as usual. A degree of
+    /// freedom given another control afterwards ([`RigidBody::prescribe`], [`RigidBody::force`],
+    /// e.g. the axial force of a knee simulator) leaves the pose input.
+    pub fn prescribe_pose(mut self, input: &PoseInput<D>) -> Self {
+        self.pose_input = Some((input.clone(), vec![true; rigid_dofs(D)]));
+        self.drive_by_pose();
+        self
+    }
+
+    /// The controls of the degrees of freedom [`RigidBody::prescribe_pose`] drives.
+    fn drive_by_pose(&mut self) {
+        let Some((input, driven)) = &self.pose_input else { return };
+        let order = if D == 2 { [0, 1, 2] } else { self.order };
+        for (dof, _) in driven.iter().enumerate().filter(|(_, &on)| on) {
+            // 2D: tx, ty, rz; the angle about z of the planar rotation
+            let component = if D == 2 && dof == 2 { 5 } else { dof };
+            let history = PoseDof { input: input.clone(), component, order };
+            self.controls[dof] = DofControl::Prescribed(Arc::new(history));
+        }
+    }
+
+    /// `dof` no longer follows a [`PoseInput`].
+    fn release_from_pose(&mut self, dof: usize) {
+        if let Some((_, driven)) = &mut self.pose_input {
+            if let Some(on) = driven.get_mut(dof) {
+                *on = false;
+            }
+        }
+    }
+
     /// Prescribes degree of freedom `dof` by `history` (length or radians).
     ///
     /// # Errors
@@ -299,6 +507,7 @@ impl<const D: usize> RigidBody<D> {
     pub fn prescribe(mut self, dof: usize, history: impl LoadHistory + 'static) -> Result<Self, JointError> {
         self.check_dof(dof)?;
         self.controls[dof] = DofControl::Prescribed(Arc::new(history));
+        self.release_from_pose(dof);
         Ok(self)
     }
 
@@ -310,6 +519,7 @@ impl<const D: usize> RigidBody<D> {
     pub fn force(mut self, dof: usize, history: impl LoadHistory + 'static) -> Result<Self, JointError> {
         self.check_dof(dof)?;
         self.controls[dof] = DofControl::Force { load: Arc::new(history), guess: None };
+        self.release_from_pose(dof);
         Ok(self)
     }
 
@@ -327,6 +537,7 @@ impl<const D: usize> RigidBody<D> {
     ) -> Result<Self, JointError> {
         self.check_dof(dof)?;
         self.controls[dof] = DofControl::Force { load: Arc::new(history), guess: Some(Arc::new(guess)) };
+        self.release_from_pose(dof);
         Ok(self)
     }
 
@@ -349,6 +560,7 @@ impl<const D: usize> RigidBody<D> {
             return Err(self.bad_order(order));
         }
         self.order = [axes[0], axes[1], axes[2]];
+        self.drive_by_pose();
         Ok(self)
     }
 
@@ -1395,5 +1607,134 @@ impl LineSearch {
         };
         self.alpha = next;
         Some(next)
+    }
+}
+
+#[cfg(test)]
+mod pose_input_tests {
+    use super::*;
+
+    const ORDERS: [[usize; 3]; 6] = [[0, 1, 2], [1, 2, 0], [2, 0, 1], [0, 2, 1], [2, 1, 0], [1, 0, 2]];
+
+    fn rotation(order: [usize; 3], q: [Real; 3]) -> Tensor<3> {
+        order.iter().fold(Tensor::<3>::identity(), |r, &a| r * axis_rotation(a, q[a]))
+    }
+
+    #[test]
+    fn euler_angles_invert_every_rotation_order() {
+        for order in ORDERS {
+            for (mut q, middle) in [
+                ([0.3, -0.7, 1.1], -0.7),
+                ([-2.9, 1.2, 3.0], 1.2),
+                ([0.0; 3], 0.0),
+                ([1.0, -1.5, -0.2], -1.5),
+            ] {
+                // the middle angle of the order lies in [−π/2, π/2], the others in (−π, π]
+                q[order[1]] = middle;
+                let got = euler_angles(&rotation(order, q), order);
+                // the same rotation in any case
+                let again = rotation(order, got);
+                assert!((again - rotation(order, q)).abs().max() < 1e-12);
+                for a in 0..3 {
+                    assert!((got[a] - q[a]).abs() < 1e-12, "order {order:?}: {got:?} vs {q:?}");
+                }
+            }
+            // gimbal lock (middle angle ±π/2): other angles, the same rotation
+            let mut q = [0.4, 0.4, 0.4];
+            q[order[1]] = std::f64::consts::FRAC_PI_2;
+            let r = rotation(order, q);
+            let again = rotation(order, euler_angles(&r, order));
+            assert!((again - r).abs().max() < 1e-12, "order {order:?}");
+        }
+    }
+
+    #[test]
+    fn quaternion_axis_angle_and_matrix_give_the_same_pose() -> Result<(), JointError> {
+        let (axis, angle) = ([1.0, -2.0, 0.5], 0.7_f64);
+        let n = Vector::<3>::from(axis).normalize();
+        let (s, c) = (0.5 * angle).sin_cos();
+        let by_quaternion = PoseInput::<3>::new();
+        // a quaternion off unit length is normalised
+        by_quaternion
+            .set_quaternion([1.0, 2.0, 3.0], [2.0 * c, 2.0 * s * n[0], 2.0 * s * n[1], 2.0 * s * n[2]])?;
+        let by_axis = PoseInput::<3>::new();
+        by_axis.set_axis_angle([1.0, 2.0, 3.0], axis, angle)?;
+        let r = by_axis.get().1;
+        let by_matrix = PoseInput::<3>::new();
+        by_matrix.set_rotation_matrix(
+            [1.0, 2.0, 3.0],
+            std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
+        )?;
+        for other in [&by_quaternion, &by_matrix] {
+            assert!((other.get().1 - r).abs().max() < 1e-15);
+            assert_eq!(other.translation(), [1.0, 2.0, 3.0]);
+        }
+        // Rodrigues: the axis is fixed, and a perpendicular vector turns by the angle
+        assert!((r * n - n).norm() < 1e-15);
+        let p = n.cross(&Vector::<3>::new(0.0, 0.0, 1.0)).normalize();
+        assert!(((r * p).dot(&p) - angle.cos()).abs() < 1e-15);
+        Ok(())
+    }
+
+    #[test]
+    fn bad_poses_are_refused_and_leave_the_pose() -> Result<(), JointError> {
+        let input = PoseInput::<3>::new();
+        input.set_axis_angle([0.5, 0.0, 0.0], [0.0, 0.0, 1.0], 0.25)?;
+        let before = input.get();
+        assert!(input.set_quaternion([0.0; 3], [0.0; 4]).is_err());
+        assert!(input.set_quaternion([f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]).is_err());
+        assert!(input.set_axis_angle([0.0; 3], [0.0; 3], 1.0).is_err());
+        assert!(input.set_axis_angle([0.0; 3], [1.0, 0.0, 0.0], f64::INFINITY).is_err());
+        let shear = [[1.0, 0.1, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        assert!(input.set_rotation_matrix([0.0; 3], shear).is_err());
+        let mirror = [[-1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+        assert!(input.set_rotation_matrix([0.0; 3], mirror).is_err());
+        assert_eq!(input.get(), before);
+        assert!(PoseInput::<2>::new().set([0.0, f64::NAN], 0.0).is_err());
+        Ok(())
+    }
+
+    #[test]
+    fn a_posed_body_follows_its_input_in_its_rotation_order() -> Result<(), JointError> {
+        let input = PoseInput::<3>::new();
+        // the order set after prescribe_pose still applies; the force-controlled dof leaves it
+        let body = RigidBody::<3>::new("b", Point::<3>::zeros())?
+            .prescribe_pose(&input)
+            .force(1, synovia_time::history::Constant(-1.0))?
+            .with_rotation_order("xyz")?;
+        let q = [0.2, -0.4, 0.9];
+        input.set_rotation_matrix([0.1, 0.2, 0.3], {
+            let r = rotation([0, 1, 2], q);
+            std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]))
+        })?;
+        let values: Vec<Option<Real>> = body
+            .controls()
+            .iter()
+            .map(|c| match c {
+                DofControl::Prescribed(h) => Some(h.value(0.0)),
+                DofControl::Force { .. } => None,
+            })
+            .collect();
+        assert_eq!(values[1], None);
+        for (got, want) in
+            [(values[0], 0.1), (values[2], 0.3), (values[3], q[0]), (values[4], q[1]), (values[5], q[2])]
+        {
+            assert!((got.unwrap_or(Real::NAN) - want).abs() < 1e-12, "{values:?}");
+        }
+        // 2D: translation and the angle
+        let planar = PoseInput::<2>::new();
+        let body = RigidBody::<2>::new("p", Point::<2>::zeros())?.prescribe_pose(&planar);
+        planar.set([0.5, -0.25], 1.25)?;
+        let values: Vec<Real> = body
+            .controls()
+            .iter()
+            .filter_map(|c| if let DofControl::Prescribed(h) = c { Some(h.value(3.0)) } else { None })
+            .collect();
+        assert!(
+            (values[0] - 0.5).abs() < 1e-15
+                && (values[1] + 0.25).abs() < 1e-15
+                && (values[2] - 1.25).abs() < 1e-12
+        );
+        Ok(())
     }
 }
