@@ -102,6 +102,32 @@ fn every_example_scenario_runs() {
         assert_eq!(last.pieces.len(), summary["bodies"].as_array().unwrap().len());
         let names: Vec<&str> = last.pieces[0].point_data.iter().map(|f| f.name.as_str()).collect();
         assert!(names.contains(&"displacement") && names.contains(&"contact_pressure"), "{names:?}");
+        // the stress and strain tensors of every body (`[output] stress`, default true)
+        for piece in &last.pieces {
+            for name in ["stress", "strain"] {
+                let f = piece.cell_field(name).unwrap_or_else(|| panic!("{stem}: no {name}"));
+                assert_eq!(f.components, 6, "{stem}: {name}");
+            }
+            assert_eq!(piece.cell_field("principal_stress").map(|f| f.components), Some(3), "{stem}");
+        }
+    }
+}
+
+/// `[output] stress = false`: the files carry the displacement and the contact state only.
+#[test]
+fn stress_fields_can_be_left_out() {
+    let text = std::fs::read_to_string(scenarios_dir().join("hertz2d.toml")).unwrap();
+    assert!(!text.contains("[output]"), "hertz2d.toml has its own [output]");
+    let dir = tmp("no-stress");
+    let file = dir.join("hertz2d.toml");
+    std::fs::write(&file, format!("{text}\n[output]\nstress = false\n")).unwrap();
+    let o = run(&file, &dir.join("out"));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let series = synovia::io::read_pvd(dir.join("out").join("hertz2d.pvd")).unwrap();
+    let last = synovia::io::read_vtu(&series[series.len() - 1].file).unwrap();
+    for piece in &last.pieces {
+        assert!(piece.cell_field("stress").is_none() && piece.point_field("von_mises_nodal").is_none());
+        assert!(piece.point_field("contact_pressure").is_some());
     }
 }
 
