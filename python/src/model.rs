@@ -1,0 +1,865 @@
+//! `synovia.Model`: a joint model in 2D or 3D from NumPy arrays or a scenario file, and
+//! `synovia.Material`.
+
+use std::any::Any;
+use std::sync::Arc;
+
+use numpy::{PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use synovia::builder::{Analysis, BodyMaterial, JointModel};
+use synovia::contact_ops::obstacle::SignedDistance;
+use synovia::contact_ops::operators::{ContactPair, CylinderObstacle, PlaneObstacle, SphereObstacle};
+use synovia::fem::{BodyId, ComponentMask};
+use synovia::material::{anisotropic, isotropic, plane_strain, plane_stress, VoigtMatrix};
+use synovia::mesh::math::{Point, Vector};
+use synovia::mesh::{BoundaryKind, Mesh};
+use synovia::prelude::LoadHistory;
+use synovia_scenario::{build::build, Scenario};
+
+use crate::error::{err, msg, set_callback_error, solved, take_callback_error};
+use crate::history::history;
+use crate::result::{Collector, PyRunResult, RunData};
+use crate::session::PySession;
+
+// The model is shared with the thread of a `Session` and runs release the GIL: it must be
+// `Send + Sync`.
+const _: fn() = || {
+    fn send_sync<T: Send + Sync>() {}
+    send_sync::<JointModel<2>>();
+    send_sync::<JointModel<3>>();
+};
+
+/// The material of a body (`synovia.Material`), made by its static constructors and turned
+/// into the model's material when a body is added.
+#[pyclass(name = "Material", module = "synovia", frozen)]
+#[derive(Debug, Clone)]
+pub struct PyMaterial {
+    kind: MatKind,
+}
+
+#[derive(Debug, Clone)]
+enum MatKind {
+    Isotropic { e: f64, nu: f64 },
+    PlaneStrain { e: f64, nu: f64 },
+    PlaneStress { e: f64, nu: f64 },
+    Anisotropic { c: Vec<f64>, n: usize },
+}
+
+#[pymethods]
+impl PyMaterial {
+    /// Isotropic linear elasticity with Young's modulus `E` and Poisson's ratio `nu`: 3D, or
+    /// plane strain on a 2D body.
+    #[staticmethod]
+    #[allow(non_snake_case)]
+    fn isotropic(E: f64, nu: f64) -> Self {
+        Self { kind: MatKind::Isotropic { e: E, nu } }
+    }
+    /// Isotropic, plane strain (2D bodies only).
+    #[staticmethod]
+    #[allow(non_snake_case)]
+    fn plane_strain(E: f64, nu: f64) -> Self {
+        Self { kind: MatKind::PlaneStrain { e: E, nu } }
+    }
+    /// Isotropic, plane stress (2D bodies only).
+    #[staticmethod]
+    #[allow(non_snake_case)]
+    fn plane_stress(E: f64, nu: f64) -> Self {
+        Self { kind: MatKind::PlaneStress { e: E, nu } }
+    }
+    /// General anisotropic elasticity from the Voigt stiffness matrix `C` (3 × 3 in 2D,
+    /// 6 × 6 in 3D; engineering shear strains; symmetric positive definite).
+    #[staticmethod]
+    #[allow(non_snake_case)]
+    fn anisotropic(C: PyReadonlyArray2<'_, f64>) -> PyResult<Self> {
+        let a = C.as_array();
+        if a.nrows() != a.ncols() {
+            return Err(msg(format!("the stiffness matrix must be square, got {}×{}", a.nrows(), a.ncols())));
+        }
+        Ok(Self { kind: MatKind::Anisotropic { c: a.iter().copied().collect(), n: a.nrows() } })
+    }
+    fn __repr__(&self) -> String {
+        format!("Material({:?})", self.kind)
+    }
+}
+
+fn downcast<U: 'static>(b: Box<dyn Any>, what: &str) -> PyResult<U> {
+    b.downcast::<U>().map(|b| *b).map_err(|_| msg(what.to_string()))
+}
+
+fn material_for<const D: usize>(m: &PyMaterial) -> PyResult<BodyMaterial<D>> {
+    let any: Box<dyn Any> = match (&m.kind, D) {
+        (MatKind::Isotropic { e, nu }, 3) => {
+            Box::new(BodyMaterial::<3>::from(isotropic(*e, *nu).map_err(err)?))
+        }
+        (MatKind::Isotropic { e, nu } | MatKind::PlaneStrain { e, nu }, 2) => {
+            Box::new(BodyMaterial::<2>::from(plane_strain(*e, *nu).map_err(err)?))
+        }
+        (MatKind::PlaneStress { e, nu }, 2) => {
+            Box::new(BodyMaterial::<2>::from(plane_stress(*e, *nu).map_err(err)?))
+        }
+        (MatKind::Anisotropic { c, n }, _) => {
+            let c = VoigtMatrix::from_row_slice(*n, *n, c);
+            return Ok(BodyMaterial::<D>::from(anisotropic::<D>(c).map_err(err)?));
+        }
+        _ => return Err(msg("plane strain and plane stress materials are for 2D bodies only")),
+    };
+    downcast::<BodyMaterial<D>>(any, "material of another dimension")
+}
+
+/// The joint model of either dimension, shared with open sessions.
+#[derive(Debug, Clone)]
+pub(crate) enum Joint {
+    D2(Arc<JointModel<2>>),
+    D3(Arc<JointModel<3>>),
+}
+
+macro_rules! with_joint {
+    ($self:expr, $j:ident => $body:expr) => {
+        match &$self.joint {
+            Joint::D2($j) => $body,
+            Joint::D3($j) => $body,
+        }
+    };
+}
+
+macro_rules! with_joint_mut {
+    ($self:expr, $j:ident => $body:expr) => {
+        match &mut $self.joint {
+            Joint::D2(a) => {
+                let $j = get_mut(a)?;
+                $body
+            }
+            Joint::D3(a) => {
+                let $j = get_mut(a)?;
+                $body
+            }
+        }
+    };
+}
+
+fn get_mut<const D: usize>(a: &mut Arc<JointModel<D>>) -> PyResult<&mut JointModel<D>> {
+    Arc::get_mut(a).ok_or_else(|| {
+        msg("the model is in use by an open Session: close it (Session.close()) before changing the model")
+    })
+}
+
+fn vector<const D: usize>(v: &[f64], what: &str) -> PyResult<Vector<D>> {
+    if v.len() != D {
+        return Err(msg(format!("{what} must have {D} components, got {}", v.len())));
+    }
+    Ok(Vector::<D>::from_fn(|i, _| v[i]))
+}
+
+fn point<const D: usize>(v: &[f64], what: &str) -> PyResult<Point<D>> {
+    Ok(Point::from(vector::<D>(v, what)?))
+}
+
+fn mask(components: Option<Vec<usize>>, d: usize) -> PyResult<ComponentMask> {
+    match components {
+        None => Ok(ComponentMask::ALL),
+        Some(c) => {
+            let mut m = [false; 3];
+            for k in c {
+                if k >= d {
+                    return Err(msg(format!("component {k} out of range for dimension {d}")));
+                }
+                m[k] = true;
+            }
+            Ok(ComponentMask(m))
+        }
+    }
+}
+
+fn body_id<const D: usize>(j: &JointModel<D>, body: &Bound<'_, PyAny>) -> PyResult<BodyId> {
+    if let Ok(i) = body.extract::<usize>() {
+        j.model().body(BodyId(i)).map_err(err)?;
+        return Ok(BodyId(i));
+    }
+    let name: String = body.extract().map_err(|_| msg("a body is given by its index (int) or name (str)"))?;
+    j.model().body_id(&name).map_err(err)
+}
+
+fn index_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<Vec<usize>>> {
+    let np = obj.py().import_bound("numpy")?;
+    let arr = np.call_method1("asarray", (obj,))?;
+    let arr = arr.call_method1("astype", ("int64",))?;
+    let a: PyReadonlyArray2<i64> =
+        arr.extract().map_err(|_| msg(format!("{what} must be a 2-D integer array with {cols} columns")))?;
+    if a.shape()[1] != cols {
+        return Err(msg(format!("{what} must have {cols} columns, got {}", a.shape()[1])));
+    }
+    let a = a.as_array();
+    let mut out = Vec::with_capacity(a.nrows());
+    for (r, row) in a.rows().into_iter().enumerate() {
+        let mut v = Vec::with_capacity(cols);
+        for &x in row {
+            if x < 0 {
+                return Err(msg(format!("{what}: negative node index {x} in row {r}")));
+            }
+            v.push(x as usize);
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+fn float_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<Vec<f64>>> {
+    let np = obj.py().import_bound("numpy")?;
+    let arr = np.call_method1("asarray", (obj, "float64"))?;
+    let a: PyReadonlyArray2<f64> =
+        arr.extract().map_err(|_| msg(format!("{what} must be a 2-D float array with {cols} columns")))?;
+    if a.shape()[1] != cols {
+        return Err(msg(format!("{what} must have {cols} columns, got {}", a.shape()[1])));
+    }
+    Ok(a.as_array().rows().into_iter().map(|r| r.to_vec()).collect())
+}
+
+/// The values of a Python vector-like (`D` floats).
+fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    if let Ok(v) = obj.extract::<f64>() {
+        return Ok(vec![v]);
+    }
+    let np = obj.py().import_bound("numpy")?;
+    let arr = np.call_method1("asarray", (obj, "float64"))?.call_method0("ravel")?;
+    arr.call_method0("tolist")?
+        .extract::<Vec<f64>>()
+        .map_err(|_| msg(format!("{what} must be a sequence of floats")))
+}
+
+/// A Python callable `f(x, t) -> D floats` as a displacement field.
+fn py_field<const D: usize>(f: Py<PyAny>) -> impl Fn(&Point<D>, f64) -> Vector<D> + Send + Sync + 'static {
+    move |x: &Point<D>, t: f64| {
+        Python::with_gil(|py| {
+            let call = || -> PyResult<Vector<D>> {
+                let xs = numpy::PyArray1::from_vec_bound(py, x.iter().copied().collect());
+                let v = f.call1(py, (xs, t))?;
+                let v = floats(v.bind(py), "the value of a displacement field")?;
+                vector::<D>(&v, "the value of a displacement field")
+            };
+            call().unwrap_or_else(|e| {
+                set_callback_error(e);
+                Vector::<D>::from_element(f64::NAN)
+            })
+        })
+    }
+}
+
+fn scaled<const D: usize>(
+    h: impl LoadHistory + 'static,
+    v: Vector<D>,
+) -> impl Fn(&Point<D>, f64) -> Vector<D> + Send + Sync {
+    move |_x: &Point<D>, t: f64| v * h.value(t)
+}
+
+// ----- the generic bodies of the methods -----
+
+fn add_body<const D: usize>(
+    j: &mut JointModel<D>,
+    name: &str,
+    nodes: &Bound<'_, PyAny>,
+    cells: &Bound<'_, PyAny>,
+    material: &PyMaterial,
+    parts: Option<&Bound<'_, PyDict>>,
+) -> PyResult<usize> {
+    let pts: Vec<Point<D>> =
+        float_array(nodes, D, "nodes")?.iter().map(|r| Point::<D>::from_fn(|i, _| r[i])).collect();
+    let cells: Vec<usize> = index_array(cells, D + 1, "cells")?.into_iter().flatten().collect();
+    // cells of either orientation (meshio meshes need not orient them): inverted ones are flipped
+    let (mut mesh, _flipped) =
+        Mesh::<D>::new_with_repair(pts, cells).map_err(|e| msg(format!("body `{name}`: {e}")))?;
+    if let Some(parts) = parts {
+        for (k, v) in parts.iter() {
+            let pname: String = k.extract()?;
+            let facets = index_array(&v, D, &format!("part `{pname}`"))?;
+            mesh.add_boundary_part_from_facets(&pname, BoundaryKind::TractionFree, &facets)
+                .map_err(|e| msg(format!("body `{name}`, part `{pname}`: {e}")))?;
+        }
+    }
+    let mat = material_for::<D>(material)?;
+    Ok(j.add_body(name, mesh, mat).map_err(err)?.0)
+}
+
+fn add_part<const D: usize>(
+    j: &mut JointModel<D>,
+    body: &Bound<'_, PyAny>,
+    name: &str,
+    facets: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let id = body_id(j, body)?;
+    let facets = index_array(facets, D, &format!("part `{name}`"))?;
+    let b = j.model_mut().body_mut(id).map_err(err)?;
+    let bname = b.name.clone();
+    b.mesh
+        .add_boundary_part_from_facets(name, BoundaryKind::TractionFree, &facets)
+        .map_err(|e| msg(format!("body `{bname}`, part `{name}`: {e}")))?;
+    Ok(())
+}
+
+fn add_part_where<const D: usize>(
+    j: &mut JointModel<D>,
+    body: &Bound<'_, PyAny>,
+    name: &str,
+    select: &Bound<'_, PyAny>,
+) -> PyResult<()> {
+    let id = body_id(j, body)?;
+    let py = select.py();
+    let f = select.clone().unbind();
+    let r = j.define_part(id, name, |x: &Point<D>, n: &Vector<D>| {
+        let xs = numpy::PyArray1::from_vec_bound(py, x.iter().copied().collect());
+        let ns = numpy::PyArray1::from_vec_bound(py, n.iter().copied().collect());
+        match f.call1(py, (xs, ns)).and_then(|v| v.is_truthy(py)) {
+            Ok(b) => b,
+            Err(e) => {
+                set_callback_error(e);
+                false
+            }
+        }
+    });
+    if let Some(e) = take_callback_error() {
+        return Err(e);
+    }
+    r.map_err(err)?;
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn contact_pair<const D: usize>(
+    j: &mut JointModel<D>,
+    name: &str,
+    body_k: &Bound<'_, PyAny>,
+    part_k: &str,
+    body_l: &Bound<'_, PyAny>,
+    part_l: &str,
+    friction: f64,
+    discretisation: &str,
+    search_distance: Option<f64>,
+) -> PyResult<()> {
+    let k = body_id(j, body_k)?;
+    let l = body_id(j, body_l)?;
+    let pair = match discretisation {
+        "node-to-node" | "node_to_node" => ContactPair::node_to_node(name, k, part_k, l, part_l),
+        "node-to-segment" | "node_to_segment" | "node-to-facet" | "node_to_facet" => {
+            ContactPair::node_to_segment(name, k, part_k, l, part_l)
+        }
+        "mortar" => ContactPair::mortar(name, k, part_k, l, part_l),
+        _ => {
+            return Err(msg(format!(
+                "unknown discretisation `{discretisation}`: use \"node-to-node\", \"node-to-segment\" or \"mortar\""
+            )))
+        }
+    };
+    let mut pair = pair.with_friction(friction);
+    if let Some(d) = search_distance {
+        pair = pair.with_search_distance(d);
+    }
+    j.add_contact(pair).map_err(err)?;
+    Ok(())
+}
+
+fn contact_obstacle<const D: usize>(
+    j: &mut JointModel<D>,
+    name: &str,
+    body: &Bound<'_, PyAny>,
+    part: &str,
+    obstacle: Arc<dyn SignedDistance<D>>,
+    friction: f64,
+) -> PyResult<()> {
+    let id = body_id(j, body)?;
+    j.add_contact(ContactPair::rigid(name, id, part, obstacle).with_friction(friction)).map_err(err)?;
+    Ok(())
+}
+
+fn run_joint<const D: usize>(
+    joint: &JointModel<D>,
+    how: &RunKind,
+    keep_steps: bool,
+) -> Result<RunData, synovia::builder::JointError> {
+    let mut col = Collector { keep_steps, ..Default::default() };
+    let observer = |v: &synovia::builder::StepView<'_, D>| {
+        col.step(v.model, v.geometry, v.result);
+        Ok(())
+    };
+    let run = match how {
+        RunKind::Static(t) => joint.run_quasistatic_with(&[*t], observer)?,
+        RunKind::QuasiStatic(times) => joint.run_quasistatic_with(times, observer)?,
+        RunKind::Dynamic(dt, steps) => joint.run_dynamic_with(*dt, *steps, observer)?,
+        RunKind::Analysis => joint.run_with(observer)?,
+    };
+    col.finish(joint.model(), run).map_err(synovia::builder::JointError::Invalid)
+}
+
+#[derive(Debug, Clone)]
+enum RunKind {
+    Static(f64),
+    QuasiStatic(Vec<f64>),
+    Dynamic(f64, usize),
+    Analysis,
+}
+
+/// A joint model (`synovia.Model`): bodies (P1 triangles in 2D, tetrahedra in 3D) from NumPy
+/// arrays, materials, boundary conditions on named boundary parts with load histories, contact
+/// pairs, the contact solver, and static, quasi-static and dynamic runs.
+///
+/// Bodies are referred to by index (`int`) or name (`str`). A load history is `None` (1 at
+/// every time), a number, a `synovia.Parameter`, an `(n, 2)` table of `(t, h)` rows (piecewise
+/// linear) or a callable `h(t)`.
+#[pyclass(name = "Model", module = "synovia")]
+#[derive(Debug)]
+pub struct PyModel {
+    pub(crate) joint: Joint,
+    name: Option<String>,
+    warnings: Vec<String>,
+}
+
+impl PyModel {
+    fn run_kind(&self, py: Python<'_>, how: RunKind, keep_steps: bool) -> PyResult<PyRunResult> {
+        let joint = self.joint.clone();
+        take_callback_error();
+        let r = py.allow_threads(move || match &joint {
+            Joint::D2(j) => run_joint(j, &how, keep_steps),
+            Joint::D3(j) => run_joint(j, &how, keep_steps),
+        });
+        let data = solved(r)?;
+        Ok(PyRunResult { data })
+    }
+}
+
+#[pymethods]
+impl PyModel {
+    /// An empty model of dimension 2 (plane problems) or 3.
+    #[new]
+    fn new(dimension: usize) -> PyResult<Self> {
+        let joint = match dimension {
+            2 => Joint::D2(Arc::new(JointModel::new())),
+            3 => Joint::D3(Arc::new(JointModel::new())),
+            _ => return Err(msg(format!("dimension must be 2 or 3, got {dimension}"))),
+        };
+        Ok(Self { joint, name: None, warnings: Vec::new() })
+    }
+
+    /// A model from a TOML scenario file (`docs/scenario.md`): bodies, materials, conditions,
+    /// contact pairs, rigid bodies, solver and analysis; `Model.run()` runs its analysis.
+    /// Output settings of the file (`[output]`) are not used: results come back as a
+    /// `RunResult`.
+    #[staticmethod]
+    fn from_scenario(py: Python<'_>, path: std::path::PathBuf) -> PyResult<Self> {
+        let built = py.allow_threads(move || -> Result<(Joint, String, Vec<String>), String> {
+            let sc = Scenario::from_file(&path).map_err(|e| e.to_string())?;
+            let dim = *sc.doc.dimension.get_ref();
+            let name = sc.name();
+            match dim {
+                2 => build::<2>(&sc)
+                    .map(|b| (Joint::D2(Arc::new(b.joint)), name, b.warnings))
+                    .map_err(|e| e.to_string()),
+                3 => build::<3>(&sc)
+                    .map(|b| (Joint::D3(Arc::new(b.joint)), name, b.warnings))
+                    .map_err(|e| e.to_string()),
+                _ => Err(format!("{}: dimension must be 2 or 3, got {dim}", path.display())),
+            }
+        });
+        let (joint, name, warnings) = built.map_err(msg)?;
+        Ok(Self { joint, name: Some(name), warnings })
+    }
+
+    /// Dimension (2 or 3).
+    #[getter]
+    fn dimension(&self) -> usize {
+        match self.joint {
+            Joint::D2(_) => 2,
+            Joint::D3(_) => 3,
+        }
+    }
+    /// The scenario's name (models from scenario files), else `None`.
+    #[getter]
+    fn name(&self) -> Option<String> {
+        self.name.clone()
+    }
+    /// Warnings found while building a scenario (the model is usable).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+    /// Body names, in order.
+    #[getter]
+    fn bodies(&self) -> Vec<String> {
+        with_joint!(self, j => j.model().bodies().iter().map(|b| b.name.clone()).collect())
+    }
+    /// Contact pair names.
+    #[getter]
+    fn pairs(&self) -> Vec<String> {
+        with_joint!(self, j => j.pairs().iter().map(|p| p.name.clone()).collect())
+    }
+    /// The analysis set by the scenario (`{"type": "static", "time": t}`,
+    /// `{"type": "quasistatic", "times": [...]}`, `{"type": "dynamic", "dt": dt, "steps": n}`)
+    /// or `None`.
+    #[getter]
+    fn analysis<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let a = with_joint!(self, j => j.analysis().cloned());
+        let Some(a) = a else { return Ok(None) };
+        let d = PyDict::new_bound(py);
+        d.set_item("type", a.kind())?;
+        match a {
+            Analysis::Static { time } => d.set_item("time", time)?,
+            Analysis::QuasiStatic { times } => d.set_item("times", times)?,
+            Analysis::Dynamic { dt, steps } => {
+                d.set_item("dt", dt)?;
+                d.set_item("steps", steps)?;
+            }
+        }
+        Ok(Some(d))
+    }
+    /// The contact solver's name.
+    #[getter]
+    fn solver_name(&self) -> String {
+        with_joint!(self, j => j.solver_name().to_string())
+    }
+    /// Boundary part names of a body.
+    fn parts(&self, body: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+        with_joint!(self, j => {
+            let id = body_id(j, body)?;
+            let b = j.model().body(id).map_err(err)?;
+            Ok(b.mesh.boundary_parts().iter().map(|p| p.name().to_string()).collect())
+        })
+    }
+    /// Node coordinates of a body, shape `(n_nodes, D)`.
+    fn nodes<'py>(
+        &self,
+        py: Python<'py>,
+        body: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+        use numpy::PyArrayMethods;
+        let (v, d) = with_joint!(self, j => {
+            let id = body_id(j, body)?;
+            let b = j.model().body(id).map_err(err)?;
+            (b.mesh.nodes().iter().flat_map(|p| p.iter().copied().collect::<Vec<_>>()).collect::<Vec<f64>>(), self.dimension())
+        });
+        let n = v.len() / d;
+        numpy::PyArray1::from_vec_bound(py, v).reshape([n, d])
+    }
+    /// Cells of a body, shape `(n_cells, D + 1)`.
+    fn cells<'py>(
+        &self,
+        py: Python<'py>,
+        body: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<u64>>> {
+        use numpy::PyArrayMethods;
+        let (v, d) = with_joint!(self, j => {
+            let id = body_id(j, body)?;
+            let b = j.model().body(id).map_err(err)?;
+            (b.mesh.cells().flat_map(|c| c.iter().map(|&i| i as u64).collect::<Vec<_>>()).collect::<Vec<u64>>(), self.dimension())
+        });
+        let n = v.len() / (d + 1);
+        numpy::PyArray1::from_vec_bound(py, v).reshape([n, d + 1])
+    }
+
+    /// Adds a body: `nodes` `(n, D)` coordinates, `cells` `(m, D + 1)` node indices (P1
+    /// triangles / tetrahedra, any orientation), its `material`, and boundary `parts`
+    /// `{name: (k, D) facet node indices}` (edges in 2D, triangles in 3D; each must be a
+    /// boundary facet). Returns the body's index.
+    #[pyo3(signature = (name, nodes, cells, material, parts = None))]
+    fn add_body(
+        &mut self,
+        name: &str,
+        nodes: &Bound<'_, PyAny>,
+        cells: &Bound<'_, PyAny>,
+        material: PyRef<'_, PyMaterial>,
+        parts: Option<&Bound<'_, PyDict>>,
+    ) -> PyResult<usize> {
+        with_joint_mut!(self, j => add_body(j, name, nodes, cells, &material, parts))
+    }
+    /// Adds a body from a `meshio.Mesh`: its triangles (2D) or tetrahedra (3D) with the
+    /// points they use; boundary parts from its line (2D) / triangle (3D) cells, named by
+    /// `cell_sets` or by the `gmsh:physical` tags with the names of `field_data` (else
+    /// `tag_<n>`). Returns the body's index.
+    fn add_meshio(
+        &mut self,
+        py: Python<'_>,
+        name: &str,
+        mesh: &Bound<'_, PyAny>,
+        material: PyRef<'_, PyMaterial>,
+    ) -> PyResult<usize> {
+        let helper = py.import_bound("synovia._meshio")?;
+        let arrays = helper.call_method1("arrays_from_meshio", (mesh, self.dimension()))?;
+        let (nodes, cells, parts): (Bound<'_, PyAny>, Bound<'_, PyAny>, Bound<'_, PyDict>) =
+            arrays.extract()?;
+        with_joint_mut!(self, j => add_body(j, name, &nodes, &cells, &material, Some(&parts)))
+    }
+    /// Adds a boundary part from facets (`(k, D)` node indices of boundary facets).
+    fn add_part(&mut self, body: &Bound<'_, PyAny>, name: &str, facets: &Bound<'_, PyAny>) -> PyResult<()> {
+        with_joint_mut!(self, j => add_part(j, body, name, facets))
+    }
+    /// Adds a boundary part: the boundary facets whose centroid `x` and outward unit normal
+    /// `n` (NumPy arrays) satisfy `select(x, n)`.
+    fn add_part_where(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        name: &str,
+        select: &Bound<'_, PyAny>,
+    ) -> PyResult<()> {
+        with_joint_mut!(self, j => add_part_where(j, body, name, select))
+    }
+
+    /// Clamps a part (`u = 0`).
+    fn clamp(&mut self, body: &Bound<'_, PyAny>, part: &str) -> PyResult<()> {
+        with_joint_mut!(self, j => { let id = body_id(j, body)?; j.clamp(id, part).map_err(err)?; Ok(()) })
+    }
+    /// Makes a part a symmetry plane / sliding support (`u · n = 0`).
+    fn symmetry(&mut self, body: &Bound<'_, PyAny>, part: &str) -> PyResult<()> {
+        with_joint_mut!(self, j => { let id = body_id(j, body)?; j.symmetry(id, part).map_err(err)?; Ok(()) })
+    }
+    /// Prescribes the displacement `u(x, t) = h(t) value` on a part; `components` (indices)
+    /// restricts it to some components, the others stay free.
+    #[pyo3(signature = (body, part, value, history = None, components = None))]
+    fn prescribe(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        value: &Bound<'_, PyAny>,
+        history: Option<&Bound<'_, PyAny>>,
+        components: Option<Vec<usize>>,
+    ) -> PyResult<()> {
+        let value = floats(value, "value")?;
+        let h = self::history(history)?;
+        let d = self.dimension();
+        let m = mask(components, d)?;
+        with_joint_mut!(self, j => {
+            let id = body_id(j, body)?;
+            j.prescribe_field(id, part, m, scaled(h, vector(&value, "value")?)).map_err(err)?;
+            Ok(())
+        })
+    }
+    /// Prescribes any displacement field `u = field(x, t)` (a callable returning `D` floats)
+    /// on a part.
+    #[pyo3(signature = (body, part, field, components = None))]
+    fn prescribe_field(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        field: &Bound<'_, PyAny>,
+        components: Option<Vec<usize>>,
+    ) -> PyResult<()> {
+        if !field.is_callable() {
+            return Err(msg("field must be a callable f(x, t) returning the displacement"));
+        }
+        let m = mask(components, self.dimension())?;
+        let f = field.clone().unbind();
+        with_joint_mut!(self, j => {
+            let id = body_id(j, body)?;
+            j.prescribe_field(id, part, m, py_field(f)).map_err(err)?;
+            Ok(())
+        })
+    }
+    /// Prescribes the traction `τ n = h(t) value` on a part.
+    #[pyo3(signature = (body, part, value, history = None))]
+    fn traction(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        value: &Bound<'_, PyAny>,
+        history: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let value = floats(value, "value")?;
+        let h = self::history(history)?;
+        with_joint_mut!(self, j => {
+            let id = body_id(j, body)?;
+            j.traction(id, part, vector(&value, "value")?, h).map_err(err)?;
+            Ok(())
+        })
+    }
+    /// Prescribes a normal pressure `p(t) = h(t) value` on a part (`p > 0` pushes into the
+    /// body).
+    #[pyo3(signature = (body, part, value, history = None))]
+    fn pressure(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        value: f64,
+        history: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let h = self::history(history)?;
+        with_joint_mut!(self, j => {
+            let id = body_id(j, body)?;
+            j.pressure(id, part, value, h).map_err(err)?;
+            Ok(())
+        })
+    }
+    /// Sets the body force `F(x, t) = h(t) value` per unit volume of a body.
+    #[pyo3(signature = (body, value, history = None))]
+    fn body_force(
+        &mut self,
+        body: &Bound<'_, PyAny>,
+        value: &Bound<'_, PyAny>,
+        history: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let value = floats(value, "value")?;
+        let h = self::history(history)?;
+        with_joint_mut!(self, j => {
+            let id = body_id(j, body)?;
+            j.body_force(id, vector(&value, "value")?, h).map_err(err)?;
+            Ok(())
+        })
+    }
+    /// Bonds `part_a` of `body_a` to `part_b` of `body_b` (nodes at equal positions share
+    /// their displacement).
+    fn tie(
+        &mut self,
+        body_a: &Bound<'_, PyAny>,
+        part_a: &str,
+        body_b: &Bound<'_, PyAny>,
+        part_b: &str,
+    ) -> PyResult<()> {
+        with_joint_mut!(self, j => {
+            let a = body_id(j, body_a)?;
+            let b = body_id(j, body_b)?;
+            j.tie(a, part_a, b, part_b).map_err(err)?;
+            Ok(())
+        })
+    }
+    /// Sets the density of a body (dynamic runs).
+    fn set_density(&mut self, body: &Bound<'_, PyAny>, density: f64) -> PyResult<()> {
+        with_joint_mut!(self, j => { let id = body_id(j, body)?; j.set_density(id, density).map_err(err)?; Ok(()) })
+    }
+    /// Sets a uniform initial velocity of a body (dynamic runs).
+    fn initial_velocity(&mut self, body: &Bound<'_, PyAny>, velocity: &Bound<'_, PyAny>) -> PyResult<()> {
+        let v = floats(velocity, "velocity")?;
+        with_joint_mut!(self, j => { let id = body_id(j, body)?; j.initial_velocity(id, vector(&v, "velocity")?).map_err(err)?; Ok(()) })
+    }
+
+    /// Adds a body–body contact pair between `part_k` of `body_k` and `part_l` of `body_l`
+    /// with Coulomb coefficient `friction`. `discretisation`: `"node-to-node"` (matching
+    /// nodes), `"node-to-segment"` (node-to-facet in 3D; non-matching meshes) or `"mortar"`
+    /// (dual mortar). `search_distance` bounds the contact search (non-matching pairs).
+    #[pyo3(signature = (name, body_k, part_k, body_l, part_l, friction = 0.0, discretisation = "node-to-node", search_distance = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn contact(
+        &mut self,
+        name: &str,
+        body_k: &Bound<'_, PyAny>,
+        part_k: &str,
+        body_l: &Bound<'_, PyAny>,
+        part_l: &str,
+        friction: f64,
+        discretisation: &str,
+        search_distance: Option<f64>,
+    ) -> PyResult<()> {
+        with_joint_mut!(self, j => contact_pair(j, name, body_k, part_k, body_l, part_l, friction, discretisation, search_distance))
+    }
+    /// Adds a contact pair between a part and the rigid half-space bounded by the plane
+    /// through `point` with outward `normal` (the side the body is on).
+    #[pyo3(signature = (name, body, part, point, normal, friction = 0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn contact_plane(
+        &mut self,
+        name: &str,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        point: &Bound<'_, PyAny>,
+        normal: &Bound<'_, PyAny>,
+        friction: f64,
+    ) -> PyResult<()> {
+        let (p, n) = (floats(point, "point")?, floats(normal, "normal")?);
+        with_joint_mut!(self, j => {
+            let o = PlaneObstacle::new(self::point(&p, "point")?, vector(&n, "normal")?).map_err(err)?;
+            contact_obstacle(j, name, body, part, Arc::new(o), friction)
+        })
+    }
+    /// Adds a contact pair between a part and a rigid ball (`cavity=False`, the body is
+    /// outside) or spherical cavity (`cavity=True`, the body is inside) of `radius` about
+    /// `center` (a disc / circular hole in 2D).
+    #[pyo3(signature = (name, body, part, center, radius, cavity = false, friction = 0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn contact_sphere(
+        &mut self,
+        name: &str,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        center: &Bound<'_, PyAny>,
+        radius: f64,
+        cavity: bool,
+        friction: f64,
+    ) -> PyResult<()> {
+        let c = floats(center, "center")?;
+        with_joint_mut!(self, j => {
+            let o = SphereObstacle::new(self::point(&c, "center")?, radius, cavity).map_err(err)?;
+            contact_obstacle(j, name, body, part, Arc::new(o), friction)
+        })
+    }
+    /// Adds a contact pair between a part and a rigid cylinder (3D only) through `point` with
+    /// `axis` and `radius` (`cavity=True`: the body is inside).
+    #[pyo3(signature = (name, body, part, point, axis, radius, cavity = false, friction = 0.0))]
+    #[allow(clippy::too_many_arguments)]
+    fn contact_cylinder(
+        &mut self,
+        name: &str,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        point: &Bound<'_, PyAny>,
+        axis: &Bound<'_, PyAny>,
+        radius: f64,
+        cavity: bool,
+        friction: f64,
+    ) -> PyResult<()> {
+        let (p, a) = (floats(point, "point")?, floats(axis, "axis")?);
+        let Joint::D3(arc) = &mut self.joint else {
+            return Err(msg("cylinder obstacles are 3D only (use contact_sphere for a disc in 2D)"));
+        };
+        let j = get_mut(arc)?;
+        let o =
+            CylinderObstacle::new(self::point::<3>(&p, "point")?, vector::<3>(&a, "axis")?, radius, cavity)
+                .map_err(err)?;
+        contact_obstacle(j, name, body, part, Arc::new(o), friction)
+    }
+    /// Chooses the contact solver by name: `"pdas-fallback"` (default), `"pdas"`,
+    /// `"au-pdas"`, `"uzawa-mprgp"` or `"dual-mprgp"`.
+    fn solver(&mut self, name: &str) -> PyResult<()> {
+        with_joint_mut!(self, j => { j.solver(name).map_err(err)?; Ok(()) })
+    }
+    /// Nested iteration for cold-started contact solves (`None` turns it off; default 32).
+    #[pyo3(signature = (min_rows))]
+    fn nested_iteration(&mut self, min_rows: Option<usize>) -> PyResult<()> {
+        with_joint_mut!(self, j => { j.nested_iteration(min_rows); Ok(()) })
+    }
+
+    /// Solves the static problem at time `t` (GIL released).
+    #[pyo3(signature = (t = 0.0))]
+    fn run_static(&self, py: Python<'_>, t: f64) -> PyResult<PyRunResult> {
+        self.run_kind(py, RunKind::Static(t), false)
+    }
+    /// Runs the quasi-static scheme over `times` (strictly increasing; GIL released).
+    /// `keep_steps=True` keeps the displacement of every step.
+    #[pyo3(signature = (times, keep_steps = false))]
+    fn run_quasistatic(&self, py: Python<'_>, times: Vec<f64>, keep_steps: bool) -> PyResult<PyRunResult> {
+        self.run_kind(py, RunKind::QuasiStatic(times), keep_steps)
+    }
+    /// Runs the dynamic scheme: `steps` steps of `dt` (record 0 is the initial state; needs
+    /// densities). GIL released.
+    #[pyo3(signature = (dt, steps, keep_steps = false))]
+    fn run_dynamic(&self, py: Python<'_>, dt: f64, steps: usize, keep_steps: bool) -> PyResult<PyRunResult> {
+        self.run_kind(py, RunKind::Dynamic(dt, steps), keep_steps)
+    }
+    /// Runs the analysis of the scenario file the model came from (GIL released).
+    #[pyo3(signature = (keep_steps = false))]
+    fn run(&self, py: Python<'_>, keep_steps: bool) -> PyResult<PyRunResult> {
+        self.run_kind(py, RunKind::Analysis, keep_steps)
+    }
+    /// Validates, assembles and factorises the model once and returns a `Session` that
+    /// solves it again and again with new loads (`Parameter` values, callables reading Python
+    /// state, or the time) without refactorising. The model cannot be changed while the
+    /// session is open.
+    fn prepare(&self, py: Python<'_>) -> PyResult<PySession> {
+        PySession::open(py, self.joint.clone())
+    }
+    fn __repr__(&self) -> String {
+        format!("Model(dimension={}, bodies={:?}, pairs={:?})", self.dimension(), self.bodies(), self.pairs())
+    }
+}
+
+/// Runs a TOML scenario file (its analysis) and returns the `RunResult`; same as
+/// `Model.from_scenario(path).run()`.
+#[pyfunction]
+#[pyo3(signature = (path, keep_steps = false))]
+pub fn run_scenario(py: Python<'_>, path: std::path::PathBuf, keep_steps: bool) -> PyResult<PyRunResult> {
+    let m = PyModel::from_scenario(py, path)?;
+    m.run(py, keep_steps)
+}
