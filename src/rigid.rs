@@ -234,7 +234,9 @@ fn axis_rotation(axis: usize, angle: Real) -> Tensor<3> {
 /// ```
 ///
 /// with `q_i, q_k ∈ (−π, π]`, `q_j ∈ [−π/2, π/2]` (at `q_j = ±π/2` the split between `q_i` and
-/// `q_k` is one of many, the rotation the same).
+/// `q_k` is one of many, the rotation the same). Written here rather than taken from nalgebra:
+/// its `Rotation3::euler_angles_ordered` (0.34), tried in its place, gave angles that rebuild a
+/// rotation 1.43 away from the given one at gimbal lock (order `xyz`, middle angle π/2).
 pub fn euler_angles(rotation: &Tensor<3>, order: [usize; 3]) -> [Real; 3] {
     let [i, j, k] = order;
     let eps = if (j + 3 - i) % 3 == 1 { 1.0 } else { -1.0 };
