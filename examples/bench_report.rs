@@ -222,8 +222,8 @@ fn pose_resolve_case(scale: f64) -> Res<Value> {
     let times: Vec<Real> = (0..=poses).map(|i| i as Real / poses as Real).collect();
     // pass 1 (not timed): the superior–inferior translations that carry the ISO load
     let found = Tkr3d { friction: 0.0, ..Tkr3d::default() };
-    let joint = found.joint_model()?;
-    let mut session = joint.prepare()?;
+    let found_joint = found.joint_model()?;
+    let mut session = found_joint.prepare()?;
     let mut si = Vec::with_capacity(times.len());
     for &t in &times {
         session.solve_static(t)?;
@@ -264,8 +264,7 @@ fn pose_resolve_case(scale: f64) -> Res<Value> {
             out["candidate_nodes"] = json!(session.geometry().len());
         }
     }
-    let joint = found.joint_model()?;
-    let (elastic_s, elastic_runs) = elastic_time(joint.model())?;
+    let (elastic_s, elastic_runs) = elastic_time(found_joint.model())?;
     out["elastic_s"] = json!(elastic_s);
     out["elastic_runs"] = json!(elastic_runs);
     out["poses"] = json!(times.len() - 1);

@@ -661,21 +661,7 @@ fn decode_base64(text: &str, header: Header) -> Result<Vec<u8>, String> {
             }
         }
     };
-    let announced = match (hb, head.get(..hb)) {
-        (8, Some(h)) => {
-            let a: [u8; 8] = h.try_into().map_err(|_| "bad header")?;
-            if header.big_endian {
-                u64::from_be_bytes(a)
-            } else {
-                u64::from_le_bytes(a)
-            }
-        }
-        (4, Some(h)) => {
-            let a: [u8; 4] = h.try_into().map_err(|_| "bad header")?;
-            u64::from(if header.big_endian { u32::from_be_bytes(a) } else { u32::from_le_bytes(a) })
-        }
-        _ => return Err("bad binary header".into()),
-    };
+    let announced = header_uint(head.get(..hb).ok_or("bad binary header")?, header)?;
     let announced = usize::try_from(announced).map_err(|_| "header too large")?;
     if body.len() < announced {
         return Err(format!(
