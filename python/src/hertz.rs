@@ -38,6 +38,25 @@ pub fn run_dict<'py>(py: Python<'py>, r: &ContactRun) -> PyResult<Bound<'py, PyD
     Ok(d)
 }
 
+/// Runs `problem` with the solver called `solver` (checked before, so a bad name is an error
+/// without a solve) with the GIL released, and returns its [`run_dict`].
+fn solve_to_dict<'py>(
+    py: Python<'py>,
+    solver: &str,
+    problem: impl FnOnce(
+            &dyn synovia::contact_ops::ContactSolver,
+        ) -> Result<ContactRun, synovia::contact_ops::ContactError>
+        + Send,
+) -> PyResult<Bound<'py, PyDict>> {
+    let name = solver.to_string();
+    synovia::solvers::by_name(&name).map_err(err)?;
+    let r = py.allow_threads(move || {
+        let s = synovia::solvers::by_name(&name)?;
+        problem(s.as_ref())
+    });
+    run_dict(py, &solved(r)?)
+}
+
 /// 2D Hertz (plane strain): a half-disc of radius `radius` (`E = e1`, `ν = nu1`) pushed by
 /// `push` at its flat top onto a rigid flat (`e2=None`) or a mirrored half-disc (`E = e2`,
 /// `ν = nu2`), refined `levels` times toward the contact point, solved by `solver`. Returns the
@@ -60,13 +79,7 @@ pub fn hertz2d<'py>(
     nested: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = Hertz2d { radius, e1, nu1, e2, nu2, push, n, levels, refine_radius, nested };
-    let name = solver.to_string();
-    synovia::solvers::by_name(&name).map_err(err)?;
-    let r = py.allow_threads(move || {
-        let s = synovia::solvers::by_name(&name)?;
-        synovia_models::hertz::hertz2d(&p, s.as_ref())
-    });
-    run_dict(py, &solved(r)?)
+    solve_to_dict(py, solver, move |s| synovia_models::hertz::hertz2d(&p, s))
 }
 
 /// 3D Hertz: a hemisphere of radius `radius` (`E = e`, `ν = nu`) pushed by `push` onto a
@@ -88,11 +101,5 @@ pub fn hertz3d<'py>(
     nested: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = Hertz3d { radius, e, nu, push, n, levels, refine_radius, nested };
-    let name = solver.to_string();
-    synovia::solvers::by_name(&name).map_err(err)?;
-    let r = py.allow_threads(move || {
-        let s = synovia::solvers::by_name(&name)?;
-        synovia_models::hertz::hertz3d(&p, s.as_ref())
-    });
-    run_dict(py, &solved(r)?)
+    solve_to_dict(py, solver, move |s| synovia_models::hertz::hertz3d(&p, s))
 }
