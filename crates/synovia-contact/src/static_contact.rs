@@ -170,6 +170,30 @@ impl<const D: usize> StaticContact<D> {
         })
     }
 
+    /// A new numeric factorisation of a caller-assembled matrix on the same pattern and interface
+    /// ordering ([`ElasticSolver::refactorise`]; the symbolic analysis and the contact geometry
+    /// are kept, the kept Schur columns and load solves are dropped): e.g. the tangent stiffness
+    /// `K_T(u_k)` of each Newton iteration of a nonlinear solve (`synovia-nonlinear`), whose
+    /// linearised contact problem is then solved by [`StaticContact::solve_load`].
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] unless built by [`StaticContact::with_system_matrix`];
+    /// the errors of `assemble` and of the factorisation.
+    pub fn refactorise(
+        &mut self,
+        assemble: impl FnOnce(&DofMap<D>, &mut SymmetricMatrix) -> Result<(), FemError>,
+    ) -> Result<(), ContactError> {
+        if !self.caller_matrix {
+            return Err(ContactError::InvalidParameter(
+                "refactorise needs a StaticContact built on a caller-assembled matrix (with_system_matrix)"
+                    .into(),
+            ));
+        }
+        self.context.clear();
+        self.elastic.refactorise(assemble)?;
+        Ok(())
+    }
+
     /// Solves the contact problem of docs/model.md §5 with the caller's reduced right-hand side
     /// `load` (`F̄`, one entry per reduced dof) and lifts of prescribed displacements `lifts`
     /// (one per dof group, [`DofMap::lifts`]; they enter the gaps and the slip shifts) on the

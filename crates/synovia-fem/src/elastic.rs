@@ -121,7 +121,9 @@ pub struct ElasticSolver<const D: usize> {
     dofs: DofMap<D>,
     stiffness: SymmetricMatrix,
     cholesky: CholeskySolver,
-    body_c: Vec<DMatrix<Real>>,
+    /// The constant stiffness of every body; `None` for a caller-assembled matrix of a model
+    /// with nonlinear materials.
+    body_c: Option<Vec<DMatrix<Real>>>,
     params: ElasticParams,
     info: ElasticInfo,
     stabilisation: Option<Stabilisation>,
@@ -266,13 +268,19 @@ impl<const D: usize> ElasticSolver<D> {
         let (mut stiffness, metis) = pattern(model, &dofs)?;
         let setup_s = t0.elapsed().as_secs_f64();
         let t1 = Instant::now();
-        let body_c = body_stiffnesses(model)?;
-        match system {
-            Some(assemble) => assemble(&dofs, &mut stiffness)?,
-            None => assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| {
-                stiffness_into(geo, &body_c[b], out)
-            })?,
-        }
+        let body_c = match system {
+            Some(assemble) => {
+                assemble(&dofs, &mut stiffness)?;
+                body_stiffnesses(model).ok()
+            }
+            None => {
+                let body_c = body_stiffnesses(model)?;
+                assemble_matrix(model, &dofs, &mut stiffness, |b, _, geo, out| {
+                    stiffness_into(geo, &body_c[b], out)
+                })?;
+                Some(body_c)
+            }
+        };
         let assembly_s = t1.elapsed().as_secs_f64();
         let mut ordering = match (params.ordering, D) {
             (OrderingChoice::Amd, _) | (OrderingChoice::Auto, 2) => Ordering::Amd,
@@ -317,12 +325,43 @@ impl<const D: usize> ElasticSolver<D> {
         Ok(Self { dofs, stiffness, cholesky, body_c, params, info, stabilisation })
     }
 
+    /// A new numeric factorisation on the same pattern and ordering (the symbolic analysis is
+    /// kept): `assemble` receives the dof map and the zeroed matrix and fills it with the new
+    /// symmetric positive definite `A` (e.g. the tangent stiffness `K_T(u)` of a Newton
+    /// iteration, [`crate::nonlinear::assemble_tangent`]). [`ElasticSolver::stiffness`] and
+    /// [`ElasticSolver::system_matrix`] return the new `A` afterwards.
+    ///
+    /// # Errors
+    /// [`FemError::InvalidParameter`] for a semi-coercive solver (its stabilisation belongs to
+    /// the original stiffness); the errors of `assemble` and of the factorisation (a matrix that
+    /// is not positive definite). After an error the solver must not be used for solves.
+    pub fn refactorise(
+        &mut self,
+        assemble: impl FnOnce(&DofMap<D>, &mut SymmetricMatrix) -> Result<(), FemError>,
+    ) -> Result<(), FemError> {
+        if self.stabilisation.is_some() {
+            return Err(FemError::InvalidParameter(
+                "a semi-coercive (stabilised) factorisation cannot be refactorised with a new matrix".into(),
+            ));
+        }
+        let t0 = Instant::now();
+        self.stiffness.zero();
+        assemble(&self.dofs, &mut self.stiffness)?;
+        self.info.assembly_s = t0.elapsed().as_secs_f64();
+        self.cholesky.factorize(&self.stiffness)?;
+        self.info.numeric_s = self.cholesky.info().numeric_s;
+        Ok(())
+    }
+
     /// The reduced right-hand side `F̃(t) = Pᵀ (F(t) − K u_p(t))`.
     pub fn rhs(&self, model: &Model<D>, t: Real) -> Result<(Vec<Real>, Vec<Vector<D>>), FemError> {
         let lifts = self.dofs.lifts(model, t)?;
         let mut rhs = vec![0.0; self.dofs.n_dofs()];
         add_loads(model, &self.dofs, t, self.params.load_degree, &mut rhs)?;
-        let c = &self.body_c;
+        let c = match &self.body_c {
+            Some(c) => c,
+            None => &body_stiffnesses(model)?,
+        };
         subtract_lift(model, &self.dofs, &lifts, &mut rhs, |b, _, geo, out| stiffness_into(geo, &c[b], out))?;
         Ok((rhs, lifts))
     }

@@ -93,6 +93,17 @@ pub enum FemError {
         /// Material name.
         material: String,
     },
+    /// A cell could not be evaluated by a nonlinear solve: `det F ≤ 0` (an inverted element) or
+    /// a non-finite stress from its material.
+    #[error("body `{body}`, cell {cell}: the element is inverted or its material gave no finite stress (det F = {det_f:e}); reduce the load step")]
+    InvertedElement {
+        /// Body name.
+        body: String,
+        /// Cell index.
+        cell: usize,
+        /// `det F` of the cell (1 for small strain).
+        det_f: f64,
+    },
     /// The material stiffness has the wrong size for the dimension.
     #[error("body `{body}`: material stiffness is {got}×{got}, expected {expected}×{expected}")]
     MaterialSize {

@@ -21,6 +21,7 @@ pub mod elastic;
 pub mod element;
 pub mod error;
 pub mod model;
+pub mod nonlinear;
 pub mod post;
 pub mod quadrature;
 
@@ -30,6 +31,7 @@ pub use elastic::{
     OrderingChoice, Reorder, Stabilisation,
 };
 pub use error::FemError;
+pub use nonlinear::Kinematics;
 pub use model::{Body, BodyId, ComponentMask, Model, TractionField, VectorField};
 pub use post::BodyFields;
 pub use quadrature::QuadratureRule;

@@ -59,12 +59,18 @@
 //!   [`LinearElastic::rotated`];
 //! * admissibility check of a Voigt matrix: [`check_admissible`].
 //!
+//! Hyperelastic laws (docs/model.md §2.3) are [`Hyperelastic`] materials of an energy
+//! `W(I₁, I₂, J)` ([`InvariantEnergy`]): [`neo_hookean`], [`mooney_rivlin`], or a user's own
+//! energy. With `synovia_fem::nonlinear` they run in small-strain or total Lagrangian
+//! finite-strain kinematics.
+//!
 //! Users may implement [`Material`] for their own (nonlinear) laws; the trait is object safe and
 //! [`KelvinVoigt`] stores `Arc<dyn Material<D>>`.
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
 mod error;
+mod hyperelastic;
 mod isotropic;
 mod kelvin_voigt;
 mod linear;
@@ -72,6 +78,9 @@ mod transverse;
 mod voigt;
 
 pub use error::MaterialError;
+pub use hyperelastic::{
+    mooney_rivlin, neo_hookean, Hyperelastic, InvariantEnergy, Invariants, MooneyRivlin, NeoHookean,
+};
 pub use isotropic::{
     from_lame, isotropic, lame_parameters, plane_strain, plane_strain_from_lame, plane_stress,
     IsotropicParameters,

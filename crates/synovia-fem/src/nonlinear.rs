@@ -1,0 +1,463 @@
+//! Nonlinear elasticity on P1 simplices (docs/model.md §2.3): the internal force `F_int(u)` and
+//! the tangent stiffness `K_T(u) = ∂F_int/∂u` of bodies with any [`Material`] (linear or not),
+//! in small-strain or total Lagrangian finite-strain kinematics.
+//!
+//! ## Small strain (`Kinematics::SmallStrain`)
+//!
+//! With `ε = B u` (the strain–displacement matrix of [`crate::element`]), `τ = τ(ε)` the
+//! material's stress and `C_T = ∂τ/∂ε` its tangent:
+//!
+//! ```text
+//! F_int,T = |T| Bᵀ τ(B u_T),     K_T = |T| Bᵀ C_T(B u_T) B.
+//! ```
+//!
+//! ## Finite strain, total Lagrangian (`Kinematics::FiniteStrain`)
+//!
+//! On the reference cell, `F = I + ∇u` (constant on a P1 cell), the Green–Lagrange strain
+//! `E = ½(FᵀF − I)`, the second Piola–Kirchhoff stress `S = τ(E)` and `𝕔 = ∂S/∂E` (the same
+//! [`Material`] evaluated at `E`). The variation of `E` for the nodal displacement `δu_{a,i}` is
+//! `δE_JK = ½(F_iJ ∂_K φ_a + F_iK ∂_J φ_a)`, i.e. the rows of the nonlinear strain–displacement
+//! matrix `B_NL(F)`, and
+//!
+//! ```text
+//! F_int,T = |T| B_NLᵀ S,
+//! K_T = |T| (B_NLᵀ 𝕔 B_NL + G),   G_(a,i),(b,k) = δ_ik ∇φ_aᵀ S ∇φ_b   (geometric stiffness),
+//! ```
+//!
+//! the first variation of `Π_int = Σ_T |T| W(E)` and its Hessian. In 2D the kinematics are
+//! plane strain. Loads (body forces, tractions) are dead loads on the reference configuration.
+//! The Cauchy stress is `σ = J⁻¹ F S Fᵀ` ([`cauchy_stress`]).
+//!
+//! An element whose `det F ≤ 0` or whose material returns a non-finite stress is reported as
+//! [`FemError::InvertedElement`]; the nonlinear solvers treat it as a failed step and cut it back.
+
+use nalgebra::DMatrix;
+use synovia_linalg::SymmetricMatrix;
+use synovia_material::{Material, VoigtVector};
+use synovia_mesh::math::{det, Real, Tensor, Vector};
+
+use crate::assembly::assemble_matrix;
+use crate::dofs::DofMap;
+use crate::element::{voigt_strain, SimplexGeometry};
+use crate::error::FemError;
+use crate::model::{BodyId, Model};
+
+/// The kinematics of a body's strain measure.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Kinematics {
+    /// `ε = ½(∇u + ∇uᵀ)`, equilibrium on the reference configuration (the model's default).
+    #[default]
+    SmallStrain,
+    /// Total Lagrangian: `E = ½(FᵀF − I)`, `F = I + ∇u`, second Piola–Kirchhoff stress.
+    FiniteStrain,
+}
+
+impl Kinematics {
+    /// `"small"` or `"finite"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Kinematics::SmallStrain => "small",
+            Kinematics::FiniteStrain => "finite",
+        }
+    }
+}
+
+/// The strain measure of the displacement gradient `∇u`: `ε(u)` (small strain) or the
+/// Green–Lagrange strain `E = ½(∇u + ∇uᵀ + ∇uᵀ∇u)` (finite strain), Voigt with engineering shear.
+pub fn strain_measure<const D: usize>(kinematics: Kinematics, grad_u: &Tensor<D>) -> Vec<Real> {
+    match kinematics {
+        Kinematics::SmallStrain => voigt_strain(grad_u),
+        Kinematics::FiniteStrain => {
+            let f = Tensor::<D>::identity() + grad_u;
+            let e = (f.transpose() * f - Tensor::<D>::identity()) * 0.5;
+            if D == 2 {
+                vec![e[(0, 0)], e[(1, 1)], 2.0 * e[(0, 1)]]
+            } else {
+                vec![e[(0, 0)], e[(1, 1)], e[(2, 2)], 2.0 * e[(1, 2)], 2.0 * e[(0, 2)], 2.0 * e[(0, 1)]]
+            }
+        }
+    }
+}
+
+/// The Cauchy stress `σ = J⁻¹ F S Fᵀ` (Voigt, plain shear) of a second Piola–Kirchhoff stress
+/// `s` (Voigt) at the displacement gradient `∇u`; `None` if `det F ≤ 0`. In 2D (plane strain)
+/// the in-plane components.
+pub fn cauchy_stress<const D: usize>(grad_u: &Tensor<D>, s: &[Real]) -> Option<Vec<Real>> {
+    let f = Tensor::<D>::identity() + grad_u;
+    let j = det(&f);
+    if !(j > 0.0) {
+        return None;
+    }
+    let st = crate::element::stress_tensor::<D>(s);
+    let sigma = f * st * f.transpose() / j;
+    Some(if D == 2 {
+        vec![sigma[(0, 0)], sigma[(1, 1)], sigma[(0, 1)]]
+    } else {
+        vec![sigma[(0, 0)], sigma[(1, 1)], sigma[(2, 2)], sigma[(1, 2)], sigma[(0, 2)], sigma[(0, 1)]]
+    })
+}
+
+/// The Voigt rows `(J, K)` of dimension `D` (engineering shear order of [`voigt_strain`]).
+fn pairs<const D: usize>() -> &'static [(usize, usize)] {
+    const P2: [(usize, usize); 3] = [(0, 0), (1, 1), (0, 1)];
+    const P3: [(usize, usize); 6] = [(0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1)];
+    if D == 2 {
+        &P2
+    } else {
+        &P3
+    }
+}
+
+/// Why an element could not be evaluated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ElementFailure {
+    /// `det F` (finite strain; 1 for small strain).
+    pub det_f: Real,
+}
+
+/// The response of one cell at nodal displacements `u` (node-major, `D(D+1)` entries):
+/// writes the internal force `F_int,T` into `force`, the tangent `K_T` (row-major
+/// `D(D+1)` square) into `tangent` if given, and returns the strain energy `|T| Φ`.
+///
+/// # Errors
+/// [`ElementFailure`] if `det F ≤ 0` or the material's stress, tangent or energy is not finite.
+pub fn element_response<const D: usize>(
+    geo: &SimplexGeometry<D>,
+    material: &dyn Material<D>,
+    kinematics: Kinematics,
+    u: &[Real],
+    force: &mut [Real],
+    tangent: Option<&mut [Real]>,
+) -> Result<Real, ElementFailure> {
+    let n = D * (D + 1);
+    let grad_u = geo.displacement_gradient(u);
+    let f = Tensor::<D>::identity() + grad_u;
+    let det_f = match kinematics {
+        Kinematics::SmallStrain => 1.0,
+        Kinematics::FiniteStrain => det(&f),
+    };
+    if !(det_f > 0.0) {
+        return Err(ElementFailure { det_f });
+    }
+    let strain = VoigtVector::from_vec(strain_measure::<D>(kinematics, &grad_u));
+    let stress = material.stress(&strain);
+    let energy = material.energy_density(&strain) * geo.measure;
+    if stress.iter().any(|v| !v.is_finite()) || !energy.is_finite() {
+        return Err(ElementFailure { det_f });
+    }
+    let pr = pairs::<D>();
+    let nv = pr.len();
+    // B (nv × n): rows of δe for each nodal dof (a, i)
+    let mut b = [[0.0; 12]; 6];
+    let grads: Vec<Vector<D>> = (0..=D).map(|a| geo.grad(a)).collect();
+    for (a, g) in grads.iter().enumerate() {
+        for i in 0..D {
+            for (r, &(jj, kk)) in pr.iter().enumerate() {
+                // small strain: F = I in the formula below
+                let (fij, fik) = match kinematics {
+                    Kinematics::SmallStrain => {
+                        (if i == jj { 1.0 } else { 0.0 }, if i == kk { 1.0 } else { 0.0 })
+                    }
+                    Kinematics::FiniteStrain => (f[(i, jj)], f[(i, kk)]),
+                };
+                b[r][D * a + i] = if jj == kk { fij * g[jj] } else { fij * g[kk] + fik * g[jj] };
+            }
+        }
+    }
+    for (q, fq) in force.iter_mut().enumerate().take(n) {
+        *fq = geo.measure * (0..nv).map(|r| b[r][q] * stress[r]).sum::<Real>();
+    }
+    if let Some(kt) = tangent {
+        let c: DMatrix<Real> = material.tangent(&strain);
+        if c.iter().any(|v| !v.is_finite()) {
+            return Err(ElementFailure { det_f });
+        }
+        let mut cb = [[0.0; 12]; 6];
+        for r in 0..nv {
+            for q in 0..n {
+                cb[r][q] = (0..nv).map(|s| c[(r, s)] * b[s][q]).sum();
+            }
+        }
+        for p in 0..n {
+            for q in 0..n {
+                kt[p * n + q] = geo.measure * (0..nv).map(|r| b[r][p] * cb[r][q]).sum::<Real>();
+            }
+        }
+        if kinematics == Kinematics::FiniteStrain {
+            let s = crate::element::stress_tensor::<D>(stress.as_slice());
+            for a in 0..=D {
+                let sga = s * grads[a];
+                for bb in 0..=D {
+                    let g = geo.measure * grads[bb].dot(&sga);
+                    for i in 0..D {
+                        kt[(D * a + i) * n + D * bb + i] += g;
+                    }
+                }
+            }
+        }
+    }
+    Ok(energy)
+}
+
+/// Nodal displacements of cell `c` of body `b` (node-major).
+fn cell_displacement<const D: usize>(
+    model: &Model<D>,
+    b: usize,
+    c: usize,
+    displacement: &[Vec<Vector<D>>],
+    out: &mut [Real],
+) {
+    for (a, &node) in model.bodies()[b].mesh.cell(c).iter().enumerate() {
+        let u = displacement[b][node];
+        for i in 0..D {
+            out[D * a + i] = u[i];
+        }
+    }
+}
+
+fn check_kinematics<const D: usize>(
+    model: &Model<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+) -> Result<(), FemError> {
+    let nb = model.bodies().len();
+    if kinematics.len() != nb {
+        return Err(FemError::Length {
+            what: "kinematics (one per body)",
+            expected: nb,
+            got: kinematics.len(),
+        });
+    }
+    if displacement.len() != nb {
+        return Err(FemError::Length {
+            what: "displacement (one field per body)",
+            expected: nb,
+            got: displacement.len(),
+        });
+    }
+    for (b, body) in model.bodies().iter().enumerate() {
+        if displacement[b].len() != body.mesh.n_nodes() {
+            return Err(FemError::Length {
+                what: "nodal displacements of a body",
+                expected: body.mesh.n_nodes(),
+                got: displacement[b].len(),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn failure<const D: usize>(model: &Model<D>, b: usize, c: usize, e: ElementFailure) -> FemError {
+    FemError::InvertedElement { body: model.bodies()[b].name.clone(), cell: c, det_f: e.det_f }
+}
+
+/// The reduced internal force `Pᵀ F_int(u)` and the strain energy `Σ_T |T| Φ` at the nodal
+/// displacements `displacement[body][node]` (the full field, lift included), with one
+/// [`Kinematics`] per body.
+///
+/// # Errors
+/// [`FemError::Length`] for inconsistent sizes, [`FemError::InvertedElement`], degenerate cells.
+pub fn internal_force<const D: usize>(
+    model: &Model<D>,
+    dofs: &DofMap<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+) -> Result<(Vec<Real>, Real), FemError> {
+    check_kinematics(model, kinematics, displacement)?;
+    let n = D * (D + 1);
+    let mut out = vec![0.0; dofs.n_dofs()];
+    let mut energy = 0.0;
+    let mut ue = vec![0.0; n];
+    let mut fe = vec![0.0; n];
+    let groups = dofs.groups();
+    for (b, body) in model.bodies().iter().enumerate() {
+        for c in 0..body.mesh.n_cells() {
+            let pts = body.mesh.cell_points(c);
+            let geo =
+                SimplexGeometry::new(&pts).filter(|g| g.measure > 0.0).ok_or_else(|| FemError::Mesh {
+                    body: body.name.clone(),
+                    source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
+                })?;
+            cell_displacement(model, b, c, displacement, &mut ue);
+            energy += element_response(&geo, body.material.as_ref(), kinematics[b], &ue, &mut fe, None)
+                .map_err(|e| failure(model, b, c, e))?;
+            for (a, &node) in body.mesh.cell(c).iter().enumerate() {
+                let g = &groups[dofs.group_of(BodyId(b), node)];
+                let v = Vector::<D>::from_fn(|i, _| fe[D * a + i]);
+                for k in 0..g.n_dofs {
+                    out[g.first_dof + k] += g.basis[k].dot(&v);
+                }
+            }
+        }
+    }
+    Ok((out, energy))
+}
+
+/// Assembles the reduced tangent stiffness `Pᵀ K_T(u) P` at the nodal displacements
+/// `displacement` into `matrix` (on the model's pattern, [`crate::assembly::pattern`]; values
+/// first set to zero), with one [`Kinematics`] per body. With linear materials and small
+/// strain it is the stiffness `K̃` of the linear solve.
+///
+/// # Errors
+/// As [`internal_force`], and the errors of [`assemble_matrix`].
+pub fn assemble_tangent<const D: usize>(
+    model: &Model<D>,
+    dofs: &DofMap<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+    matrix: &mut SymmetricMatrix,
+) -> Result<(), FemError> {
+    check_kinematics(model, kinematics, displacement)?;
+    let first_failure = std::sync::Mutex::new(None::<(usize, usize, ElementFailure)>);
+    assemble_matrix(model, dofs, matrix, |b, c, geo, out| {
+        let n = D * (D + 1);
+        let mut ue = [0.0; 12];
+        let mut fe = [0.0; 12];
+        cell_displacement(model, b, c, displacement, &mut ue[..n]);
+        let material = model.bodies()[b].material.as_ref();
+        if let Err(e) = element_response(geo, material, kinematics[b], &ue[..n], &mut fe[..n], Some(out)) {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            if let Ok(mut f) = first_failure.lock() {
+                if f.as_ref().is_none_or(|x| (x.0, x.1) > (b, c)) {
+                    *f = Some((b, c, e));
+                }
+            }
+        }
+    })?;
+    let failed = first_failure.lock().ok().and_then(|f| *f);
+    if let Some((b, c, e)) = failed {
+        return Err(failure(model, b, c, e));
+    }
+    Ok(())
+}
+
+/// Per cell of every body: the strain measure `e` (small-strain `ε` or Green–Lagrange `E`),
+/// the stress (small strain: `τ`; finite strain: the Cauchy stress `σ = J⁻¹ F S Fᵀ`) and
+/// `det F`, all Voigt (strain with engineering shear, stress plain).
+///
+/// # Errors
+/// As [`internal_force`].
+#[allow(clippy::type_complexity)]
+pub fn cell_stresses<const D: usize>(
+    model: &Model<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+) -> Result<Vec<Vec<(Vec<Real>, Vec<Real>, Real)>>, FemError> {
+    check_kinematics(model, kinematics, displacement)?;
+    let n = D * (D + 1);
+    let mut ue = vec![0.0; n];
+    let mut out = Vec::with_capacity(model.bodies().len());
+    for (b, body) in model.bodies().iter().enumerate() {
+        let mut cells = Vec::with_capacity(body.mesh.n_cells());
+        for c in 0..body.mesh.n_cells() {
+            let pts = body.mesh.cell_points(c);
+            let geo = SimplexGeometry::new(&pts).ok_or_else(|| FemError::Mesh {
+                body: body.name.clone(),
+                source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
+            })?;
+            cell_displacement(model, b, c, displacement, &mut ue);
+            let grad_u = geo.displacement_gradient(&ue);
+            let e = strain_measure::<D>(kinematics[b], &grad_u);
+            let s = body.material.stress(&VoigtVector::from_vec(e.clone()));
+            let (stress, det_f) = match kinematics[b] {
+                Kinematics::SmallStrain => (s.iter().copied().collect::<Vec<_>>(), 1.0),
+                Kinematics::FiniteStrain => {
+                    let det_f = det(&(Tensor::<D>::identity() + grad_u));
+                    let sigma = cauchy_stress::<D>(&grad_u, s.as_slice())
+                        .ok_or(ElementFailure { det_f })
+                        .map_err(|e| failure(model, b, c, e))?;
+                    (sigma, det_f)
+                }
+            };
+            if stress.iter().any(|v| !v.is_finite()) {
+                return Err(failure(model, b, c, ElementFailure { det_f }));
+            }
+            cells.push((e, stress, det_f));
+        }
+        out.push(cells);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use synovia_material::neo_hookean;
+    use synovia_mesh::math::Point;
+
+    fn tet() -> SimplexGeometry<3> {
+        let p = [
+            Point::<3>::new(0.1, 0.0, 0.0),
+            Point::<3>::new(1.0, 0.2, 0.0),
+            Point::<3>::new(0.0, 1.1, 0.1),
+            Point::<3>::new(0.2, 0.1, 0.9),
+        ];
+        SimplexGeometry::new(&p).unwrap()
+    }
+
+    /// `F_int = ∂(|T|Φ)/∂u` and `K_T = ∂F_int/∂u` by central differences, both kinematics.
+    #[test]
+    fn force_and_tangent_are_derivatives_of_the_energy() {
+        let geo = tet();
+        let law = neo_hookean(10.0, 0.35).unwrap();
+        let u: Vec<Real> = (0..12).map(|k| 0.07 * ((k * 7 % 5) as Real - 2.0) + 0.01 * k as Real).collect();
+        for kin in [Kinematics::SmallStrain, Kinematics::FiniteStrain] {
+            let mut f = vec![0.0; 12];
+            let mut k = vec![0.0; 144];
+            element_response(&geo, &law, kin, &u, &mut f, Some(&mut k)).unwrap();
+            let h = 1e-6;
+            for q in 0..12 {
+                let (mut up, mut um) = (u.clone(), u.clone());
+                up[q] += h;
+                um[q] -= h;
+                let (mut fp, mut fm) = (vec![0.0; 12], vec![0.0; 12]);
+                let wp = element_response(&geo, &law, kin, &up, &mut fp, None).unwrap();
+                let wm = element_response(&geo, &law, kin, &um, &mut fm, None).unwrap();
+                let dw = (wp - wm) / (2.0 * h);
+                assert!((dw - f[q]).abs() < 1e-6 * (1.0 + f[q].abs()), "{kin:?}: dW/du{q} {dw} vs {}", f[q]);
+                for p in 0..12 {
+                    let df = (fp[p] - fm[p]) / (2.0 * h);
+                    assert!(
+                        (df - k[p * 12 + q]).abs() < 1e-5 * (1.0 + k[p * 12 + q].abs()),
+                        "{kin:?}: K[{p},{q}]"
+                    );
+                }
+            }
+            // symmetric
+            for p in 0..12 {
+                for q in 0..12 {
+                    assert!((k[p * 12 + q] - k[q * 12 + p]).abs() < 1e-9 * (1.0 + k[p * 12 + q].abs()));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rigid_rotation_is_stress_free_in_finite_strain() {
+        let geo = tet();
+        let law = neo_hookean(10.0, 0.3).unwrap();
+        let (s, c) = (0.6f64.sin(), 0.6f64.cos());
+        let rot = Tensor::<3>::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        let verts = [[0.1, 0.0, 0.0], [1.0, 0.2, 0.0], [0.0, 1.1, 0.1], [0.2, 0.1, 0.9]];
+        let mut u = vec![0.0; 12];
+        for (a, x) in verts.iter().enumerate() {
+            let x = Vector::<3>::new(x[0], x[1], x[2]);
+            let y = rot * x - x;
+            for i in 0..3 {
+                u[3 * a + i] = y[i];
+            }
+        }
+        let mut f = vec![0.0; 12];
+        let w = element_response(&geo, &law, Kinematics::FiniteStrain, &u, &mut f, None).unwrap();
+        assert!(w.abs() < 1e-12 && f.iter().all(|v| v.abs() < 1e-12), "{w} {f:?}");
+        // small strain sees a (spurious) strain for a finite rotation
+        let w_small = element_response(&geo, &law, Kinematics::SmallStrain, &u, &mut f, None).unwrap();
+        assert!(w_small > 1e-3);
+        // inverted
+        let mut u_inv = vec![0.0; 12];
+        for (a, x) in verts.iter().enumerate() {
+            u_inv[3 * a] = -2.0 * x[0];
+        }
+        assert!(element_response(&geo, &law, Kinematics::FiniteStrain, &u_inv, &mut f, None).is_err());
+    }
+}

@@ -1,0 +1,536 @@
+//! # synovia-nonlinear
+//!
+//! Nonlinear elasticity in contact (docs/model.md §2.3 and §8): bodies with any
+//! [`synovia_material::Material`] — nonlinear small-strain laws, or hyperelastic laws
+//! ([`synovia_material::neo_hookean`], [`synovia_material::mooney_rivlin`], a user's
+//! [`synovia_material::InvariantEnergy`]) in total Lagrangian finite strain — pressed into each
+//! other or into obstacles, with Tresca friction frozen per load level as in the linear model.
+//!
+//! ## The iteration (docs/model.md §8)
+//!
+//! At a load level `t` the unknowns `ũ` (reduced, `u = u_p(t) + P ũ`) solve
+//!
+//! ```text
+//! F_int(u) + B_hnᵀ κ Λ_n + B_Htᵀ Λ_t = F_ext(t),   Λ_n ≥ 0 ⟂ B_hn u ≤ d,   Tresca on Λ_t.
+//! ```
+//!
+//! Newton's method linearises the material around the iterate `ũ_k`:
+//! `F_int(u) ≈ F_int(u_k) + K_T(u_k)(ũ − ũ_k)`. Each iteration is then exactly the linear contact
+//! problem of docs/model.md §5 with the operator `A = K_T(u_k)` and the load
+//! `F̄ = F_ext − F_int(u_k) + K_T(u_k) ũ_k` — solved by any [`ContactSolver`] (PDAS, the
+//! semismooth Newton of the contact conditions, warm-started from the previous iteration's
+//! multipliers, so the two Newton methods run nested: the material's outside, the contact's
+//! inside). With small-strain contact the constraints are linear in `u`, so the iteration is
+//! Newton's method (sequential quadratic programming) on the whole nonsmooth system; with
+//! finite strain the contact geometry is rebuilt on the deformed configuration `x + u_k` at
+//! every iteration (re-pairing, normals, gaps in total form).
+//!
+//! **Convergence** is measured on the equilibrium residual
+//! `R = F_ext − F_int(u_{k+1}) − c_{k+1}` with the contact forces `c = F̄ − K_T ũ*` of the
+//! linearised solve, relative to the largest of `‖F_ext‖`, `‖F_int‖`, `‖c‖` and the residual at
+//! the start of the level; a full step whose relative increment `‖δũ‖/‖ũ‖` is below the
+//! tolerance also ends the iteration (a level that barely changed, residual at rounding).
+//! **Line search**: a backtracking (Armijo) search on `‖R‖` along `(δũ, δc)`; an iterate with an
+//! inverted element is a failed trial. **Load stepping with cut-back**: a level whose Newton
+//! iteration fails (no convergence, an inverted element, a failed contact solve) is bisected
+//! in time (histories evaluated at the intermediate times) up to
+//! [`NewtonParams::max_cutbacks`] times.
+//!
+//! The matrix changes every iteration, so each iteration refactorises `K_T` numerically
+//! ([`StaticContact::refactorise`]): the symbolic analysis and the interface ordering are done
+//! once.
+#![warn(missing_docs)]
+#![forbid(unsafe_code)]
+
+use std::time::Instant;
+
+use synovia_contact::operators::{ContactGeometry, ContactPair};
+use synovia_contact::{ContactError, ContactSolution, ContactSolver, StaticContact, StaticContactResult};
+use synovia_fem::assembly::add_loads;
+use synovia_fem::nonlinear::{assemble_tangent, internal_force};
+use synovia_fem::{DofMap, ElasticParams, FemError, Kinematics, Model};
+use synovia_mesh::math::{Real, Vector};
+
+/// Errors of the nonlinear solves.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum NonlinearError {
+    /// Model, dof or element error (including [`FemError::InvertedElement`] at a converged level).
+    #[error(transparent)]
+    Fem(#[from] FemError),
+    /// Contact set-up or solve error.
+    #[error(transparent)]
+    Contact(#[from] ContactError),
+    /// Newton's method did not reach the tolerance at a level even after cutting the step back.
+    #[error("no convergence at t = {time}: {reason} (after {cutbacks} cut-backs, last step {step:e}); reduce the load step or check the model")]
+    NoConvergence {
+        /// The level that failed.
+        time: Real,
+        /// Cut-backs tried.
+        cutbacks: usize,
+        /// The smallest step tried.
+        step: Real,
+        /// What failed last.
+        reason: String,
+    },
+    /// Invalid parameters or arguments.
+    #[error("invalid parameter: {0}")]
+    InvalidParameter(String),
+}
+
+/// Parameters of the Newton iteration and the load stepping.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct NewtonParams {
+    /// Relative equilibrium residual to reach (default `1e-10`).
+    pub tolerance: Real,
+    /// Newton iterations per level (default `30`).
+    pub max_iterations: usize,
+    /// Backtracking line search on `‖R‖` (default `true`).
+    pub line_search: bool,
+    /// Halvings of a level in time after a failure (default `8`).
+    pub max_cutbacks: usize,
+    /// Load degree of the quadrature of loads (default `2`).
+    pub load_degree: usize,
+}
+
+impl Default for NewtonParams {
+    fn default() -> Self {
+        Self { tolerance: 1e-10, max_iterations: 30, line_search: true, max_cutbacks: 8, load_degree: 2 }
+    }
+}
+
+impl NewtonParams {
+    /// Sets [`Self::tolerance`].
+    pub fn with_tolerance(mut self, tolerance: Real) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+    /// Sets [`Self::max_iterations`].
+    pub fn with_max_iterations(mut self, max_iterations: usize) -> Self {
+        self.max_iterations = max_iterations;
+        self
+    }
+    /// Sets [`Self::line_search`].
+    pub fn with_line_search(mut self, line_search: bool) -> Self {
+        self.line_search = line_search;
+        self
+    }
+    /// Sets [`Self::max_cutbacks`].
+    pub fn with_max_cutbacks(mut self, max_cutbacks: usize) -> Self {
+        self.max_cutbacks = max_cutbacks;
+        self
+    }
+
+    fn check(&self) -> Result<(), NonlinearError> {
+        if !(self.tolerance > 0.0 && self.tolerance < 1.0) || self.max_iterations == 0 {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "Newton tolerance must lie in (0, 1) and max_iterations be positive, got {} and {}",
+                self.tolerance, self.max_iterations
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// One Newton iteration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NewtonIteration {
+    /// Relative equilibrium residual after the iteration.
+    pub residual: Real,
+    /// `‖δũ‖ / max(‖ũ‖, tiny)` of the accepted step.
+    pub increment: Real,
+    /// Line-search step `α` accepted.
+    pub step: Real,
+    /// Iterations of the contact solver inside this Newton iteration.
+    pub contact_iterations: usize,
+    /// Active contact rows of the linearised solve.
+    pub active: usize,
+}
+
+/// What the Newton iteration of one level did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct NewtonReport {
+    /// Every Newton iteration of the last (successful) solve of the level.
+    pub iterations: Vec<NewtonIteration>,
+    /// Cut-backs (halvings) the level needed.
+    pub cutbacks: usize,
+    /// Sub-levels solved to reach the level (1 without cut-back).
+    pub sublevels: usize,
+    /// Newton iterations over all sub-levels and failed trials.
+    pub total_iterations: usize,
+    /// Numeric factorisations of `K_T`.
+    pub factorisations: usize,
+    /// Wall time (s).
+    pub time_s: f64,
+}
+
+impl NewtonReport {
+    /// The final relative residual.
+    pub fn residual(&self) -> Real {
+        self.iterations.last().map_or(0.0, |i| i.residual)
+    }
+}
+
+/// A converged level.
+#[derive(Debug, Clone)]
+pub struct NonlinearResult<const D: usize> {
+    /// Time of the level.
+    pub time: Real,
+    /// The linearised contact solve of the last Newton iteration: nodal displacements
+    /// `u = u_p + P ũ` per body, multipliers, KKT residuals (of the linearised problem, which
+    /// at convergence is the nonlinear one up to the residual of [`NewtonReport::residual`]).
+    pub contact: StaticContactResult<D>,
+    /// Strain energy `Σ_T |T| Φ(e)` at the solution.
+    pub strain_energy: Real,
+    /// The Newton report.
+    pub report: NewtonReport,
+}
+
+/// The converged state the next level starts from.
+#[derive(Debug, Clone)]
+struct State<const D: usize> {
+    time: Real,
+    reduced: Vec<Real>,
+    /// Reduced contact forces `c` (for the line search's merit).
+    contact_force: Vec<Real>,
+    result: Option<StaticContactResult<D>>,
+}
+
+/// Nonlinear elasticity with contact: the Newton iteration of the module docs on one symbolic
+/// factorisation, with load stepping. Holds the converged state (time, displacement,
+/// multipliers) that the next level starts from.
+#[derive(Debug)]
+pub struct NonlinearContact<const D: usize> {
+    contact: StaticContact<D>,
+    dofs: DofMap<D>,
+    pairs: Vec<ContactPair<D>>,
+    kinematics: Vec<Kinematics>,
+    params: NewtonParams,
+    state: State<D>,
+}
+
+fn norm(x: &[Real]) -> Real {
+    x.iter().map(|v| v * v).sum::<Real>().sqrt()
+}
+
+impl<const D: usize> NonlinearContact<D> {
+    /// Sets up the contact pairs and the symbolic factorisation of the tangent on the model's
+    /// pattern (contact dofs ordered last), with one [`Kinematics`] per body. The state is the
+    /// unloaded reference configuration at `t = 0`.
+    ///
+    /// # Errors
+    /// Invalid pairs, parameters or kinematics; a tangent at `u = 0` that is not positive
+    /// definite (e.g. bodies that nothing holds).
+    pub fn new(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        kinematics: &[Kinematics],
+        elastic: ElasticParams,
+        params: NewtonParams,
+    ) -> Result<Self, NonlinearError> {
+        params.check()?;
+        let nb = model.bodies().len();
+        if kinematics.len() != nb {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "{} kinematics given for {nb} bodies (one per body)",
+                kinematics.len()
+            )));
+        }
+        let zero: Vec<Vec<Vector<D>>> =
+            model.bodies().iter().map(|b| vec![Vector::<D>::zeros(); b.mesh.n_nodes()]).collect();
+        let contact = StaticContact::with_system_matrix(model, pairs, elastic, |dofs, m| {
+            assemble_tangent(model, dofs, kinematics, &zero, m)
+        })?;
+        let dofs = contact.elastic().dofs().clone();
+        let n = dofs.n_dofs();
+        Ok(Self {
+            contact,
+            dofs,
+            pairs: pairs.to_vec(),
+            kinematics: kinematics.to_vec(),
+            params,
+            state: State { time: 0.0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None },
+        })
+    }
+
+    /// The contact machinery (geometry, factorisation of the last tangent).
+    pub fn contact(&self) -> &StaticContact<D> {
+        &self.contact
+    }
+
+    /// The contact geometry of the last iteration.
+    pub fn geometry(&self) -> &ContactGeometry<D> {
+        self.contact.geometry()
+    }
+
+    /// The dof map.
+    pub fn dofs(&self) -> &DofMap<D> {
+        &self.dofs
+    }
+
+    /// The parameters.
+    pub fn params(&self) -> &NewtonParams {
+        &self.params
+    }
+
+    /// Time of the converged state.
+    pub fn time(&self) -> Real {
+        self.state.time
+    }
+
+    /// Reduced unknowns `ũ` of the converged state.
+    pub fn reduced(&self) -> &[Real] {
+        &self.state.reduced
+    }
+
+    /// Back to the unloaded reference configuration at time `t0`.
+    pub fn reset(&mut self, t0: Real) {
+        let n = self.dofs.n_dofs();
+        self.state = State { time: t0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None };
+    }
+
+    fn finite_strain(&self) -> bool {
+        self.kinematics.contains(&Kinematics::FiniteStrain)
+    }
+
+    /// Solves the level `t` from the converged state, halving the step in time on failure
+    /// (module docs), and commits the new state. Friction: Tresca with the slip bounds
+    /// `g_c = F_c |Λ_n|` of the state each sub-level starts from (Coulomb frozen per level,
+    /// docs/model.md §3), slip measured from that state; the first level from the reference
+    /// configuration is frictionless.
+    ///
+    /// # Errors
+    /// [`NonlinearError::NoConvergence`] when the cut-backs are exhausted (the state is left
+    /// at the last converged sub-level); model and contact errors that no cut-back can cure.
+    #[tracing::instrument(level = "debug", skip_all, fields(t))]
+    pub fn step_to(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
+        if !t.is_finite() || t < self.state.time {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "level t = {t} must be finite and not before the state's time {}",
+                self.state.time
+            )));
+        }
+        let start = Instant::now();
+        let mut report = NewtonReport::default();
+        let mut target = t;
+        let mut halvings = 0usize;
+        loop {
+            let from = self.state.time;
+            match self.newton(model, target, solver, &mut report) {
+                Ok((result, energy, iterations, reduced, force)) => {
+                    report.sublevels += 1;
+                    self.state =
+                        State { time: target, reduced, contact_force: force, result: Some(result.clone()) };
+                    if target >= t {
+                        report.iterations = iterations;
+                        report.time_s = start.elapsed().as_secs_f64();
+                        return Ok(NonlinearResult {
+                            time: t,
+                            contact: result,
+                            strain_energy: energy,
+                            report,
+                        });
+                    }
+                    target = t;
+                }
+                Err(e) => {
+                    let recoverable = matches!(
+                        e,
+                        NonlinearError::NoConvergence { .. }
+                            | NonlinearError::Fem(FemError::InvertedElement { .. })
+                            | NonlinearError::Contact(_)
+                            | NonlinearError::Fem(FemError::Linalg(_))
+                    );
+                    if !recoverable || halvings >= self.params.max_cutbacks {
+                        let step = target - from;
+                        return Err(match e {
+                            NonlinearError::NoConvergence { reason, .. } => {
+                                NonlinearError::NoConvergence { time: t, cutbacks: halvings, step, reason }
+                            }
+                            other if recoverable => NonlinearError::NoConvergence {
+                                time: t,
+                                cutbacks: halvings,
+                                step,
+                                reason: other.to_string(),
+                            },
+                            other => other,
+                        });
+                    }
+                    halvings += 1;
+                    report.cutbacks += 1;
+                    target = from + 0.5 * (target - from);
+                    tracing::debug!(target, "cut-back");
+                }
+            }
+        }
+    }
+
+    /// Runs the levels `times` (increasing, after the state's time) with [`Self::step_to`],
+    /// calling `observer` after each.
+    ///
+    /// # Errors
+    /// As [`Self::step_to`], and the observer's errors.
+    pub fn run(
+        &mut self,
+        model: &Model<D>,
+        times: &[Real],
+        solver: &dyn ContactSolver,
+        mut observer: impl FnMut(&NonlinearResult<D>) -> Result<(), NonlinearError>,
+    ) -> Result<Vec<NonlinearResult<D>>, NonlinearError> {
+        let mut out = Vec::with_capacity(times.len());
+        for &t in times {
+            let r = self.step_to(model, t, solver)?;
+            observer(&r)?;
+            out.push(r);
+        }
+        Ok(out)
+    }
+
+    /// Newton's method at `t` from the committed state; nothing is committed.
+    #[allow(clippy::type_complexity)]
+    fn newton(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        report: &mut NewtonReport,
+    ) -> Result<(StaticContactResult<D>, Real, Vec<NewtonIteration>, Vec<Real>, Vec<Real>), NonlinearError>
+    {
+        let n = self.dofs.n_dofs();
+        let lifts = self.dofs.lifts(model, t)?;
+        let mut f_ext = vec![0.0; n];
+        add_loads(model, &self.dofs, t, self.params.load_degree, &mut f_ext)?;
+        let mut u = self.state.reduced.clone();
+        let mut disp = self.dofs.expand(&u, &lifts)?;
+        let (mut f_int, _) = internal_force(model, &self.dofs, &self.kinematics, &disp)?;
+        let mut c = self.state.contact_force.clone();
+        // friction frozen from the committed state (none from the reference configuration)
+        let previous = self.state.result.as_ref();
+        let friction =
+            previous.is_some() && self.contact.geometry().nodes.iter().any(|node| node.friction > 0.0);
+        let slip_bound = match (friction, previous) {
+            (true, Some(p)) => Some(self.contact.geometry().slip_bounds_from_pressure(&p.solution.lambda_n)),
+            _ => None,
+        };
+        let previous_disp = if friction { previous.map(|p| p.displacement.clone()) } else { None };
+        let mut warm: Option<ContactSolution> = previous.map(|p| p.solution.clone());
+        let residual_of = |f_int: &[Real], c: &[Real]| -> Vec<Real> {
+            (0..n).map(|i| f_ext[i] - f_int[i] - c[i]).collect()
+        };
+        let mut r_norm = norm(&residual_of(&f_int, &c));
+        // the force scale of the level: its initial residual (e.g. the forces of a prescribed
+        // displacement's jump, which leave the reduced rows once balanced)
+        let r_start = r_norm;
+        let mut iterations = Vec::new();
+        for _ in 0..self.params.max_iterations {
+            report.total_iterations += 1;
+            if self.finite_strain() {
+                self.contact.update_geometry(model, &self.pairs, &disp)?;
+            }
+            let kin = &self.kinematics;
+            let at = &disp;
+            self.contact.refactorise(|dofs, m| assemble_tangent(model, dofs, kin, at, m))?;
+            report.factorisations += 1;
+            let k = self.contact.elastic().stiffness();
+            let mut ku = vec![0.0; n];
+            k.mul_vec(&u, &mut ku);
+            let load: Vec<Real> = (0..n).map(|i| f_ext[i] - f_int[i] + ku[i]).collect();
+            let rows = self.contact.geometry().len();
+            let warm_start = warm.as_ref().filter(|w| w.lambda_n.len() == rows);
+            let result = self.contact.solve_load(
+                &load,
+                &lifts,
+                solver,
+                slip_bound.as_deref().filter(|g| g.len() == rows),
+                previous_disp.as_deref(),
+                warm_start,
+            )?;
+            let u_star = &result.solution.u;
+            let mut k_star = vec![0.0; n];
+            k.mul_vec(u_star, &mut k_star);
+            let c_star: Vec<Real> = (0..n).map(|i| load[i] - k_star[i]).collect();
+            let delta: Vec<Real> = (0..n).map(|i| u_star[i] - u[i]).collect();
+            // backtracking line search on ‖R‖ along (δũ, δc)
+            let mut alpha = 1.0;
+            let accepted = loop {
+                let u_try: Vec<Real> = (0..n).map(|i| u[i] + alpha * delta[i]).collect();
+                let c_try: Vec<Real> = (0..n).map(|i| c[i] + alpha * (c_star[i] - c[i])).collect();
+                let disp_try = self.dofs.expand(&u_try, &lifts)?;
+                match internal_force(model, &self.dofs, &self.kinematics, &disp_try) {
+                    Ok((f_try, e_try)) => {
+                        let r_try = norm(&residual_of(&f_try, &c_try));
+                        if !self.params.line_search
+                            || r_try <= (1.0 - 1e-4 * alpha) * r_norm
+                            || alpha < 1.0 / 64.0
+                        {
+                            break Some((u_try, c_try, disp_try, f_try, e_try, r_try));
+                        }
+                    }
+                    Err(FemError::InvertedElement { .. })
+                        if self.params.line_search && alpha >= 1.0 / 64.0 => {}
+                    Err(e) => return Err(e.into()),
+                }
+                alpha *= 0.5;
+                if alpha < 1.0 / 128.0 {
+                    break None;
+                }
+            };
+            let Some((u_new, c_new, disp_new, f_new, e_new, r_new)) = accepted else {
+                return Err(NonlinearError::NoConvergence {
+                    time: t,
+                    cutbacks: 0,
+                    step: 0.0,
+                    reason: "the line search found no admissible step".into(),
+                });
+            };
+            let increment = alpha * norm(&delta) / norm(&u_new).max(Real::MIN_POSITIVE);
+            u = u_new;
+            c = c_new;
+            disp = disp_new;
+            f_int = f_new;
+            let energy = e_new;
+            r_norm = r_new;
+            let scale = norm(&f_ext).max(norm(&f_int)).max(norm(&c)).max(r_start);
+            let relative = if scale > 0.0 { r_norm / scale } else { 0.0 };
+            iterations.push(NewtonIteration {
+                residual: relative,
+                increment,
+                step: alpha,
+                contact_iterations: result.solution.report.iterations,
+                active: result.solution.report.active,
+            });
+            tracing::debug!(relative, increment, alpha, "Newton iteration");
+            if !relative.is_finite() {
+                break;
+            }
+            // converged: the residual at the tolerance, or a full step that no longer moves
+            // the iterate (a residual at rounding level of a level that barely changed)
+            let done = alpha == 1.0
+                && (relative <= self.params.tolerance || scale == 0.0 || increment <= self.params.tolerance);
+            warm = Some(result.solution.clone());
+            if done {
+                let mut result = result;
+                result.displacement = disp;
+                result.solution.u = u.clone();
+                return Ok((result, energy, iterations, u, c));
+            }
+        }
+        let last = iterations.last().map_or(Real::NAN, |i| i.residual);
+        Err(NonlinearError::NoConvergence {
+            time: t,
+            cutbacks: 0,
+            step: 0.0,
+            reason: format!(
+                "{} Newton iterations left the relative residual at {last:e} (tolerance {:e})",
+                iterations.len(),
+                self.params.tolerance
+            ),
+        })
+    }
+}
