@@ -31,8 +31,8 @@ pub use elastic::{
     OrderingChoice, Reorder, Stabilisation,
 };
 pub use error::FemError;
-pub use nonlinear::Kinematics;
 pub use model::{Body, BodyId, ComponentMask, Model, TractionField, VectorField};
+pub use nonlinear::Kinematics;
 pub use post::BodyFields;
 pub use quadrature::QuadratureRule;
 /// The linear algebra the elastic solve uses (re-exported from `synovia-linalg`).

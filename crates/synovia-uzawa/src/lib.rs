@@ -69,6 +69,8 @@ pub mod schur;
 pub mod uzawa;
 
 pub use dual::DualMprgp;
-pub use qp::{estimate_norm, mpgp, mprgp, ConvexBlock, DenseHessian, Hessian, QpOptions, QpReport};
+pub use qp::{
+    estimate_norm, mpgp, mprgp, qp_until, ConvexBlock, DenseHessian, Hessian, QpOptions, QpReport, StopTest,
+};
 pub use schur::SchurOperator;
 pub use uzawa::UzawaMprgp;

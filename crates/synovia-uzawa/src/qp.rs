@@ -389,6 +389,34 @@ pub fn mpgp<H: Hessian + ?Sized>(
     finish("mpgp", run(hessian, b, blocks, x, options, Proportioning::Projected, None))
 }
 
+/// A caller's stopping test `stop(iteration, x, g)` for [`qp_until`].
+pub type StopTest<'a> = dyn FnMut(usize, &[f64], &[f64]) -> bool + 'a;
+
+/// [`mprgp`] (`chopped = true`: proportioning along the chopped gradient, boxes only) or
+/// [`mpgp`] (`chopped = false`) with the caller's stopping test instead of the fixed tolerance:
+/// the iteration stops as converged as soon as `stop(iteration, x, g)` returns `true` for the
+/// current iterate `x` and its gradient `g = H x − b` (or at an exactly stationary point). For
+/// outer iterations whose inner precision depends on the iterate, e.g. the adaptive test
+/// `‖g^P(x)‖ ≤ min(M ‖G x‖, η)` of SMALBE (Dostál 2009, Ch. 6). `options.tolerance` and
+/// `options.absolute_tolerance` are ignored; after `options.max_iterations` the report is
+/// returned with `converged = false` (no error), so the caller decides.
+///
+/// # Errors
+/// As [`mpgp`], except [`ContactError::NoConvergence`].
+pub fn qp_until<H: Hessian + ?Sized>(
+    hessian: &mut H,
+    b: &[f64],
+    blocks: &[ConvexBlock],
+    x: &mut [f64],
+    options: &QpOptions,
+    chopped: bool,
+    stop: &mut StopTest<'_>,
+) -> Result<QpReport, ContactError> {
+    let opts = QpOptions { tolerance: 0.0, absolute_tolerance: f64::MAX, ..*options };
+    let mut monitor = |s: &QpState<'_>| stop(s.iteration, s.x, s.g);
+    solve_qp(hessian, b, blocks, x, &opts, chopped, Some(&mut monitor)).map(|(rep, _)| rep)
+}
+
 /// The MPRGP/MPGP iteration for crate-internal callers: returns the report (with
 /// `converged = false` instead of an error after `max_iterations`). The monitor is called with
 /// every iterate (iteration 0 = the projected initial guess) and must also return `true` for the

@@ -1,0 +1,657 @@
+//! The TFETI dual problem and its solution by SMALBE with MPRGP/MPGP inner solves
+//! (docs/model.md §11).
+//!
+//! With the subdomain stiffnesses `K = diag K_s`, kernels `R = diag R_s`, the constraint rows
+//! `B = [B_E; Ĉ]` (equality rows of [`crate::Decomposition`], contact rows `Ĉ` of the
+//! undecomposed problem mapped onto the owner copies and scaled to unit norm), offsets
+//! `c = (0, d, s)` and the load `f̂`, the primal problem `min ½ uᵀKu − f̂ᵀu` s.t. `B_E u = 0`,
+//! `B_hn u ≤ d`, Tresca on `B_Ht` has the dual
+//!
+//! ```text
+//! min ½ λᵀ F λ − λᵀ d̃   s.t.  λ ∈ Ω,  G λ = e,
+//! F = B K⁺ Bᵀ,  d̃ = B K⁺ f̂ − c,  G = Rᵀ Bᵀ,  e = Rᵀ f̂,
+//! Ω: λ_E free, λ_n ≥ 0, ‖λ_t,c‖ ≤ 1/s_c (the unit disc in the unscaled multipliers).
+//! ```
+//!
+//! `λ₀ = G_Eᵀ (G_E G_Eᵀ)⁻¹ e` lives on the equality rows, so it is feasible for `Ω`; with
+//! `λ = λ₀ + λ̃`, `G̃ = L⁻¹ G` (`G Gᵀ = L Lᵀ`), `Q = G̃ᵀ G̃` and `P = I − Q` (the projector onto
+//! the natural coarse space's complement) the problem becomes
+//!
+//! ```text
+//! min ½ λ̃ᵀ (P F P + ρ Q) λ̃ − λ̃ᵀ P (d̃ − F λ₀)   s.t.  λ̃ ∈ Ω,  G̃ λ̃ = 0,
+//! ```
+//!
+//! solved by SMALBE-M (Dostál 2009, *Optimal Quadratic Programming Algorithms*, Ch. 6):
+//! the inner bound/disc-constrained problems of the augmented Lagrangian
+//! `L(λ̃, μ) = ½ λ̃ᵀ(PFP + ρQ)λ̃ − λ̃ᵀ b + μᵀ G̃ λ̃` by MPRGP (2D) or MPGP (3D) of
+//! `synovia-uzawa` to the adaptive precision `‖g^P‖ ≤ min(M ‖G̃ λ̃‖, η)`, then
+//! `μ ← μ + ρ G̃ λ̃`, and `M ← M/β` when `L` did not increase by `ρ/2 ‖G̃ λ̃‖²`. The primal
+//! solution is `u = K⁺ (f̂ − Bᵀ λ) + R α` with `α = −(G_E G_Eᵀ)⁻¹ G_E (d̃ − F λ)_E` (the
+//! equality rows hold exactly).
+
+use std::time::Instant;
+
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
+use synovia_contact::{ContactError, FrictionConstraints, NormalConstraints};
+use synovia_uzawa::{estimate_norm, qp_until, ConvexBlock, Hessian, QpOptions};
+
+use crate::comm::Communicator;
+use crate::decomposition::{Decomposition, Entry};
+use crate::error::FetiError;
+
+/// Parameters of the TFETI solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub struct TfetiParams {
+    /// Relative tolerance `ε`: stop when `‖g^P‖ ≤ ε ‖b‖` and `‖G̃ λ̃‖ ≤ ε ‖b‖` (default `1e-12`).
+    pub tolerance: f64,
+    /// Maximum SMALBE (outer) iterations (default 200).
+    pub max_outer: usize,
+    /// Maximum MPRGP/MPGP iterations in total (default 50 000).
+    pub max_inner: usize,
+    /// Penalty `ρ` as a multiple of `‖P F P‖` (default 1).
+    pub rho_factor: f64,
+    /// Initial `M` as a multiple of `ρ` (default 1).
+    pub m_factor: f64,
+    /// `η` as a multiple of `‖b‖` (default 0.1).
+    pub eta_factor: f64,
+    /// Decrease factor `β > 1` of `M` (default 10).
+    pub beta: f64,
+}
+
+impl Default for TfetiParams {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-12,
+            max_outer: 200,
+            max_inner: 50_000,
+            rho_factor: 1.0,
+            m_factor: 1.0,
+            eta_factor: 0.1,
+            beta: 10.0,
+        }
+    }
+}
+
+impl TfetiParams {
+    /// Sets [`Self::tolerance`].
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+    /// Sets [`Self::max_outer`].
+    pub fn with_max_outer(mut self, max_outer: usize) -> Self {
+        self.max_outer = max_outer;
+        self
+    }
+}
+
+/// What a TFETI solve did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TfetiReport {
+    /// Subdomains.
+    pub subdomains: usize,
+    /// Ranks.
+    pub ranks: usize,
+    /// Dual unknowns: gluing, Dirichlet, normal, tangential rows.
+    pub dual: [usize; 4],
+    /// Coarse dimension `Σ r_s`.
+    pub coarse_dim: usize,
+    /// SMALBE iterations.
+    pub outer_iterations: usize,
+    /// MPRGP/MPGP iterations (all outer iterations together).
+    pub inner_iterations: usize,
+    /// Products with `F` (one subdomain solve each per subdomain).
+    pub f_products: usize,
+    /// Final `‖g^P‖/‖b‖`.
+    pub gradient: f64,
+    /// Final `‖G̃ λ̃‖/‖b‖`.
+    pub feasibility: f64,
+    /// Seconds of the dual set-up (rows, coarse problem).
+    pub setup_s: f64,
+    /// Seconds of the SMALBE iteration and the primal recovery.
+    pub solve_s: f64,
+}
+
+/// The solution in the terms of the undecomposed problem (docs/model.md §5).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TfetiSolution {
+    /// Reduced displacement `U`.
+    pub u: Vec<f64>,
+    /// `Λ_n` per normal row.
+    pub lambda_n: Vec<f64>,
+    /// `Λ_t` per tangential row.
+    pub lambda_t: Vec<f64>,
+    /// What was done.
+    pub report: TfetiReport,
+}
+
+/// A subdomain's dual rows and its entries `(position in rows, local dof, value)`.
+#[derive(Debug, Default)]
+struct SubRows {
+    rows: Vec<usize>,
+    entries: Vec<(usize, usize, f64)>,
+}
+
+/// The assembled dual operator of one contact problem.
+struct Dual<'a> {
+    dec: &'a Decomposition,
+    comm: &'a dyn Communicator,
+    m: usize,
+    sub_rows: Vec<SubRows>,
+    loads: Vec<Vec<f64>>,
+    counts: Vec<usize>,
+    offsets: Vec<f64>,
+    /// Coarse columns `G[:, ρ]`.
+    g_cols: Vec<Vec<(usize, f64)>>,
+    n_coarse: usize,
+    /// `L` with `G Gᵀ = L Lᵀ`.
+    l: DMatrix<f64>,
+    /// Cholesky of `G_E G_Eᵀ`.
+    ge: nalgebra::Cholesky<f64, nalgebra::Dyn>,
+    products: std::sync::atomic::AtomicUsize,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+impl<'a> Dual<'a> {
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        dec: &'a Decomposition,
+        comm: &'a dyn Communicator,
+        rows: &[Vec<Entry>],
+        offsets: Vec<f64>,
+        load: &[f64],
+    ) -> Result<Self, FetiError> {
+        let d = dec.dim;
+        let n_sub = dec.subdomains.len();
+        let m = rows.len();
+        let mut sub_rows: Vec<SubRows> = (0..n_sub).map(|_| SubRows::default()).collect();
+        for (r, row) in rows.iter().enumerate() {
+            for &(s, dof, v) in row {
+                let sr = &mut sub_rows[s];
+                if sr.rows.last() != Some(&r) {
+                    sr.rows.push(r);
+                }
+                let pos = sr.rows.len() - 1;
+                sr.entries.push((pos, dof, v));
+            }
+        }
+        // f̂ on the owner copies
+        let mut loads: Vec<Vec<f64>> = dec.subdomains.iter().map(|s| vec![0.0; s.n_dofs()]).collect();
+        for g in &dec.groups {
+            let Some(&(s, a)) = g.copies.first() else { continue };
+            for k in 0..g.n_dofs {
+                let fk = load[g.first_dof + k];
+                for c in 0..d {
+                    loads[s][d * a + c] += fk * g.basis[k * d + c];
+                }
+            }
+        }
+        let counts: Vec<usize> =
+            dec.ranks.iter().map(|r| r.clone().map(|s| sub_rows[s].rows.len()).sum()).collect();
+        // coarse
+        let mut coarse_off = Vec::with_capacity(n_sub);
+        let mut n_coarse = 0;
+        for s in &dec.subdomains {
+            coarse_off.push(n_coarse);
+            n_coarse += s.kernel.ncols();
+        }
+        let mut g_cols: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
+        for (r, row) in rows.iter().enumerate() {
+            let mut col: Vec<(usize, f64)> = Vec::new();
+            for &(s, dof, v) in row {
+                let ker = &dec.subdomains[s].kernel;
+                for k in 0..ker.ncols() {
+                    col.push((coarse_off[s] + k, v * ker[(dof, k)]));
+                }
+            }
+            col.sort_by_key(|e| e.0);
+            let mut merged: Vec<(usize, f64)> = Vec::with_capacity(col.len());
+            for e in col {
+                match merged.last_mut() {
+                    Some(l) if l.0 == e.0 => l.1 += e.1,
+                    _ => merged.push(e),
+                }
+            }
+            g_cols[r] = merged;
+        }
+        let n_eq = dec.equality.len();
+        let gram = |range: std::ops::Range<usize>| {
+            let mut a = DMatrix::<f64>::zeros(n_coarse, n_coarse);
+            for col in &g_cols[range] {
+                for &(i, vi) in col {
+                    for &(j, vj) in col {
+                        a[(i, j)] += vi * vj;
+                    }
+                }
+            }
+            a
+        };
+        let ge = nalgebra::Cholesky::new(gram(0..n_eq)).ok_or(FetiError::SemiCoercive { pivot: 0 })?;
+        let l = nalgebra::Cholesky::new(gram(0..m)).ok_or(FetiError::SemiCoercive { pivot: 0 })?.l();
+        Ok(Self {
+            dec,
+            comm,
+            m,
+            sub_rows,
+            loads,
+            counts,
+            offsets,
+            g_cols,
+            n_coarse,
+            l,
+            ge,
+
+            products: std::sync::atomic::AtomicUsize::new(0),
+        })
+    }
+
+    /// `B K⁺ (f̂ [with_load] − Bᵀ λ)`, summed in subdomain order (docs: [`crate::comm`]).
+    fn bkb(&self, lambda: &[f64], with_load: bool) -> Result<Vec<f64>, FetiError> {
+        self.products.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let (dec, sub_rows, loads) = (self.dec, &self.sub_rows, &self.loads);
+        let local: Vec<Vec<f64>> = dec
+            .owned
+            .clone()
+            .into_par_iter()
+            .map(|s| {
+                let sub = &dec.subdomains[s];
+                let sr = &sub_rows[s];
+                let mut x = if with_load { loads[s].clone() } else { vec![0.0; sub.n_dofs()] };
+                for &(pos, dof, v) in &sr.entries {
+                    x[dof] -= v * lambda[sr.rows[pos]];
+                }
+                sub.pinv_in_place(&mut x, s)?;
+                let mut out = vec![0.0; sr.rows.len()];
+                for &(pos, dof, v) in &sr.entries {
+                    out[pos] += v * x[dof];
+                }
+                Ok(out)
+            })
+            .collect::<Result<_, FetiError>>()?;
+        let all = self.comm.all_gather(&local.concat(), &self.counts)?;
+        let mut y = vec![0.0; self.m];
+        let mut k = 0;
+        for sr in &self.sub_rows {
+            for &r in &sr.rows {
+                y[r] += all[k];
+                k += 1;
+            }
+        }
+        Ok(y)
+    }
+
+    /// `F λ`.
+    fn f(&self, lambda: &[f64]) -> Result<Vec<f64>, FetiError> {
+        let mut y = self.bkb(lambda, false)?;
+        y.iter_mut().for_each(|v| *v = -*v);
+        Ok(y)
+    }
+
+    /// `G λ` (rows `range` only).
+    fn g(&self, lambda: &[f64], range: std::ops::Range<usize>) -> DVector<f64> {
+        let mut out = DVector::zeros(self.n_coarse);
+        for r in range {
+            if lambda[r] != 0.0 {
+                for &(i, v) in &self.g_cols[r] {
+                    out[i] += v * lambda[r];
+                }
+            }
+        }
+        out
+    }
+
+    /// `Gᵀ μ` into the rows `range` of a vector of length `m`.
+    fn gt(&self, mu: &DVector<f64>, range: std::ops::Range<usize>) -> Vec<f64> {
+        let mut out = vec![0.0; self.m];
+        for r in range {
+            out[r] = self.g_cols[r].iter().map(|&(i, v)| v * mu[i]).sum();
+        }
+        out
+    }
+
+    /// `G̃ λ = L⁻¹ G λ`.
+    fn gt_orth(&self, lambda: &[f64]) -> DVector<f64> {
+        let mut v = self.g(lambda, 0..self.m);
+        self.l.solve_lower_triangular_mut(&mut v);
+        v
+    }
+
+    /// `G̃ᵀ μ = Gᵀ L⁻ᵀ μ`.
+    fn gt_orth_t(&self, mu: &DVector<f64>) -> Vec<f64> {
+        let mut v = mu.clone();
+        self.l.tr_solve_lower_triangular_mut(&mut v);
+        self.gt(&v, 0..self.m)
+    }
+
+    /// `Q λ = G̃ᵀ G̃ λ`.
+    fn q(&self, lambda: &[f64]) -> Vec<f64> {
+        let v = self.gt_orth(lambda);
+        self.gt_orth_t(&v)
+    }
+
+    /// `P λ = λ − Q λ`.
+    fn p(&self, lambda: &[f64]) -> Vec<f64> {
+        let q = self.q(lambda);
+        lambda.iter().zip(&q).map(|(a, b)| a - b).collect()
+    }
+}
+
+/// `H = P F P + ρ Q` as a [`Hessian`].
+struct ProjectedHessian<'d, 'a> {
+    dual: &'d Dual<'a>,
+    rho: f64,
+}
+
+impl Hessian for ProjectedHessian<'_, '_> {
+    fn apply(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), ContactError> {
+        let d = self.dual;
+        let px = d.p(x);
+        let fpx = d.f(&px).map_err(ContactError::from)?;
+        let pfpx = d.p(&fpx);
+        if self.rho != 0.0 {
+            let qx = d.q(x);
+            for ((yi, a), b) in y.iter_mut().zip(&pfpx).zip(&qx) {
+                *yi = a + self.rho * b;
+            }
+        } else {
+            y.copy_from_slice(&pfpx);
+        }
+        Ok(())
+    }
+}
+
+/// `‖g^P‖` of `x ∈ Ω` with gradient `g` (see `synovia_uzawa::qp`).
+fn projected_gradient(blocks: &[ConvexBlock], x: &[f64], g: &[f64]) -> f64 {
+    let mut s = 0.0;
+    let mut k = 0;
+    for b in blocks {
+        match *b {
+            ConvexBlock::Interval { lower, upper } => {
+                let gi = g[k];
+                let v = if x[k] <= lower {
+                    gi.min(0.0)
+                } else if x[k] >= upper {
+                    gi.max(0.0)
+                } else {
+                    gi
+                };
+                s += v * v;
+                k += 1;
+            }
+            ConvexBlock::Ball { dim, radius } => {
+                let (xi, gi) = (&x[k..k + dim], &g[k..k + dim]);
+                let nx = norm(xi);
+                if nx >= radius * (1.0 - 1e-12) && nx > 0.0 {
+                    let ng: f64 = xi.iter().zip(gi).map(|(a, b)| a * b).sum::<f64>() / nx;
+                    let c = ng.min(0.0);
+                    for (a, b) in xi.iter().zip(gi) {
+                        let v = b - c * a / nx;
+                        s += v * v;
+                    }
+                } else {
+                    s += gi.iter().map(|v| v * v).sum::<f64>();
+                }
+                k += dim;
+            }
+        }
+    }
+    s.sqrt()
+}
+
+/// Solves the contact problem with load `load` (reduced unknowns of the decomposed model),
+/// normal rows and optional Tresca rows by TFETI (module docs). Collective: every rank calls it
+/// with the same data.
+///
+/// # Errors
+/// [`FetiError::Mismatch`] for a problem on other unknowns, [`FetiError::SemiCoercive`],
+/// [`FetiError::NoConvergence`], and the errors of the subdomain solves and communication.
+pub fn solve(
+    dec: &Decomposition,
+    comm: &dyn Communicator,
+    load: &[f64],
+    normal: &NormalConstraints,
+    friction: Option<&FrictionConstraints>,
+    params: &TfetiParams,
+) -> Result<TfetiSolution, FetiError> {
+    let t0 = Instant::now();
+    let n = dec.n_reduced;
+    if load.len() != n || normal.rows.ncols() != n || friction.is_some_and(|f| f.rows.ncols() != n) {
+        return Err(FetiError::Mismatch { expected: n, got: load.len() });
+    }
+    let (mn, mt) = (normal.rows.nrows(), friction.map_or(0, |f| f.rows.nrows()));
+    if normal.weights.len() != mn || normal.gap.len() != mn {
+        return Err(FetiError::InvalidParameter("normal rows, weights and gaps differ in length".into()));
+    }
+    let comps = friction.map_or(1, |f| f.components.max(1));
+    if friction.is_some_and(|f| f.shift.len() != mt || mt % comps != 0) {
+        return Err(FetiError::InvalidParameter("friction rows and shifts differ in length".into()));
+    }
+    if !(params.tolerance > 0.0 && params.rho_factor > 0.0 && params.beta > 1.0 && params.m_factor > 0.0) {
+        return Err(FetiError::InvalidParameter(format!("{params:?}")));
+    }
+    // rows: equality, normal (unit norm), friction (cell-wise common scale)
+    let n_eq = dec.equality.len();
+    let mut rows: Vec<Vec<Entry>> = dec.equality.clone();
+    let mut scale = vec![1.0; n_eq];
+    let mut offsets = vec![0.0; n_eq];
+    let mut blocks: Vec<ConvexBlock> =
+        vec![ConvexBlock::Interval { lower: f64::NEG_INFINITY, upper: f64::INFINITY }; n_eq];
+    for r in 0..mn {
+        let row = dec.map_row(normal.rows.row(r));
+        let nr = row.iter().map(|e| e.2 * e.2).sum::<f64>().sqrt();
+        let s = if nr > 0.0 { 1.0 / nr } else { 1.0 };
+        rows.push(row.into_iter().map(|(a, b, v)| (a, b, v * s)).collect());
+        scale.push(s);
+        offsets.push(s * normal.gap[r]);
+        blocks.push(ConvexBlock::Interval { lower: 0.0, upper: f64::INFINITY });
+    }
+    if let Some(fr) = friction {
+        for c in 0..mt / comps {
+            let cell: Vec<Vec<Entry>> = (0..comps).map(|k| dec.map_row(fr.rows.row(c * comps + k))).collect();
+            let n2: f64 = cell.iter().flatten().map(|e| e.2 * e.2).sum::<f64>() / comps as f64;
+            let s = if n2 > 0.0 { 1.0 / n2.sqrt() } else { 1.0 };
+            for (k, row) in cell.into_iter().enumerate() {
+                rows.push(row.into_iter().map(|(a, b, v)| (a, b, v * s)).collect());
+                scale.push(s);
+                offsets.push(s * fr.shift[c * comps + k]);
+            }
+            if comps == 1 {
+                blocks.push(ConvexBlock::Interval { lower: -1.0 / s, upper: 1.0 / s });
+            } else {
+                blocks.push(ConvexBlock::Ball { dim: comps, radius: 1.0 / s });
+            }
+        }
+    }
+    let dual = Dual::new(dec, comm, &rows, offsets, load)?;
+    let m = dual.m;
+    // e = Rᵀ f̂, λ₀ = G_Eᵀ (G_E G_Eᵀ)⁻¹ e
+    let mut e = DVector::zeros(dual.n_coarse);
+    {
+        let mut off = 0;
+        for (s, sub) in dec.subdomains.iter().enumerate() {
+            for k in 0..sub.kernel.ncols() {
+                e[off + k] = sub.kernel.column(k).iter().zip(&dual.loads[s]).map(|(a, b)| a * b).sum();
+            }
+            off += sub.kernel.ncols();
+        }
+    }
+    let lambda0 = dual.gt(&dual.ge.solve(&e), 0..n_eq);
+    // b = P (d̃ − F λ₀) = P (B K⁺ (f̂ − Bᵀ λ₀) − c)
+    let mut r0 = dual.bkb(&lambda0, true)?;
+    r0.iter_mut().zip(&dual.offsets).for_each(|(a, c)| *a -= c);
+    let b = dual.p(&r0);
+    let bnorm = norm(&b).max(f64::MIN_POSITIVE);
+    let setup_s = t0.elapsed().as_secs_f64();
+
+    // ‖P F P‖, ρ, M, η
+    let mut pfp = ProjectedHessian { dual: &dual, rho: 0.0 };
+    let (est, _) = estimate_norm(&mut pfp, m, 30)?;
+    let est = est.max(f64::MIN_POSITIVE);
+    let rho = params.rho_factor * est;
+    let mut hess = ProjectedHessian { dual: &dual, rho };
+    let mut big_m = params.m_factor * rho;
+    let eta = params.eta_factor * bnorm;
+    let eps = params.tolerance * bnorm;
+    let chopped = blocks.iter().all(|b| matches!(b, ConvexBlock::Interval { .. }));
+    let mut opts = QpOptions::default().with_hessian_norm(Some(1.05 * est.max(rho))).with_precondition(false);
+
+    let mut x = vec![0.0; m];
+    let mut mu = DVector::<f64>::zeros(dual.n_coarse);
+    let mut report = TfetiReport {
+        subdomains: dec.subdomains.len(),
+        ranks: comm.size(),
+        dual: [dec.n_gluing, n_eq - dec.n_gluing, mn, mt],
+        coarse_dim: dual.n_coarse,
+        setup_s,
+        ..Default::default()
+    };
+    let mut l_prev = f64::NEG_INFINITY;
+    let mut converged = false;
+    let (mut gp_last, mut gx_last) = (f64::INFINITY, f64::INFINITY);
+    for outer in 1..=params.max_outer {
+        report.outer_iterations = outer;
+        let gtmu = dual.gt_orth_t(&mu);
+        let bk: Vec<f64> = b.iter().zip(&gtmu).map(|(a, c)| a - c).collect();
+        let mut last_g = Vec::new();
+        let mut final_reached = false;
+        let (mut gp_s, mut gx_s) = (0.0, 0.0);
+        opts = opts.with_max_iterations(params.max_inner.saturating_sub(report.inner_iterations).max(1));
+        let rep = {
+            let mut stop = |_it: usize, xi: &[f64], gi: &[f64]| {
+                let gp = projected_gradient(&blocks, xi, gi);
+                let gx = dual.gt_orth(xi).norm();
+                let fin = gp <= eps && gx <= eps;
+                if fin || gp <= (big_m * gx).min(eta) {
+                    final_reached = fin;
+                    last_g = gi.to_vec();
+                    gp_s = gp;
+                    gx_s = gx;
+                    true
+                } else {
+                    false
+                }
+            };
+            qp_until(&mut hess, &bk, &blocks, &mut x, &opts, chopped, &mut stop)?
+        };
+        report.inner_iterations += rep.iterations;
+        gp_last = gp_s;
+        gx_last = gx_s;
+        if !rep.converged {
+            gp_last = rep.projected_gradient_norm;
+            break;
+        }
+        if final_reached {
+            converged = true;
+            break;
+        }
+        let gx = dual.gt_orth(&x);
+        mu += &gx * rho;
+        // L(λ, μ_new) = ½ λᵀ(g + b_k) − bᵀλ + μ_newᵀ G̃ λ
+        let half: f64 =
+            x.iter().zip(last_g.iter().zip(&bk)).map(|(xi, (g, c))| xi * (g + c)).sum::<f64>() * 0.5;
+        let l_new = half - x.iter().zip(&b).map(|(a, c)| a * c).sum::<f64>() + mu.dot(&gx);
+        if l_new < l_prev + 0.5 * rho * gx.norm_squared() {
+            big_m /= params.beta;
+        }
+        l_prev = l_new;
+    }
+    report.gradient = gp_last / bnorm;
+    report.feasibility = gx_last / bnorm;
+    if !converged {
+        report.f_products = dual.products.load(std::sync::atomic::Ordering::Relaxed);
+        return Err(FetiError::NoConvergence {
+            outer: report.outer_iterations,
+            inner: report.inner_iterations,
+            gradient: report.gradient,
+            feasibility: report.feasibility,
+        });
+    }
+
+    // primal recovery
+    let lambda: Vec<f64> = x.iter().zip(&lambda0).map(|(a, c)| a + c).collect();
+    let mut rt = dual.bkb(&lambda, true)?;
+    rt.iter_mut().zip(&dual.offsets).for_each(|(a, c)| *a -= c);
+    let alpha = -dual.ge.solve(&dual.g(&rt, 0..n_eq));
+    let u = recover(&dual, &lambda, &alpha)?;
+    let lambda_n: Vec<f64> =
+        (0..mn).map(|r| scale[n_eq + r] * lambda[n_eq + r] / normal.weights[r]).collect();
+    let lambda_t: Vec<f64> = (0..mt).map(|r| scale[n_eq + mn + r] * lambda[n_eq + mn + r]).collect();
+    report.f_products = dual.products.load(std::sync::atomic::Ordering::Relaxed);
+    report.solve_s = t0.elapsed().as_secs_f64() - setup_s;
+    Ok(TfetiSolution { u, lambda_n, lambda_t, report })
+}
+
+/// `u_s = K_s⁺ (f̂_s − B_sᵀ λ) + R_s α_s` on the owned subdomains, read back on the owner copies
+/// as reduced unknowns and gathered.
+fn recover(dual: &Dual<'_>, lambda: &[f64], alpha: &DVector<f64>) -> Result<Vec<f64>, FetiError> {
+    let dec = dual.dec;
+    let d = dec.dim;
+    let n_sub = dec.subdomains.len();
+    let mut owner_groups: Vec<Vec<usize>> = vec![Vec::new(); n_sub];
+    for (gi, g) in dec.groups.iter().enumerate() {
+        if let Some(&(s, _)) = g.copies.first() {
+            owner_groups[s].push(gi);
+        }
+    }
+    let mut coarse_off = Vec::with_capacity(n_sub);
+    let mut off = 0;
+    for s in &dec.subdomains {
+        coarse_off.push(off);
+        off += s.kernel.ncols();
+    }
+    let (sub_rows, loads) = (&dual.sub_rows, &dual.loads);
+    let local: Vec<Vec<f64>> = dec
+        .owned
+        .clone()
+        .into_par_iter()
+        .map(|s| {
+            let sub = &dec.subdomains[s];
+            let sr = &sub_rows[s];
+            let mut x = loads[s].clone();
+            for &(pos, dof, v) in &sr.entries {
+                x[dof] -= v * lambda[sr.rows[pos]];
+            }
+            sub.pinv_in_place(&mut x, s)?;
+            for k in 0..sub.kernel.ncols() {
+                let a = alpha[coarse_off[s] + k];
+                for (xi, r) in x.iter_mut().zip(sub.kernel.column(k).iter()) {
+                    *xi += a * r;
+                }
+            }
+            let mut out = Vec::new();
+            for &gi in &owner_groups[s] {
+                let g = &dec.groups[gi];
+                let a = g.copies[0].1;
+                for k in 0..g.n_dofs {
+                    out.push((0..d).map(|c| g.basis[k * d + c] * x[d * a + c]).sum::<f64>());
+                }
+            }
+            Ok(out)
+        })
+        .collect::<Result<_, FetiError>>()?;
+    let counts: Vec<usize> = dec
+        .ranks
+        .iter()
+        .map(|r| {
+            r.clone().map(|s| owner_groups[s].iter().map(|&g| dec.groups[g].n_dofs).sum::<usize>()).sum()
+        })
+        .collect();
+    let all = dual.comm.all_gather(&local.concat(), &counts)?;
+    let mut u = vec![0.0; dec.n_reduced];
+    let mut k = 0;
+    for groups in &owner_groups {
+        for &gi in groups {
+            let g = &dec.groups[gi];
+            for j in 0..g.n_dofs {
+                u[g.first_dof + j] = all[k];
+                k += 1;
+            }
+        }
+    }
+    Ok(u)
+}

@@ -1,0 +1,89 @@
+//! TFETI against the direct PDAS solution of the undecomposed problem (docs/model.md §11):
+//! 2D Hertz (two cylinders, node-to-node) and 3D Hertz (hemisphere on a rigid flat), each
+//! frictionless and with Tresca friction (slip bounds from the frictionless pressure,
+//! incremental slip from it under a tangential motion of the top). Both solvers run behind the
+//! same `StaticContact::solve` on the same load and rows; `U`, `Λ_n`, `Λ_t` must agree to 1e-6
+//! relative (max norm), and the TFETI solution must satisfy the KKT conditions.
+
+use synovia_contact::{ContactSolver, StaticContact, StaticContactResult};
+use synovia_feti::{DecompositionParams, Tfeti, TfetiParams};
+use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
+use synovia_pdas::Pdas;
+
+fn rel(a: &[f64], b: &[f64]) -> f64 {
+    let scale = a.iter().fold(0.0_f64, |m, x| m.max(x.abs())).max(1e-300);
+    a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs())) / scale
+}
+
+/// Frictionless and Tresca solves by PDAS and TFETI; returns the errors `(U, Λn, Λt)` of the
+/// Tresca case.
+fn compare<const D: usize>(
+    name: &str,
+    model: &synovia_fem::model::Model<D>,
+    pairs: &[synovia_contact::operators::ContactPair<D>],
+    subdomains: usize,
+    shift: f64,
+) -> [f64; 3] {
+    let mut sc = StaticContact::new(model, pairs, Default::default()).expect("factorise");
+    sc.set_nested_iteration(None);
+    let pdas = Pdas::default();
+    let tfeti = Tfeti::for_model(
+        model,
+        &DecompositionParams::default().with_subdomains(subdomains),
+        TfetiParams::default(),
+    )
+    .expect("decomposition");
+    let dec = tfeti.decomposition();
+    println!(
+        "{name}: {} subdomains, primal {}, equality rows {:?}, coarse {}",
+        dec.n_subdomains(),
+        dec.n_primal(),
+        dec.n_equality(),
+        dec.coarse_dim()
+    );
+    assert!(dec.n_subdomains() >= subdomains);
+    let normal = sc.solve(model, 0.0, &pdas, None, None, None).expect("pdas frictionless");
+    let gc = sc.geometry().slip_bounds_from_pressure(&normal.solution.lambda_n);
+    let mut last = [0.0; 3];
+    for (case, slip, t) in [("frictionless", None, 0.0), ("tresca", Some(gc.as_slice()), shift)] {
+        let prev = slip.map(|_| normal.displacement.as_slice());
+        let solve = |s: &dyn ContactSolver| -> StaticContactResult<D> {
+            sc.solve(model, t, s, slip, prev, None)
+                .unwrap_or_else(|e| panic!("{name} {case} {}: {e}", s.name()))
+        };
+        let direct = solve(&pdas);
+        let feti = solve(&tfeti);
+        let du = rel(&direct.solution.u, &feti.solution.u);
+        let dn = rel(&direct.solution.lambda_n, &feti.solution.lambda_n);
+        let dt = if slip.is_some() { rel(&direct.solution.lambda_t, &feti.solution.lambda_t) } else { 0.0 };
+        let r = &feti.solution.report;
+        println!(
+            "{name} {case}: TFETI vs PDAS: U {du:.2e}, Λn {dn:.2e}, Λt {dt:.2e}; SMALBE {} outer, {} inner, {} F products; active {}, stick {}, slip {}",
+            r.iterations, r.inner_iterations, r.linear_solves, r.active, r.stick, r.slip
+        );
+        println!("{name} {case}: TFETI KKT {:?}", feti.kkt);
+        assert!(feti.kkt.satisfied(1e-8), "{name} {case}: KKT {:?}", feti.kkt);
+        if slip.is_some() {
+            assert!(r.stick > 0 && r.slip > 0, "{name}: needs stick and slip cells");
+        }
+        assert!(du <= 1e-6 && dn <= 1e-6 && dt <= 1e-6, "{name} {case}: {du:e} {dn:e} {dt:e}");
+        last = [du, dn, dt];
+    }
+    last
+}
+
+#[test]
+fn tfeti_equals_pdas_on_2d_hertz_with_friction() {
+    let p = Hertz2d { levels: 6, e2: Some(1.0), push: 0.02, ..Default::default() };
+    let (model, mut pairs) = hertz2d_model(&p).expect("model");
+    pairs[0].friction = 0.3;
+    compare("hertz2d", &model, &pairs, 8, 0.004);
+}
+
+#[test]
+fn tfeti_equals_pdas_on_3d_hertz_with_friction() {
+    let p = Hertz3d { n: 3, levels: 7, ..Default::default() };
+    let (model, mut pairs) = hertz3d_model(&p).expect("model");
+    pairs[0].friction = 0.3;
+    compare("hertz3d", &model, &pairs, 8, 0.002);
+}
