@@ -67,6 +67,7 @@ pub use synovia_io as io;
 pub use synovia_linalg as linalg;
 pub use synovia_material as material;
 pub use synovia_mesh as mesh;
+pub use synovia_nonlinear as nonlinear;
 pub use synovia_pdas as pdas;
 pub use synovia_time as time;
 pub use synovia_uzawa as uzawa;

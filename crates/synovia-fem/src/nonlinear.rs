@@ -331,6 +331,50 @@ pub fn assemble_tangent<const D: usize>(
     Ok(())
 }
 
+/// Subtracts the tangent's action on a change of the prescribed displacements:
+/// `rhs −= Pᵀ K_T(u) Δu_p` with `Δu_p` given per dof group (`delta_lifts`, as
+/// [`DofMap::lifts`]): the linearised response of the free unknowns to a new boundary
+/// displacement (the predictor of a load level, so that a jump of the prescribed displacement
+/// is not applied to the boundary nodes alone).
+///
+/// # Errors
+/// As [`internal_force`]; [`FemError::Length`] for `delta_lifts` of the wrong length.
+pub fn subtract_tangent_lift<const D: usize>(
+    model: &Model<D>,
+    dofs: &DofMap<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+    delta_lifts: &[Vector<D>],
+    rhs: &mut [Real],
+) -> Result<(), FemError> {
+    check_kinematics(model, kinematics, displacement)?;
+    if delta_lifts.len() != dofs.groups().len() {
+        return Err(FemError::Length {
+            what: "lift changes (one per dof group)",
+            expected: dofs.groups().len(),
+            got: delta_lifts.len(),
+        });
+    }
+    let failed = std::cell::Cell::new(None::<(usize, usize, ElementFailure)>);
+    crate::assembly::subtract_lift(model, dofs, delta_lifts, rhs, |b, c, geo, out| {
+        let n = D * (D + 1);
+        let mut ue = [0.0; 12];
+        let mut fe = [0.0; 12];
+        cell_displacement(model, b, c, displacement, &mut ue[..n]);
+        let material = model.bodies()[b].material.as_ref();
+        if let Err(e) = element_response(geo, material, kinematics[b], &ue[..n], &mut fe[..n], Some(out)) {
+            out.iter_mut().for_each(|v| *v = 0.0);
+            if failed.get().is_none() {
+                failed.set(Some((b, c, e)));
+            }
+        }
+    })?;
+    if let Some((b, c, e)) = failed.get() {
+        return Err(failure(model, b, c, e));
+    }
+    Ok(())
+}
+
 /// Per cell of every body: the strain measure `e` (small-strain `ε` or Green–Lagrange `E`),
 /// the stress (small strain: `τ`; finite strain: the Cauchy stress `σ = J⁻¹ F S Fᵀ`) and
 /// `det F`, all Voigt (strain with engineering shear, stress plain).

@@ -25,6 +25,12 @@
 //! finite strain the contact geometry is rebuilt on the deformed configuration `x + u_k` at
 //! every iteration (re-pairing, normals, gaps in total form).
 //!
+//! **Predictor**: a level starts from the converged state with its own prescribed
+//! displacements; the first iteration adds the change `Δu_p` of the prescribed displacements
+//! through the tangent, `F̄ −= Pᵀ K_T Δu_p`, so the new boundary displacement is spread into the
+//! body by the linearised problem instead of being imposed on the boundary nodes alone (which
+//! inverts the boundary layer of elements on fine meshes).
+//!
 //! **Convergence** is measured on the equilibrium residual
 //! `R = F_ext − F_int(u_{k+1}) − c_{k+1}` with the contact forces `c = F̄ − K_T ũ*` of the
 //! linearised solve, relative to the largest of `‖F_ext‖`, `‖F_int‖`, `‖c‖` and the residual at
@@ -47,7 +53,7 @@ use std::time::Instant;
 use synovia_contact::operators::{ContactGeometry, ContactPair};
 use synovia_contact::{ContactError, ContactSolution, ContactSolver, StaticContact, StaticContactResult};
 use synovia_fem::assembly::add_loads;
-use synovia_fem::nonlinear::{assemble_tangent, internal_force};
+use synovia_fem::nonlinear::{assemble_tangent, internal_force, subtract_tangent_lift};
 use synovia_fem::{DofMap, ElasticParams, FemError, Kinematics, Model};
 use synovia_mesh::math::{Real, Vector};
 
@@ -114,6 +120,11 @@ impl NewtonParams {
     /// Sets [`Self::line_search`].
     pub fn with_line_search(mut self, line_search: bool) -> Self {
         self.line_search = line_search;
+        self
+    }
+    /// Sets [`Self::load_degree`].
+    pub fn with_load_degree(mut self, load_degree: usize) -> Self {
+        self.load_degree = load_degree;
         self
     }
     /// Sets [`Self::max_cutbacks`].
@@ -407,7 +418,15 @@ impl<const D: usize> NonlinearContact<D> {
         let mut f_ext = vec![0.0; n];
         add_loads(model, &self.dofs, t, self.params.load_degree, &mut f_ext)?;
         let mut u = self.state.reduced.clone();
-        let mut disp = self.dofs.expand(&u, &lifts)?;
+        // the converged state (the undeformed reference before the first level): the new
+        // prescribed displacements enter through the predictor of the first iteration
+        let lifts_old = match self.state.result {
+            Some(_) => self.dofs.lifts(model, self.state.time)?,
+            None => vec![Vector::<D>::zeros(); lifts.len()],
+        };
+        let delta_lifts: Vec<Vector<D>> = lifts.iter().zip(&lifts_old).map(|(a, b)| a - b).collect();
+        let mut predictor = delta_lifts.iter().any(|d| d.norm_squared() > 0.0);
+        let mut disp = self.dofs.expand(&u, &lifts_old)?;
         let (mut f_int, _) = internal_force(model, &self.dofs, &self.kinematics, &disp)?;
         let mut c = self.state.contact_force.clone();
         // friction frozen from the committed state (none from the reference configuration)
@@ -426,7 +445,7 @@ impl<const D: usize> NonlinearContact<D> {
         let mut r_norm = norm(&residual_of(&f_int, &c));
         // the force scale of the level: its initial residual (e.g. the forces of a prescribed
         // displacement's jump, which leave the reduced rows once balanced)
-        let r_start = r_norm;
+        let mut r_start = r_norm;
         let mut iterations = Vec::new();
         for _ in 0..self.params.max_iterations {
             report.total_iterations += 1;
@@ -440,7 +459,13 @@ impl<const D: usize> NonlinearContact<D> {
             let k = self.contact.elastic().stiffness();
             let mut ku = vec![0.0; n];
             k.mul_vec(&u, &mut ku);
-            let load: Vec<Real> = (0..n).map(|i| f_ext[i] - f_int[i] + ku[i]).collect();
+            let mut load: Vec<Real> = (0..n).map(|i| f_ext[i] - f_int[i] + ku[i]).collect();
+            if predictor {
+                let before = load.clone();
+                subtract_tangent_lift(model, &self.dofs, kin, at, &delta_lifts, &mut load)?;
+                let lift_force: Vec<Real> = (0..n).map(|i| load[i] - before[i]).collect();
+                r_start = r_start.max(norm(&lift_force));
+            }
             let rows = self.contact.geometry().len();
             let warm_start = warm.as_ref().filter(|w| w.lambda_n.len() == rows);
             let result = self.contact.solve_load(
@@ -466,6 +491,7 @@ impl<const D: usize> NonlinearContact<D> {
                     Ok((f_try, e_try)) => {
                         let r_try = norm(&residual_of(&f_try, &c_try));
                         if !self.params.line_search
+                            || predictor
                             || r_try <= (1.0 - 1e-4 * alpha) * r_norm
                             || alpha < 1.0 / 64.0
                         {
@@ -490,6 +516,7 @@ impl<const D: usize> NonlinearContact<D> {
                 });
             };
             let increment = alpha * norm(&delta) / norm(&u_new).max(Real::MIN_POSITIVE);
+            predictor = false;
             u = u_new;
             c = c_new;
             disp = disp_new;
