@@ -48,11 +48,12 @@ use synovia_contact::{
     ContactError, ContactParams, ContactSolution, ContactSolver, FrictionLaw, KktReport, StaticContact,
     StaticContactResult,
 };
-use synovia_fem::{BodyId, ComponentMask, ElasticParams, ElasticSolver, FemError, Model};
+use synovia_fem::{BodyId, ComponentMask, ElasticParams, ElasticSolver, FemError, Kinematics, Model};
 use synovia_io::IoError;
 use synovia_material::{KelvinVoigt, LinearElastic, Material, MaterialError};
 use synovia_mesh::math::{Point, Real, Vector};
 use synovia_mesh::{BoundaryKind, Mesh, MeshError};
+use synovia_nonlinear::{NewtonParams, NonlinearContact};
 use synovia_time::dynamic::{DynamicBody, DynamicParams, DynamicStepper};
 use synovia_time::history::{pressure, scaled, scaled_traction, LoadHistory, RigidMotion};
 use synovia_time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
@@ -87,6 +88,9 @@ pub enum JointError {
     /// An input/output error (Gmsh files, VTU output).
     #[error(transparent)]
     Io(#[from] IoError),
+    /// Nonlinear solve errors (Newton without convergence after the cut-backs, ...).
+    #[error(transparent)]
+    Nonlinear(#[from] synovia_nonlinear::NonlinearError),
     /// A part already has a kind that contradicts the requested condition.
     #[error("body `{body}`, part `{part}` is already of kind {current:?}; it cannot also be {requested:?}")]
     PartKind {
@@ -274,6 +278,8 @@ pub struct JointModel<const D: usize> {
     force_control: ForceControlParams,
     interface_block: synovia_linalg::InterfaceBlockParams,
     screening_band: Option<Real>,
+    kinematics: Vec<Kinematics>,
+    newton: NewtonParams,
 }
 
 impl<const D: usize> fmt::Debug for JointModel<D> {
@@ -346,6 +352,8 @@ impl<const D: usize> JointModel<D> {
             force_control: ForceControlParams::default(),
             interface_block: synovia_linalg::InterfaceBlockParams::default(),
             screening_band: None,
+            kinematics: Vec::new(),
+            newton: NewtonParams::default(),
         }
     }
 
@@ -548,6 +556,7 @@ impl<const D: usize> JointModel<D> {
         let id = self.model.add_body(name, mesh, material)?;
         self.dynamic.push(dynamic);
         self.initial_velocity.push(None);
+        self.kinematics.push(Kinematics::SmallStrain);
         Ok(id)
     }
 
@@ -944,6 +953,42 @@ impl<const D: usize> JointModel<D> {
         self.dynamic_params = params;
         self
     }
+    /// The kinematics of a body's strain (docs/model.md §2.3): [`Kinematics::SmallStrain`]
+    /// (default) or [`Kinematics::FiniteStrain`] (total Lagrangian, the contact geometry on
+    /// the deformed configuration). A model with a finite-strain body or a nonlinear material
+    /// (no [`Material::linear_stiffness`], e.g. [`synovia_material::neo_hookean`]) is solved by
+    /// the Newton iteration of [`synovia_nonlinear`] (static and quasi-static analyses).
+    ///
+    /// # Errors
+    /// Unknown body.
+    pub fn set_kinematics(
+        &mut self,
+        body: impl BodyRef,
+        kinematics: Kinematics,
+    ) -> Result<&mut Self, JointError> {
+        let id = body.resolve(&self.model)?;
+        self.kinematics[id.0] = kinematics;
+        Ok(self)
+    }
+
+    /// The kinematics of every body.
+    pub fn kinematics(&self) -> &[Kinematics] {
+        &self.kinematics
+    }
+
+    /// Parameters of the Newton iteration of nonlinear models ([`NewtonParams`]).
+    pub fn newton_params(&mut self, params: NewtonParams) -> &mut Self {
+        self.newton = params;
+        self
+    }
+
+    /// `true` if a body has a nonlinear material or finite-strain kinematics: the model is then
+    /// solved by the Newton iteration of [`synovia_nonlinear`].
+    pub fn is_nonlinear(&self) -> bool {
+        self.kinematics.contains(&Kinematics::FiniteStrain)
+            || self.model.bodies().iter().any(|b| b.material.linear_stiffness().is_none())
+    }
+
     /// Nested iteration for cold starts of static and quasi-static contact solves
     /// ([`StaticContact::set_nested_iteration`]; default `Some(32)`).
     pub fn nested_iteration(&mut self, min_rows: Option<usize>) -> &mut Self {
@@ -1101,6 +1146,11 @@ impl<const D: usize> JointModel<D> {
     /// solver.
     pub fn prepare(&self) -> Result<JointSession<'_, D>, JointError> {
         self.check_penetration_policy()?;
+        if self.is_nonlinear() {
+            return Err(JointError::Invalid(
+                "re-solve sessions need a linear model: nonlinear materials and finite strain are solved by run_static / run_quasistatic".into(),
+            ));
+        }
         JointSession::new(self)
     }
 
@@ -1131,6 +1181,9 @@ impl<const D: usize> JointModel<D> {
         self.model.validate()?;
         let solver = self.build_solver()?;
         let n_steps = times.len();
+        if self.is_nonlinear() {
+            return self.run_nonlinear_levels(times, solver.as_ref(), start, observer);
+        }
         if self.pairs.is_empty() {
             return self.run_elastic(times, solver.name(), start, observer);
         }
@@ -1176,6 +1229,101 @@ impl<const D: usize> JointModel<D> {
             setup_s,
             total_s: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// The levels of a nonlinear model (nonlinear materials or finite strain): the Newton
+    /// iteration of [`synovia_nonlinear::NonlinearContact`] with load stepping and cut-back,
+    /// Tresca friction frozen per level (docs/model.md §2.3, §8).
+    fn run_nonlinear_levels(
+        &self,
+        times: &[Real],
+        solver: &dyn ContactSolver,
+        start: Instant,
+        mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
+    ) -> Result<RunResult<D>, JointError> {
+        check_levels(times)?;
+        if !self.rigid_bodies.is_empty() {
+            return Err(JointError::Invalid(
+                "rigid bodies (mixed control) are not supported with nonlinear materials or finite strain yet; \
+                 prescribe the partner's motion or use a linear material"
+                    .into(),
+            ));
+        }
+        if !self.friction_laws.is_empty() {
+            return Err(JointError::Invalid(
+                "friction laws other than a constant coefficient are not supported with nonlinear materials or finite strain yet"
+                    .into(),
+            ));
+        }
+        let mut nl = NonlinearContact::new(
+            &self.model,
+            &self.pairs,
+            &self.kinematics,
+            self.elastic_params,
+            self.newton,
+        )?;
+        // the reference configuration before the first level (the same start as the linear
+        // quasi-static scheme's first level, which is solved from the undeformed body)
+        let t0 = times.first().copied().unwrap_or(0.0).min(0.0);
+        nl.reset(t0);
+        let setup_s = start.elapsed().as_secs_f64();
+        let n_dofs = nl.dofs().n_dofs();
+        let mut records = Vec::with_capacity(times.len());
+        let mut last = None;
+        for (step, &t) in times.iter().enumerate() {
+            let t_step = Instant::now();
+            let level = nl.step_to(&self.model, t, solver)?;
+            let geometry = nl.geometry();
+            let record = StepRecord {
+                step,
+                time: t,
+                pairs: synovia_time::results::pair_records(geometry, &level.contact),
+                strain_energy: level.strain_energy,
+                iterations: level.report.total_iterations,
+                step_s: t_step.elapsed().as_secs_f64(),
+                solver: level.contact.solution.report.solver.clone(),
+                fallback: level.contact.solution.report.fallback.clone(),
+                ..Default::default()
+            };
+            tracing::debug!(
+                newton = level.report.iterations.len(),
+                cutbacks = level.report.cutbacks,
+                residual = level.report.residual(),
+                "nonlinear level"
+            );
+            observer(&StepView {
+                model: &self.model,
+                geometry,
+                record: &record,
+                result: &level.contact,
+                n_steps: times.len(),
+            })?;
+            records.push(record);
+            last = Some(level.contact);
+        }
+        Ok(RunResult {
+            records,
+            displacement: last.as_ref().map(|r| r.displacement.clone()).unwrap_or_default(),
+            contact: if self.pairs.is_empty() { None } else { last },
+            n_dofs,
+            contact_nodes: nl.geometry().len(),
+            solver: solver.name().to_string(),
+            setup_s,
+            total_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The dynamic scheme for a nonlinear model — not available yet.
+    fn run_nonlinear_dynamic(
+        &self,
+        _dt: Real,
+        _steps: usize,
+        _start: Instant,
+        _observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
+    ) -> Result<RunResult<D>, JointError> {
+        Err(JointError::Invalid(
+            "the dynamic analysis of nonlinear materials or finite strain is not available yet; use a static or quasi-static analysis".into(),
+        ))
     }
 
     /// The levels of a model with rigid bodies: each level poses them and finds their
@@ -1281,6 +1429,9 @@ impl<const D: usize> JointModel<D> {
     ) -> Result<RunResult<D>, JointError> {
         let start = Instant::now();
         self.model.validate()?;
+        if self.is_nonlinear() {
+            return self.run_nonlinear_dynamic(dt, steps, start, observer);
+        }
         let solver = self.build_solver()?;
         let mut bodies = Vec::with_capacity(self.dynamic.len());
         for (body, data) in self.model.bodies().iter().zip(&self.dynamic) {

@@ -521,6 +521,7 @@ fn run_dim<const D: usize>(
     let mut contact_nodes = 0;
     let mut first_step_at: Option<f64> = None;
     let mut interrupted = false;
+    let kinematics = built.joint.kinematics().to_vec();
     let result = built.joint.run_with(|view| {
         let index = steps.len();
         if first_step_at.is_none() {
@@ -531,7 +532,8 @@ fn run_dim<const D: usize>(
             if writer.is_none() {
                 writer = Some(
                     QuasiStaticOutput::with_encoding(folder.dir(), &name, view.geometry, plan.encoding)?
-                        .with_solid_fields(plan.stress),
+                        .with_solid_fields(plan.stress)
+                        .with_kinematics(kinematics.clone()),
                 );
             }
             match writer.as_mut() {

@@ -134,9 +134,25 @@ pub fn body_fields<const D: usize>(
     model: &Model<D>,
     displacement: &[Vec<Vector<D>>],
 ) -> Result<Vec<BodyFields>, FemError> {
+    body_fields_with_kinematics(model, displacement, &[])
+}
+
+/// [`body_fields`] with the kinematics of each body (`kinematics[body]`; missing entries are
+/// small strain): for a finite-strain body the strain is the Green–Lagrange strain
+/// `E = ½(FᵀF − I)` and the stress the Cauchy stress `σ = J⁻¹ F S Fᵀ` (in 2D, `σ_zz = S_zz / J`),
+/// and the energy `Σ_T |T| W(E)` on the reference cells (docs/model.md §2.3).
+///
+/// # Errors
+/// As [`body_fields`]; [`FemError::InvertedElement`] for a cell with `det F ≤ 0`.
+pub fn body_fields_with_kinematics<const D: usize>(
+    model: &Model<D>,
+    displacement: &[Vec<Vector<D>>],
+    kinematics: &[crate::Kinematics],
+) -> Result<Vec<BodyFields>, FemError> {
     check_displacement(model, displacement)?;
     let mut out = Vec::with_capacity(model.bodies().len());
-    for (body, u) in model.bodies().iter().zip(displacement) {
+    for (bi, (body, u)) in model.bodies().iter().zip(displacement).enumerate() {
+        let finite = kinematics.get(bi) == Some(&crate::Kinematics::FiniteStrain);
         let nc = body.mesh.n_cells();
         let mut f = BodyFields {
             cell_strain: Vec::with_capacity(nc),
@@ -160,9 +176,22 @@ pub fn body_fields<const D: usize>(
                     ue[D * a + i] = u[n][i];
                 }
             }
-            let eps = DVector::from_vec(voigt_strain::<D>(&geo.displacement_gradient(&ue)));
-            let sig = body.material.stress(&eps);
-            let szz = if D == 2 { body.material.out_of_plane_stress(&eps) } else { 0.0 };
+            let grad_u = geo.displacement_gradient(&ue);
+            let (eps, sig, szz) = if finite {
+                let e = crate::nonlinear::strain_measure::<D>(crate::Kinematics::FiniteStrain, &grad_u);
+                let e = DVector::from_vec(e);
+                let s = body.material.stress(&e);
+                let det_f = synovia_mesh::math::det(&(synovia_mesh::math::Tensor::<D>::identity() + grad_u));
+                let sigma = crate::nonlinear::cauchy_stress::<D>(&grad_u, s.as_slice())
+                    .ok_or_else(|| FemError::InvertedElement { body: body.name.clone(), cell: c, det_f })?;
+                let szz = if D == 2 { body.material.out_of_plane_stress(&e) / det_f } else { 0.0 };
+                (e, DVector::from_vec(sigma), szz)
+            } else {
+                let eps = DVector::from_vec(voigt_strain::<D>(&grad_u));
+                let sig = body.material.stress(&eps);
+                let szz = if D == 2 { body.material.out_of_plane_stress(&eps) } else { 0.0 };
+                (eps, sig, szz)
+            };
             f.strain_energy += geo.measure * body.material.energy_density(&eps);
             let vm = von_mises(sig.as_slice(), szz);
             for &n in body.mesh.cell(c) {

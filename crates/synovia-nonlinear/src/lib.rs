@@ -39,8 +39,10 @@
 //! **Line search**: a backtracking (Armijo) search on `‖R‖` along `(δũ, δc)`; an iterate with an
 //! inverted element is a failed trial. **Load stepping with cut-back**: a level whose Newton
 //! iteration fails (no convergence, an inverted element, a failed contact solve) is bisected
-//! in time (histories evaluated at the intermediate times) up to
-//! [`NewtonParams::max_cutbacks`] times.
+//! up to [`NewtonParams::max_cutbacks`] times: in time from a converged level (histories
+//! evaluated at the intermediate times), and in a load factor `s` that scales every load and
+//! prescribed displacement of the level (`s F_ext(t)`, `s u_p(t)`) for the first level, which
+//! starts from the undeformed reference configuration.
 //!
 //! The matrix changes every iteration, so each iteration refactorises `K_T` numerically
 //! ([`StaticContact::refactorise`]): the symbolic analysis and the interface ordering are done
@@ -202,6 +204,8 @@ pub struct NonlinearResult<const D: usize> {
 #[derive(Debug, Clone)]
 struct State<const D: usize> {
     time: Real,
+    /// Load factor of the state (0 for the reference configuration, 1 for a converged level).
+    scale: Real,
     reduced: Vec<Real>,
     /// Reduced contact forces `c` (for the line search's merit).
     contact_force: Vec<Real>,
@@ -261,7 +265,13 @@ impl<const D: usize> NonlinearContact<D> {
             pairs: pairs.to_vec(),
             kinematics: kinematics.to_vec(),
             params,
-            state: State { time: 0.0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None },
+            state: State {
+                time: 0.0,
+                scale: 0.0,
+                reduced: vec![0.0; n],
+                contact_force: vec![0.0; n],
+                result: None,
+            },
         })
     }
 
@@ -298,15 +308,16 @@ impl<const D: usize> NonlinearContact<D> {
     /// Back to the unloaded reference configuration at time `t0`.
     pub fn reset(&mut self, t0: Real) {
         let n = self.dofs.n_dofs();
-        self.state = State { time: t0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None };
+        self.state =
+            State { time: t0, scale: 0.0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None };
     }
 
     fn finite_strain(&self) -> bool {
         self.kinematics.contains(&Kinematics::FiniteStrain)
     }
 
-    /// Solves the level `t` from the converged state, halving the step in time on failure
-    /// (module docs), and commits the new state. Friction: Tresca with the slip bounds
+    /// Solves the level `t` from the converged state, halving the step (in time, or in the
+    /// load factor for the first level) on failure (module docs), and commits the new state. Friction: Tresca with the slip bounds
     /// `g_c = F_c |Λ_n|` of the state each sub-level starts from (Coulomb frozen per level,
     /// docs/model.md §3), slip measured from that state; the first level from the reference
     /// configuration is frictionless.
@@ -329,16 +340,29 @@ impl<const D: usize> NonlinearContact<D> {
         }
         let start = Instant::now();
         let mut report = NewtonReport::default();
-        let mut target = t;
+        // the path to the level, parametrised by `frac ∈ (0, 1]`: from a converged level, the
+        // time from the state's time to `t`; from the reference configuration (or a partial
+        // ramp), the load factor from the state's to 1 at the time `t`
+        let from_time = self.state.time;
+        let from_scale = self.state.scale;
+        let ramp = from_scale < 1.0;
+        let point = |frac: Real| -> (Real, Real) {
+            if ramp {
+                (t, from_scale + frac * (1.0 - from_scale))
+            } else {
+                (from_time + frac * (t - from_time), 1.0)
+            }
+        };
+        let (mut done, mut target) = (0.0, 1.0);
         let mut halvings = 0usize;
         loop {
-            let from = self.state.time;
-            match self.newton(model, target, solver, &mut report) {
+            let (time, scale) = point(target);
+            match self.newton(model, time, scale, solver, &mut report) {
                 Ok((result, energy, iterations, reduced, force)) => {
                     report.sublevels += 1;
                     self.state =
-                        State { time: target, reduced, contact_force: force, result: Some(result.clone()) };
-                    if target >= t {
+                        State { time, scale, reduced, contact_force: force, result: Some(result.clone()) };
+                    if target >= 1.0 {
                         report.iterations = iterations;
                         report.time_s = start.elapsed().as_secs_f64();
                         return Ok(NonlinearResult {
@@ -348,7 +372,8 @@ impl<const D: usize> NonlinearContact<D> {
                             report,
                         });
                     }
-                    target = t;
+                    done = target;
+                    target = 1.0;
                 }
                 Err(e) => {
                     let recoverable = matches!(
@@ -359,7 +384,7 @@ impl<const D: usize> NonlinearContact<D> {
                             | NonlinearError::Fem(FemError::Linalg(_))
                     );
                     if !recoverable || halvings >= self.params.max_cutbacks {
-                        let step = target - from;
+                        let step = target - done;
                         return Err(match e {
                             NonlinearError::NoConvergence { reason, .. } => {
                                 NonlinearError::NoConvergence { time: t, cutbacks: halvings, step, reason }
@@ -375,8 +400,8 @@ impl<const D: usize> NonlinearContact<D> {
                     }
                     halvings += 1;
                     report.cutbacks += 1;
-                    target = from + 0.5 * (target - from);
-                    tracing::debug!(target, "cut-back");
+                    target = done + 0.5 * (target - done);
+                    tracing::debug!(target, ramp, "cut-back");
                 }
             }
         }
@@ -403,26 +428,30 @@ impl<const D: usize> NonlinearContact<D> {
         Ok(out)
     }
 
-    /// Newton's method at `t` from the committed state; nothing is committed.
+    /// Newton's method at `t` with the loads and prescribed displacements scaled by `scale`,
+    /// from the committed state; nothing is committed.
     #[allow(clippy::type_complexity)]
     fn newton(
         &mut self,
         model: &Model<D>,
         t: Real,
+        scale: Real,
         solver: &dyn ContactSolver,
         report: &mut NewtonReport,
     ) -> Result<(StaticContactResult<D>, Real, Vec<NewtonIteration>, Vec<Real>, Vec<Real>), NonlinearError>
     {
         let n = self.dofs.n_dofs();
-        let lifts = self.dofs.lifts(model, t)?;
+        let lifts: Vec<Vector<D>> = self.dofs.lifts(model, t)?.into_iter().map(|l| l * scale).collect();
         let mut f_ext = vec![0.0; n];
         add_loads(model, &self.dofs, t, self.params.load_degree, &mut f_ext)?;
+        f_ext.iter_mut().for_each(|f| *f *= scale);
         let mut u = self.state.reduced.clone();
         // the converged state (the undeformed reference before the first level): the new
         // prescribed displacements enter through the predictor of the first iteration
-        let lifts_old = match self.state.result {
-            Some(_) => self.dofs.lifts(model, self.state.time)?,
-            None => vec![Vector::<D>::zeros(); lifts.len()],
+        let lifts_old: Vec<Vector<D>> = if self.state.scale > 0.0 {
+            self.dofs.lifts(model, self.state.time)?.into_iter().map(|l| l * self.state.scale).collect()
+        } else {
+            vec![Vector::<D>::zeros(); lifts.len()]
         };
         let delta_lifts: Vec<Vector<D>> = lifts.iter().zip(&lifts_old).map(|(a, b)| a - b).collect();
         let mut predictor = delta_lifts.iter().any(|d| d.norm_squared() > 0.0);

@@ -469,6 +469,21 @@ fn add_body<'a, const D: usize>(
         let rho = cx.positive(d, &dk)?;
         joint.set_density(id, rho).map_err(|e| cx.err(dk, d.span(), e.to_string()))?;
     }
+    if let Some(kin) = &b.kinematics {
+        let kk = key(k, "kinematics");
+        let value = match kin.get_ref().as_str() {
+            "small" => synovia::fem::Kinematics::SmallStrain,
+            "finite" => synovia::fem::Kinematics::FiniteStrain,
+            other => {
+                return Err(cx.err(
+                    kk,
+                    kin.span(),
+                    format!("`kinematics` is `small` or `finite`, got `{other}`"),
+                ))
+            }
+        };
+        joint.set_kinematics(id, value).map_err(|e| cx.err(kk, kin.span(), e.to_string()))?;
+    }
     if let Some(v) = &b.initial_velocity {
         let vk = key(k, "initial_velocity");
         let v0 = cx.vector::<D>(v, &vk)?;
@@ -978,7 +993,8 @@ fn material<const D: usize>(
     let present = present!(m;
         "E" => e, "nu" => nu, "plane" => plane, "E_p" => e_p, "nu_p" => nu_p, "E_a" => e_a,
         "nu_ap" => nu_ap, "G_a" => g_a, "axis" => axis, "C" => c, "elastic" => elastic,
-        "viscous" => viscous, "density" => density, "damping" => damping,
+        "viscous" => viscous, "density" => density, "damping" => damping, "c1" => c1, "c2" => c2,
+        "lambda" => lambda,
     );
     let plane_stress_wanted = || -> R<bool> {
         match &m.plane {
@@ -1063,6 +1079,28 @@ fn material<const D: usize>(
                 ));
             }
         }
+        "neo_hookean" | "mooney_rivlin" => {
+            if m.plane.as_ref().is_some_and(|p| p.get_ref() != "strain") {
+                let p = m.plane.as_ref().map(|p| p.span()).unwrap_or(span.clone());
+                return Err(cx.err(key(k, "plane"), p, "hyperelastic laws are in plane strain in 2D (`plane = \"strain\"`)"));
+            }
+            if D == 2 {
+                plane_stress_wanted()?;
+            }
+            let law: Arc<dyn Material<D>> = if kind == "neo_hookean" {
+                cx.only(k, &present, &["E", "nu", "plane"], why)?;
+                let e = cx.positive(cx.req(&m.e, k, "E", &span, why)?, &key(k, "E"))?;
+                let nu = cx.finite(cx.req(&m.nu, k, "nu", &span, why)?, &key(k, "nu"))?;
+                Arc::new(synovia::material::neo_hookean(e, nu).map_err(mat_err)?)
+            } else {
+                cx.only(k, &present, &["c1", "c2", "lambda", "plane"], why)?;
+                let c1 = cx.non_negative(cx.req(&m.c1, k, "c1", &span, why)?, &key(k, "c1"))?;
+                let c2 = cx.non_negative(cx.req(&m.c2, k, "c2", &span, why)?, &key(k, "c2"))?;
+                let lambda = cx.non_negative(cx.req(&m.lambda, k, "lambda", &span, why)?, &key(k, "lambda"))?;
+                Arc::new(synovia::material::mooney_rivlin(c1, c2, lambda).map_err(mat_err)?)
+            };
+            return Ok(BodyMaterial::Elastic(law));
+        }
         "kelvin_voigt" => {
             if !allow_kv {
                 return Err(cx.err(key(k, "type"), m.kind.span(), "a kelvin_voigt material cannot be nested"));
@@ -1086,7 +1124,7 @@ fn material<const D: usize>(
             return Err(cx.err(
                 key(k, "type"),
                 m.kind.span(),
-                format!("unknown material type `{other}` (isotropic, transversely_isotropic, anisotropic, kelvin_voigt)"),
+                format!("unknown material type `{other}` (isotropic, transversely_isotropic, anisotropic, kelvin_voigt, neo_hookean, mooney_rivlin)"),
             ))
         }
     };

@@ -350,6 +350,8 @@ pub struct BodySpec {
     pub initial_velocity: Option<Sp<Vec<f64>>>,
     /// Body force `h(t) value` per unit volume.
     pub body_force: Option<Sp<LoadSpec>>,
+    /// Strain kinematics: `small` (default) or `finite` (total Lagrangian; docs/model.md §2.3).
+    pub kinematics: Option<Sp<String>>,
     /// Extra boundary parts selected geometrically (`[[body.part]]`).
     #[serde(default, rename = "part")]
     pub parts: Vec<Sp<PartSpec>>,
@@ -427,7 +429,8 @@ pub struct ReflectSpec {
 #[serde(deny_unknown_fields)]
 #[allow(missing_docs)]
 pub struct MaterialSpec {
-    /// `isotropic`, `transversely_isotropic`, `anisotropic`, `kelvin_voigt`.
+    /// `isotropic`, `transversely_isotropic`, `anisotropic`, `kelvin_voigt`, `neo_hookean`,
+    /// `mooney_rivlin`.
     #[serde(rename = "type")]
     pub kind: Sp<String>,
     #[serde(rename = "E")]
@@ -450,6 +453,10 @@ pub struct MaterialSpec {
     pub viscous: Option<Sp<Box<MaterialSpec>>>,
     pub density: Option<Sp<f64>>,
     pub damping: Option<Sp<f64>>,
+    /// Mooney–Rivlin `c₁`, `c₂` and the volumetric `λ`.
+    pub c1: Option<Sp<f64>>,
+    pub c2: Option<Sp<f64>>,
+    pub lambda: Option<Sp<f64>>,
 }
 
 /// A boundary part selected geometrically among the boundary facets (or among the facets of

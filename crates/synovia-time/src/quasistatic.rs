@@ -100,7 +100,7 @@ use synovia_contact::{
     slip_speeds, ContactError, ContactSolution, ContactSolver, FrictionLaw, PairFrictionLaws, SolverReport,
     StaticContact, StaticContactResult,
 };
-use synovia_fem::post::body_fields;
+
 use synovia_fem::{BodyId, ElasticParams, Model};
 use synovia_io::{Encoding, Field, TimeSeriesWriter, VtuWriter};
 use synovia_mesh::math::{Real, Vector};
@@ -1063,6 +1063,7 @@ pub struct QuasiStaticOutput<const D: usize> {
     encoding: Encoding,
     geometry: ContactGeometry<D>,
     solid_fields: bool,
+    kinematics: Vec<synovia_fem::Kinematics>,
 }
 
 impl<const D: usize> QuasiStaticOutput<D> {
@@ -1098,7 +1099,17 @@ impl<const D: usize> QuasiStaticOutput<D> {
             encoding,
             geometry: geometry.clone(),
             solid_fields: true,
+            kinematics: Vec::new(),
         })
+    }
+
+    /// The kinematics of each body (default: small strain): finite-strain bodies get the
+    /// Green–Lagrange strain and the Cauchy stress in their files
+    /// ([`synovia_fem::post::body_fields_with_kinematics`]).
+    #[must_use]
+    pub fn with_kinematics(mut self, kinematics: Vec<synovia_fem::Kinematics>) -> Self {
+        self.kinematics = kinematics;
+        self
     }
 
     /// Whether the `.vtu` files carry the stress and strain fields (default `true`; `false`:
@@ -1123,7 +1134,11 @@ impl<const D: usize> QuasiStaticOutput<D> {
     ) -> Result<PathBuf, TimeError> {
         let ContactFields { pressure, friction_traction: traction, stick } =
             contact_fields(model, &self.geometry, result)?;
-        let fields = if self.solid_fields { body_fields(model, &result.displacement)? } else { Vec::new() };
+        let fields = if self.solid_fields {
+            synovia_fem::post::body_fields_with_kinematics(model, &result.displacement, &self.kinematics)?
+        } else {
+            Vec::new()
+        };
         let mut vtu = VtuWriter::new(self.encoding);
         for (bi, body) in model.bodies().iter().enumerate() {
             let Some(u) = result.displacement.get(bi) else {
