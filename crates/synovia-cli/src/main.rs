@@ -3,6 +3,8 @@
 //! ```text
 //! synovia run SCENARIO.toml --out DIR    # solve; write DIR/NAME.pvd, NAME_*.vtu, NAME.csv, summary.json, manifest.json
 //! synovia check SCENARIO.toml            # build everything up to the solve, report sizes
+//! synovia run STUDY.toml --task-index I --tasks N   # task I of N of a [sweep] study: cases c ≡ I (mod N), each into DIR/case-NNNN
+//! synovia gather DIR… [--out table.csv]  # merge the summary.json of the cases into one CSV
 //! synovia -v run …                       # one log line per step; -vv: everything; -q: errors only
 //! ```
 //!
@@ -22,8 +24,9 @@ use std::sync::Arc;
 
 use clap::{ArgAction, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use synovia_cli::run::{self, Progress, RunError, RunOptions};
+use synovia_cli::run::{self, Progress, RunError, RunOptions, SweepSummary};
 use synovia_cli::Scenario;
+use synovia_scenario::sweep;
 use tracing::Level;
 use tracing_subscriber::fmt::format::{self, FormatEvent, FormatFields};
 use tracing_subscriber::fmt::FmtContext;
@@ -56,6 +59,29 @@ enum Command {
         /// kept; the outputs of earlier runs are always replaced).
         #[arg(long)]
         force: bool,
+        /// For a scenario with `[sweep]`: this task's 0-based index among `--tasks` (default:
+        /// `SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN`; without either, all cases run here).
+        /// The task runs the cases `c` with `c mod tasks = index`, each into the subfolder
+        /// `case-NNNN` of the output directory.
+        #[arg(long, requires = "tasks")]
+        task_index: Option<usize>,
+        /// For a scenario with `[sweep]`: the number of tasks (default:
+        /// `SLURM_ARRAY_TASK_COUNT`).
+        #[arg(long, requires = "task_index")]
+        tasks: Option<usize>,
+    },
+    /// Merge the summary.json of the case folders of a `[sweep]` study into one CSV (one row
+    /// per case, the swept values as columns); refuses missing or incomplete cases.
+    Gather {
+        /// Case folders, or folders holding them (e.g. the study's output directory).
+        #[arg(required = true)]
+        folders: Vec<PathBuf>,
+        /// Write the CSV here (default: standard output).
+        #[arg(long, short)]
+        out: Option<PathBuf>,
+        /// Gather the cases present even when some are missing.
+        #[arg(long)]
+        allow_missing: bool,
     },
     /// Build everything `run` builds before solving (model, ties, contact geometry, symbolic
     /// factorisation and its memory estimate) and report it, without solving.
@@ -152,7 +178,28 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Run { scenario, out, force } => {
+        Command::Gather { folders, out, allow_missing } => {
+            match synovia_cli::gather::gather(&folders, allow_missing) {
+                Ok(csv) => match &out {
+                    Some(path) => match std::fs::write(path, csv) {
+                        Ok(()) => ExitCode::SUCCESS,
+                        Err(e) => {
+                            eprintln!("error: cannot write `{}`: {e}", path.display());
+                            ExitCode::FAILURE
+                        }
+                    },
+                    None => {
+                        print!("{csv}");
+                        ExitCode::SUCCESS
+                    }
+                },
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Command::Run { scenario, out, force, task_index, tasks } => {
             let sc = match Scenario::from_file(&scenario) {
                 Ok(sc) => sc,
                 Err(e) => {
@@ -160,17 +207,6 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            let target = if !quiet && cli.verbose == 0 && std::io::stderr().is_terminal() {
-                ProgressDrawTarget::stderr()
-            } else {
-                ProgressDrawTarget::hidden()
-            };
-            let bar = ProgressBar::with_draw_target(None, target);
-            if let Ok(style) = ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} steps, ETA {eta}  {msg}",
-            ) {
-                bar.set_style(style);
-            }
             // Ctrl-C / SIGTERM: stop after the current step with a consistent folder; a second
             // signal exits at once
             let interrupt = Arc::new(AtomicBool::new(false));
@@ -182,10 +218,127 @@ fn main() -> ExitCode {
             }) {
                 eprintln!("warning: cannot catch Ctrl-C ({e}); an interrupted run leaves partial results");
             }
+            let cases = match sweep::cases(&sc) {
+                Ok(c) => c,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let Some(cases) = cases else {
+                if task_index.is_some() {
+                    eprintln!(
+                        "error: {}: --task-index/--tasks need a scenario with a [sweep] table (docs/scenario.md)",
+                        scenario.display()
+                    );
+                    return ExitCode::from(2);
+                }
+                let options = RunOptions { force, interrupt: Some(Arc::clone(&interrupt)), sweep: None };
+                return run_one(&sc, &scenario, out.as_deref(), &options, quiet, cli.verbose);
+            };
+            let (index, count) = match task_of(task_index, tasks) {
+                Ok(t) => t,
+                Err(m) => {
+                    eprintln!("error: {m}");
+                    return ExitCode::from(2);
+                }
+            };
+            let mine = match sweep::task_cases(cases.len(), index, count) {
+                Ok(m) => m,
+                Err(e) => {
+                    eprintln!("error: {}: {e}", scenario.display());
+                    return ExitCode::from(2);
+                }
+            };
+            let mut code = ExitCode::SUCCESS;
+            for c in mine {
+                let Some(case) = cases.get(c) else { continue };
+                let case_sc = match sweep::case_scenario(&sc, case) {
+                    Ok(s) => s,
+                    Err(e) => {
+                        eprintln!("error: {e}");
+                        return ExitCode::from(2);
+                    }
+                };
+                if !quiet {
+                    println!("case {} of {}: {}", c, cases.len(), sweep::describe(case));
+                }
+                let record = SweepSummary::of(case, cases.len());
+                let options =
+                    RunOptions { force, interrupt: Some(Arc::clone(&interrupt)), sweep: Some(record) };
+                let r = run_one(&case_sc, &scenario, out.as_deref(), &options, quiet, cli.verbose);
+                if r == ExitCode::from(130) {
+                    return r;
+                }
+                if r != ExitCode::SUCCESS {
+                    code = r;
+                }
+            }
+            code
+        }
+    }
+}
+
+/// This task's `(index, count)`: from the flags, else from Slurm's array variables
+/// (`SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN`, `SLURM_ARRAY_TASK_COUNT`), else `(0, 1)`
+/// (all cases in this process).
+fn task_of(index: Option<usize>, tasks: Option<usize>) -> Result<(usize, usize), String> {
+    if let (Some(i), Some(n)) = (index, tasks) {
+        return Ok((i, n));
+    }
+    let var = |name: &str| -> Result<Option<usize>, String> {
+        match std::env::var(name) {
+            Err(_) => Ok(None),
+            Ok(v) => v
+                .trim()
+                .parse::<usize>()
+                .map(Some)
+                .map_err(|_| format!("{name}=`{v}` is not a non-negative integer")),
+        }
+    };
+    match (var("SLURM_ARRAY_TASK_ID")?, var("SLURM_ARRAY_TASK_COUNT")?) {
+        (Some(id), Some(count)) => {
+            let min = var("SLURM_ARRAY_TASK_MIN")?.unwrap_or(0);
+            let i = id
+                .checked_sub(min)
+                .ok_or_else(|| format!("SLURM_ARRAY_TASK_ID={id} is below SLURM_ARRAY_TASK_MIN={min}"))?;
+            Ok((i, count))
+        }
+        (Some(_), None) => {
+            Err("SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; pass --task-index and --tasks"
+                .into())
+        }
+        _ => Ok((0, 1)),
+    }
+}
+
+/// Runs one scenario (a plain one, or one case of a sweep) with the progress bar and the
+/// report; returns the exit code.
+fn run_one(
+    sc: &Scenario,
+    scenario: &std::path::Path,
+    out: Option<&std::path::Path>,
+    options: &RunOptions,
+    quiet: bool,
+    verbose: u8,
+) -> ExitCode {
+    let Some(interrupt) = options.interrupt.as_ref() else { return ExitCode::FAILURE };
+    {
+        {
+            let target = if !quiet && verbose == 0 && std::io::stderr().is_terminal() {
+                ProgressDrawTarget::stderr()
+            } else {
+                ProgressDrawTarget::hidden()
+            };
+            let bar = ProgressBar::with_draw_target(None, target);
+            if let Ok(style) = ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} steps, ETA {eta}  {msg}",
+            ) {
+                bar.set_style(style);
+            }
             let stop_after =
                 std::env::var("SYNOVIA_STOP_AFTER_STEPS").ok().and_then(|v| v.parse::<usize>().ok());
-            let options = RunOptions { force, interrupt: Some(Arc::clone(&interrupt)) };
-            let result = run::run_with_options(&sc, out.as_deref(), &options, &mut |p| match p {
+            let result = run::run_with_options(sc, out, options, &mut |p| match p {
                 Progress::Start { steps } => bar.set_length(steps as u64),
                 Progress::Step { index, time } => {
                     bar.set_message(format!("t = {time:.4e}"));
@@ -247,11 +400,11 @@ fn main() -> ExitCode {
                     ExitCode::SUCCESS
                 }
                 Err(e @ RunError::Failed(_)) => {
-                    report_error(&scenario, &e);
+                    report_error(scenario, &e);
                     ExitCode::FAILURE
                 }
                 Err(e) => {
-                    report_error(&scenario, &e);
+                    report_error(scenario, &e);
                     ExitCode::from(2)
                 }
             }

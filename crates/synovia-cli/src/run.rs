@@ -260,6 +260,49 @@ pub struct Summary {
     pub warnings: Vec<String>,
     /// The unit labels of every figure (`[units]` of the scenario; default mm, N, s).
     pub units: UnitsSummary,
+    /// The sweep case this run is (runs of a `[sweep]` scenario only; `synovia gather` reads
+    /// it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<SweepSummary>,
+}
+
+/// One case of a parameter study (`[sweep]`, docs/scenario.md), as recorded in `summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct SweepSummary {
+    /// 0-based case index.
+    pub case: usize,
+    /// Number of cases of the sweep.
+    pub cases: usize,
+    /// The swept keys and this case's values, in the order of `[sweep.values]`.
+    pub parameters: Vec<SweepParameter>,
+}
+
+/// One swept key and its value in a case.
+#[derive(Debug, Clone, PartialEq, Serialize, serde::Deserialize)]
+pub struct SweepParameter {
+    /// Key path, e.g. `body[0].material.E`.
+    pub key: String,
+    /// The value (TOML value as JSON).
+    pub value: serde_json::Value,
+}
+
+impl SweepSummary {
+    /// The record of `case` of a sweep of `cases` cases.
+    pub fn of(case: &synovia_scenario::sweep::Case, cases: usize) -> Self {
+        let parameters = case
+            .parameters
+            .iter()
+            .map(|(k, v)| SweepParameter {
+                key: k.clone(),
+                value: serde_json::to_value(v).unwrap_or(serde_json::Value::Null),
+            })
+            .collect();
+        Self { case: case.index, cases, parameters }
+    }
+    /// The case's folder name inside the sweep's output directory: `case-NNNN`.
+    pub fn folder(&self) -> String {
+        format!("case-{:04}", self.case)
+    }
 }
 
 /// Options of [`run_with_options`].
@@ -271,6 +314,10 @@ pub struct RunOptions {
     /// Checked after every step: once `true`, the run stops there and writes a consistent
     /// folder (`summary.json` with `"interrupted": true`).
     pub interrupt: Option<Arc<AtomicBool>>,
+    /// The sweep case the scenario is (from [`synovia_scenario::sweep::case_scenario`]): the
+    /// run then writes into the subfolder [`SweepSummary::folder`] of the output directory and
+    /// records the case in `summary.json`.
+    pub sweep: Option<SweepSummary>,
 }
 
 /// What a successful run wrote.
@@ -511,6 +558,10 @@ fn run_dim<const D: usize>(
         (None, Some(d)) => d.clone(),
         (None, None) => PathBuf::from("out").join(&name),
     };
+    let out_dir = match &options.sweep {
+        Some(case) => out_dir.join(case.folder()),
+        None => out_dir,
+    };
     let mut folder = OutDir::prepare(&out_dir, &sc.source.file, &name, options.force)?;
     let plan = built.output.clone();
     let n_steps = built.analysis.n_records();
@@ -635,6 +686,7 @@ fn run_dim<const D: usize>(
         final_kkt,
         warnings,
         units: UnitsSummary::of(&built.units, D),
+        sweep: options.sweep.clone(),
     };
     let json = serde_json::to_string_pretty(&summary).map_err(anyhow::Error::new)?;
     folder.write(SUMMARY, (json + "\n").as_bytes())?;

@@ -248,7 +248,8 @@ fn library_interrupt_flag_and_refusal() {
     let out = dir.join("out");
     let sc = synovia_cli::Scenario::from_file(scenario(&dir, 3)).unwrap();
     // a flag raised before the run stops it after its first step
-    let options = RunOptions { force: false, interrupt: Some(Arc::new(AtomicBool::new(true))) };
+    let options =
+        RunOptions { force: false, interrupt: Some(Arc::new(AtomicBool::new(true))), ..Default::default() };
     let mut seen = Vec::new();
     let report = run_with_options(&sc, Some(&out), &options, &mut |p| seen.push(p)).unwrap();
     assert!(report.summary.interrupted);
@@ -260,7 +261,7 @@ fn library_interrupt_flag_and_refusal() {
     std::fs::write(out.join("report.pdf"), "x").unwrap();
     let err = run_with_options(&sc, Some(&out), &RunOptions::default(), &mut |_| {}).unwrap_err();
     assert!(matches!(&err, RunError::Refused(m) if m.contains("report.pdf")), "{err}");
-    let forced = RunOptions { force: true, interrupt: None };
+    let forced = RunOptions { force: true, interrupt: None, ..Default::default() };
     let report = run_with_options(&sc, Some(&out), &forced, &mut |_| {}).unwrap();
     assert!(!report.summary.interrupted && report.summary.steps.len() == 4);
     consistent(&out, &["report.pdf"]);

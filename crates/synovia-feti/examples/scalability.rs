@@ -4,7 +4,8 @@
 //! with a row per `k`: subdomains, dofs, dual size, SMALBE outer and MPRGP inner iterations,
 //! `F` products and times.
 //!
-//! `cargo run --release -p synovia-feti --example scalability [-- H/h k_max]` (defaults 8, 8).
+//! `cargo run --release -p synovia-feti --example scalability [-- H/h k_max [star]]` (defaults
+//! 8, 8; `star` glues from the owner copy instead of by orthonormal rows).
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -12,7 +13,7 @@ use std::time::Instant;
 use synovia_contact::obstacle::SphereObstacle;
 use synovia_contact::operators::ContactPair;
 use synovia_fem::model::Model;
-use synovia_feti::{Decomposition, DecompositionParams, ModelProblem, SingleProcess, TfetiParams};
+use synovia_feti::{Decomposition, DecompositionParams, Gluing, ModelProblem, SingleProcess, TfetiParams};
 use synovia_material::plane_strain;
 use synovia_mesh::generators::{rectangle, Grading};
 use synovia_mesh::math::{Point, Vector};
@@ -22,34 +23,55 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let hh = args.first().copied().unwrap_or(8);
     let kmax = args.get(1).copied().unwrap_or(8);
+    let linear = std::env::args().any(|a| a == "linear");
+    let gluing = if std::env::args().any(|a| a == "star") { Gluing::Star } else { Gluing::Orthonormal };
     let mut rows = Vec::new();
     for k in (2..=kmax).step_by(2) {
         let n = k * hh;
         let mut mesh = rectangle(0.0, 1.0, 0.0, 1.0, n, n, Grading::Uniform, Grading::Uniform)?;
         mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
-        mesh.set_part_kind("bottom", BoundaryKind::Contact)?;
         let mut model = Model::<2>::new();
-        let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0, 0.3)?))?;
-        model.prescribe(b, "top", |_, _| Vector::<2>::new(0.004, -0.02))?;
-        let cylinder = SphereObstacle::new(Point::<2>::new(0.5, -2.0), 2.0, false)?;
-        let pairs = vec![ContactPair::rigid("block-cylinder", b, "bottom", Arc::new(cylinder))];
+        let pairs = if linear {
+            // diagnostic: both ends prescribed, contact with a far cylinder (inactive rows)
+            mesh.set_part_kind("bottom", BoundaryKind::Prescribed)?;
+            mesh.set_part_kind("right", BoundaryKind::Contact)?;
+            let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0, 0.3)?))?;
+            model.prescribe(b, "top", |_, _| Vector::<2>::new(0.004, -0.02))?;
+            model.prescribe(b, "bottom", |_, _| Vector::<2>::zeros())?;
+            let far = SphereObstacle::new(Point::<2>::new(4.0, 0.5), 2.0, false)?;
+            vec![ContactPair::rigid("block-far", b, "right", Arc::new(far))]
+        } else {
+            mesh.set_part_kind("bottom", BoundaryKind::Contact)?;
+            let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0, 0.3)?))?;
+            model.prescribe(b, "top", |_, _| Vector::<2>::new(0.004, -0.02))?;
+            let cylinder = SphereObstacle::new(Point::<2>::new(0.5, -2.0), 2.0, false)?;
+            vec![ContactPair::rigid("block-cylinder", b, "bottom", Arc::new(cylinder))]
+        };
         let t0 = Instant::now();
         let dec = Decomposition::new(
             &model,
-            &DecompositionParams::default().with_subdomains(k * k),
+            &DecompositionParams::default().with_subdomains(k * k).with_gluing(gluing),
             &SingleProcess,
         )?;
         let decompose_s = t0.elapsed().as_secs_f64();
         let frictionless = ModelProblem::new(&model, &pairs, 0.0, None, None)?;
-        let params = TfetiParams::default().with_tolerance(1e-8);
+        let mut params = TfetiParams::default().with_tolerance(1e-8);
+        for a in std::env::args() {
+            if let Some(v) = a.strip_prefix("rho=").and_then(|v| v.parse().ok()) {
+                params.rho_factor = v;
+            }
+            if let Some(v) = a.strip_prefix("eta=").and_then(|v| v.parse().ok()) {
+                params.eta_factor = v;
+            }
+        }
         let s0 = frictionless.solve(&dec, &SingleProcess, &params)?;
         // Tresca bounds g_c = 0.3 κ-weighted pressure of the frictionless solution
-        let gc: Vec<f64> = s0.lambda_n.iter().map(|p| 0.3 * p).collect();
+        let gc: Vec<f64> = s0.lambda_n.iter().map(|p| 0.3 * p + if linear { 1.0 } else { 0.0 }).collect();
         let tresca = ModelProblem::new(&model, &pairs, 0.0, Some(&gc), None)?;
         let s = tresca.solve(&dec, &SingleProcess, &params)?;
         let r = &s.report;
         let row = serde_json::json!({
-            "k": k, "subdomains": r.subdomains, "H_over_h": hh, "dofs": dec.n_reduced(),
+            "k": k, "gluing": format!("{gluing:?}"), "subdomains": r.subdomains, "H_over_h": hh, "dofs": dec.n_reduced(),
             "primal": dec.n_primal(), "dual": r.dual, "coarse": r.coarse_dim,
             "frictionless": {"outer": s0.report.outer_iterations, "inner": s0.report.inner_iterations, "f_products": s0.report.f_products},
             "tresca": {"outer": r.outer_iterations, "inner": r.inner_iterations, "f_products": r.f_products,

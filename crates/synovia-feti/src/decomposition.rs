@@ -5,11 +5,16 @@
 //! node (`D` per copy). A node group of the undecomposed model (one node, or nodes bonded by a
 //! tie, docs/model.md §1.2) has one or more copies; its first copy is its *owner*.
 //!
-//! * Gluing: `u_{c₀} − u_{c_j} = 0` componentwise for every further copy `c_j` (a star from the
-//!   owner: linearly independent rows).
-//! * Dirichlet: `q_iᵀ u_{c₀} = 0` for the constrained directions `q_i` of the group (the
-//!   orthogonal complement of its free basis `N`, docs/model.md (5.1)) — homogeneous because the
-//!   lift `u_p` is already in the load `F` of the reduced problem.
+//! * Gluing ([`Gluing::Orthonormal`], the default): for a group with `n ≥ 2` copies and each
+//!   component `k`, the `n − 1` rows `h_jᵀ (u_{c₀,k}, …, u_{c_{n−1},k}) = 0` with the Helmert
+//!   vectors `h_j = (1, …, 1, −j, 0, …) / √(j(j+1))` (`j` ones): an orthonormal basis of the
+//!   differences between the copies. With [`Gluing::Star`], `u_{c₀} − u_{c_j} = 0` for every
+//!   further copy (a star from the owner: independent, but not orthogonal at cross points).
+//! * Dirichlet: `q_iᵀ ū = 0` for the constrained directions `q_i` of the group (the
+//!   orthonormal complement of its free basis `N`, docs/model.md (5.1)) — homogeneous because
+//!   the lift `u_p` is already in the load `F` of the reduced problem. With orthonormal gluing
+//!   `ū = Σ_j u_{c_j} / √n` (orthogonal to the gluing rows, so the equality rows satisfy
+//!   `B_E B_Eᵀ = I` as the TFETI theory assumes); with star gluing `ū = u_{c₀}`.
 //! * A reduced load `F` and contact rows `C` of the undecomposed problem act on the owner
 //!   copies: `f̂_{c₀} = Σ_k F_k N_k`, `Ĉ_{r, c₀} = Σ_k C_{r,k} N_kᵀ`; the reduced solution is
 //!   read back as `ũ_k = N_kᵀ u_{c₀}`.
@@ -32,11 +37,24 @@ pub struct DecompositionParams {
     /// their cells (at least one per body; default 8). Parts are split further into their
     /// facet-connected components, so the number of subdomains can be slightly larger.
     pub subdomains: usize,
+    /// How the copies of a node are glued (default [`Gluing::Orthonormal`]).
+    pub gluing: Gluing,
+}
+
+/// The gluing rows at nodes shared by several subdomains (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Gluing {
+    /// Orthonormal (Helmert) rows; the Dirichlet rows act on the mean of the copies, so that
+    /// `B_E B_Eᵀ = I`.
+    #[default]
+    Orthonormal,
+    /// `u_{c₀} − u_{c_j}` from the owner copy; Dirichlet rows on the owner copy.
+    Star,
 }
 
 impl Default for DecompositionParams {
     fn default() -> Self {
-        Self { subdomains: 8 }
+        Self { subdomains: 8, gluing: Gluing::default() }
     }
 }
 
@@ -44,6 +62,11 @@ impl DecompositionParams {
     /// Sets [`Self::subdomains`].
     pub fn with_subdomains(mut self, subdomains: usize) -> Self {
         self.subdomains = subdomains;
+        self
+    }
+    /// Sets [`Self::gluing`].
+    pub fn with_gluing(mut self, gluing: Gluing) -> Self {
+        self.gluing = gluing;
         self
     }
 }
@@ -144,9 +167,22 @@ impl Decomposition {
             }
         }
         // gluing rows, then Dirichlet rows
+        let orthonormal = params.gluing == Gluing::Orthonormal;
         let mut equality: Vec<Vec<Entry>> = Vec::new();
         for g in &groups {
-            if let Some((&(s0, a0), rest)) = g.copies.split_first() {
+            let Some((&(s0, a0), rest)) = g.copies.split_first() else { continue };
+            if orthonormal {
+                for j in 1..g.copies.len() {
+                    let w = 1.0 / ((j * (j + 1)) as f64).sqrt();
+                    for k in 0..D {
+                        let mut row: Vec<Entry> =
+                            g.copies[..j].iter().map(|&(s, a)| (s, D * a + k, w)).collect();
+                        let (s, a) = g.copies[j];
+                        row.push((s, D * a + k, -(j as f64) * w));
+                        equality.push(row);
+                    }
+                }
+            } else {
                 for &(s, a) in rest {
                     for k in 0..D {
                         equality.push(vec![(s0, D * a0 + k, 1.0), (s, D * a + k, -1.0)]);
@@ -157,9 +193,17 @@ impl Decomposition {
         let n_gluing = equality.len();
         for g in &groups {
             let Some(&(s0, a0)) = g.copies.first() else { continue };
+            let mean = 1.0 / (g.copies.len() as f64).sqrt();
             for q in constrained_directions(&g.basis, g.n_dofs, D) {
-                let row: Vec<Entry> =
-                    (0..D).filter(|&k| q[k] != 0.0).map(|k| (s0, D * a0 + k, q[k])).collect();
+                let row: Vec<Entry> = if orthonormal {
+                    let mut row = Vec::with_capacity(g.copies.len() * D);
+                    for &(s, a) in &g.copies {
+                        row.extend((0..D).filter(|&k| q[k] != 0.0).map(|k| (s, D * a + k, mean * q[k])));
+                    }
+                    row
+                } else {
+                    (0..D).filter(|&k| q[k] != 0.0).map(|k| (s0, D * a0 + k, q[k])).collect()
+                };
                 equality.push(row);
             }
         }
@@ -258,4 +302,64 @@ fn constrained_directions(basis: &[f64], n: usize, d: usize) -> Vec<Vec<f64>> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use nalgebra::DMatrix;
+    use synovia_fem::model::Model;
+    use synovia_mesh::generators::{rectangle, Grading};
+    use synovia_mesh::math::Vector;
+    use synovia_mesh::BoundaryKind;
+
+    use super::*;
+    use crate::comm::SingleProcess;
+
+    /// `B_E` as a dense matrix over the primal unknowns.
+    fn dense(dec: &Decomposition) -> DMatrix<f64> {
+        let mut off = Vec::new();
+        let mut n = 0;
+        for s in &dec.subdomains {
+            off.push(n);
+            n += s.n_dofs();
+        }
+        let mut b = DMatrix::zeros(dec.equality.len(), n);
+        for (r, row) in dec.equality.iter().enumerate() {
+            for &(s, dof, v) in row {
+                b[(r, off[s] + dof)] += v;
+            }
+        }
+        b
+    }
+
+    #[test]
+    fn orthonormal_gluing_has_identity_gram_and_the_star_constraints() {
+        let mut mesh =
+            rectangle(0.0, 1.0, 0.0, 1.0, 12, 12, Grading::Uniform, Grading::Uniform).expect("mesh");
+        mesh.set_part_kind("top", BoundaryKind::Prescribed).expect("part");
+        let mut model = Model::<2>::new();
+        let law = synovia_material::plane_strain(1.0, 0.3).expect("material");
+        let b = model.add_body("block", mesh, Arc::new(law)).expect("body");
+        model.prescribe(b, "top", |_, _| Vector::<2>::new(0.0, -0.01)).expect("prescribe");
+        let params = DecompositionParams::default().with_subdomains(9);
+        let orth = Decomposition::new(&model, &params, &SingleProcess).expect("orthonormal");
+        let star =
+            Decomposition::new(&model, &params.with_gluing(Gluing::Star), &SingleProcess).expect("star");
+        // cross points (nodes in ≥ 3 subdomains) exist, on the Dirichlet boundary too
+        assert!(orth.groups.iter().any(|g| g.copies.len() >= 3));
+        assert_eq!(orth.n_equality(), star.n_equality());
+        let (bo, bs) = (dense(&orth), dense(&star));
+        let gram = &bo * bo.transpose();
+        let err = (&gram - DMatrix::<f64>::identity(gram.nrows(), gram.ncols())).amax();
+        assert!(err < 1e-14, "‖B Bᵀ − I‖ = {err}");
+        let gram_star = &bs * bs.transpose();
+        let err_star = (&gram_star - DMatrix::<f64>::identity(gram.nrows(), gram.ncols())).amax();
+        assert!(err_star > 0.5, "star gluing is not orthonormal at cross points: {err_star}");
+        // the same constraints: B_s = (B_s B_oᵀ) B_o (each star row lies in the row space of B_o)
+        let proj = (&bs * bo.transpose()) * &bo;
+        let diff = (&proj - &bs).amax();
+        assert!(diff < 1e-12, "star rows outside the orthonormal row space: {diff}");
+    }
 }

@@ -45,7 +45,7 @@ use synovia_mesh::math::{Real, Vector};
 #[cfg(feature = "mpi")]
 pub use comm::MpiCommunicator;
 pub use comm::{Communicator, SingleProcess};
-pub use decomposition::{Decomposition, DecompositionParams};
+pub use decomposition::{Decomposition, DecompositionParams, Gluing};
 pub use dual::{solve, TfetiParams, TfetiReport, TfetiSolution};
 pub use error::FetiError;
 

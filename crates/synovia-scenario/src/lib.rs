@@ -42,6 +42,7 @@
 pub mod arrays;
 pub mod build;
 pub mod scenario;
+pub mod sweep;
 
 pub use arrays::{ArrayError, ArrayModel, ConditionChange, ConditionKind, ModelArrays};
 pub use scenario::{Scenario, ScenarioError, Source};

@@ -316,6 +316,8 @@ pub struct ScenarioDoc {
     pub output: Option<Sp<OutputSpec>>,
     /// The model's units (`[units]`): labels of the outputs and the unit-mistake check.
     pub units: Option<Sp<UnitsSpec>>,
+    /// A parameter study (`[sweep]`, [`crate::sweep`]); ignored by a plain build.
+    pub sweep: Option<crate::sweep::SweepSpec>,
 }
 
 /// `[units]`: the units the model's numbers are in. They only label the outputs (synovia
