@@ -11,7 +11,7 @@ use synovia::builder::{Analysis, BodyMaterial, JointModel};
 use synovia::contact_ops::obstacle::SignedDistance;
 use synovia::contact_ops::operators::{ContactPair, CylinderObstacle, PlaneObstacle, SphereObstacle};
 use synovia::fem::{BodyId, ComponentMask};
-use synovia::material::{anisotropic, isotropic, plane_strain, plane_stress, VoigtMatrix};
+use synovia::material::{anisotropic, isotropic, plane_strain, plane_stress, Material, VoigtMatrix};
 use synovia::mesh::math::{Point, Vector};
 use synovia::mesh::{BoundaryKind, Mesh};
 use synovia::prelude::LoadHistory;
@@ -44,6 +44,8 @@ enum MatKind {
     PlaneStrain { e: f64, nu: f64 },
     PlaneStress { e: f64, nu: f64 },
     Anisotropic { c: Vec<f64>, n: usize },
+    NeoHookean { e: f64, nu: f64 },
+    MooneyRivlin { c1: f64, c2: f64, lambda: f64 },
 }
 
 #[pymethods]
@@ -78,6 +80,20 @@ impl PyMaterial {
         }
         Ok(Self { kind: MatKind::Anisotropic { c: a.iter().copied().collect(), n: a.nrows() } })
     }
+    /// Compressible neo-Hookean hyperelasticity `W = μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)²` with the
+    /// small-strain constants `E`, `nu` (plane strain on a 2D body). Run it in finite strain with
+    /// `Model.set_kinematics(body, "finite")` (docs/nonlinear.md).
+    #[staticmethod]
+    #[allow(non_snake_case)]
+    fn neo_hookean(E: f64, nu: f64) -> Self {
+        Self { kind: MatKind::NeoHookean { e: E, nu } }
+    }
+    /// Compressible Mooney–Rivlin hyperelasticity
+    /// `W = c₁(I₁ − 3) + c₂(I₂ − 3) − 2(c₁ + 2c₂) ln J + λ/2 (ln J)²`.
+    #[staticmethod]
+    fn mooney_rivlin(c1: f64, c2: f64, lam: f64) -> Self {
+        Self { kind: MatKind::MooneyRivlin { c1, c2, lambda: lam } }
+    }
     fn __repr__(&self) -> String {
         format!("Material({:?})", self.kind)
     }
@@ -101,6 +117,15 @@ fn material_for<const D: usize>(m: &PyMaterial) -> PyResult<BodyMaterial<D>> {
         (MatKind::Anisotropic { c, n }, _) => {
             let c = VoigtMatrix::from_row_slice(*n, *n, c);
             return Ok(BodyMaterial::<D>::from(anisotropic::<D>(c).map_err(err)?));
+        }
+        (MatKind::NeoHookean { e, nu }, _) => {
+            let law: Arc<dyn Material<D>> = Arc::new(synovia::material::neo_hookean(*e, *nu).map_err(err)?);
+            return Ok(BodyMaterial::<D>::from(law));
+        }
+        (MatKind::MooneyRivlin { c1, c2, lambda }, _) => {
+            let law: Arc<dyn Material<D>> =
+                Arc::new(synovia::material::mooney_rivlin(*c1, *c2, *lambda).map_err(err)?);
+            return Ok(BodyMaterial::<D>::from(law));
         }
         _ => return Err(msg("plane strain and plane stress materials are for 2D bodies only")),
     };
@@ -386,7 +411,7 @@ fn run_joint<const D: usize>(
         RunKind::Dynamic(dt, steps) => joint.run_dynamic_with(*dt, *steps, observer)?,
         RunKind::Analysis => joint.run_with(observer)?,
     };
-    col.finish(joint.model(), run).map_err(synovia::builder::JointError::Invalid)
+    col.finish(joint.model(), run, joint.kinematics()).map_err(synovia::builder::JointError::Invalid)
 }
 
 #[derive(Debug, Clone)]
@@ -715,6 +740,16 @@ impl PyModel {
             j.tie(a, part_a, b, part_b).map_err(err)?;
             Ok(())
         })
+    }
+    /// Sets the strain kinematics of a body: `"small"` (default) or `"finite"` (total
+    /// Lagrangian; the model is then solved by the Newton iteration, docs/nonlinear.md).
+    fn set_kinematics(&mut self, body: &Bound<'_, PyAny>, kinematics: &str) -> PyResult<()> {
+        let k = match kinematics {
+            "small" => synovia::fem::Kinematics::SmallStrain,
+            "finite" => synovia::fem::Kinematics::FiniteStrain,
+            other => return Err(msg(format!("kinematics is \"small\" or \"finite\", got \"{other}\""))),
+        };
+        with_joint_mut!(self, j => { let id = body_id(j, body)?; j.set_kinematics(id, k).map_err(err)?; Ok(()) })
     }
     /// Sets the density of a body (dynamic runs).
     fn set_density(&mut self, body: &Bound<'_, PyAny>, density: f64) -> PyResult<()> {

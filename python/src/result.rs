@@ -6,7 +6,8 @@ use pyo3::types::{PyDict, PyList};
 use synovia::builder::RunResult;
 use synovia::contact_ops::operators::ContactGeometry;
 use synovia::contact_ops::{KktReport, StaticContactResult};
-use synovia::fem::post::body_fields;
+use synovia::fem::post::body_fields_with_kinematics;
+use synovia::fem::Kinematics;
 use synovia::fem::Model;
 use synovia::mesh::math::Vector;
 use synovia::time::results::{PairRecord, RigidRecord, StepRecord};
@@ -153,11 +154,12 @@ pub fn finish<const D: usize>(
     data: &mut RunData,
     model: &Model<D>,
     displacement: &[Vec<Vector<D>>],
+    kinematics: &[Kinematics],
 ) -> Result<(), String> {
     data.dim = D;
     data.bodies = meshes(model);
     data.displacement = displacement.iter().map(|u| flat(u)).collect();
-    let fields = body_fields(model, displacement).map_err(|e| e.to_string())?;
+    let fields = body_fields_with_kinematics(model, displacement, kinematics).map_err(|e| e.to_string())?;
     data.stress = fields
         .iter()
         .map(|f| BodyStress {
@@ -197,8 +199,13 @@ impl Collector {
     }
 
     /// The data of a finished run.
-    pub fn finish<const D: usize>(mut self, model: &Model<D>, run: RunResult<D>) -> Result<RunData, String> {
-        finish(&mut self.data, model, &run.displacement)?;
+    pub fn finish<const D: usize>(
+        mut self,
+        model: &Model<D>,
+        run: RunResult<D>,
+        kinematics: &[Kinematics],
+    ) -> Result<RunData, String> {
+        finish(&mut self.data, model, &run.displacement, kinematics)?;
         self.data.records = run.records;
         self.data.n_dofs = run.n_dofs;
         self.data.contact_nodes = run.contact_nodes;

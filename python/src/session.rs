@@ -60,7 +60,8 @@ fn snapshot<const D: usize>(
         if !s.geometry().is_empty() {
             data.kkt = Some(result.kkt);
         }
-        finish(&mut data, model, &result.displacement)?;
+        // sessions are linear (JointModel::prepare refuses nonlinear models)
+        finish(&mut data, model, &result.displacement, &[])?;
     }
     data.records = s.record().cloned().into_iter().collect();
     data.n_dofs = info.n_dofs;

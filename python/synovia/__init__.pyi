@@ -51,6 +51,12 @@ class Material:
     @staticmethod
     def anisotropic(C: ArrayLike) -> "Material":
         """Anisotropic elasticity from the Voigt stiffness (3 × 3 in 2D, 6 × 6 in 3D)."""
+    @staticmethod
+    def neo_hookean(E: float, nu: float) -> "Material":
+        """Compressible neo-Hookean hyperelasticity with the small-strain E, nu (plane strain in 2D)."""
+    @staticmethod
+    def mooney_rivlin(c1: float, c2: float, lam: float) -> "Material":
+        """Compressible Mooney–Rivlin hyperelasticity (c1, c2, volumetric lambda)."""
 
 class RunResult:
     """The result of a run or of a session solve: records, NumPy fields, KKT residuals."""
@@ -204,6 +210,8 @@ class Model:
     def pressure(self, body: BodyRef, part: str, value: float, history: History = None) -> None: ...
     def body_force(self, body: BodyRef, value: ArrayLike, history: History = None) -> None: ...
     def tie(self, body_a: BodyRef, part_a: str, body_b: BodyRef, part_b: str) -> None: ...
+    def set_kinematics(self, body: BodyRef, kinematics: str) -> None:
+        """"small" (default) or "finite" (total Lagrangian; solved by the Newton iteration)."""
     def set_density(self, body: BodyRef, density: float) -> None: ...
     def initial_velocity(self, body: BodyRef, velocity: ArrayLike) -> None: ...
     def contact(

@@ -232,3 +232,35 @@ def test_anisotropic_material_equals_isotropic():
     assert m.run_static().pairs()["floor"]["normal_force"] == pytest.approx(FORCE_2D, rel=1e-9)
     with pytest.raises(synovia.SynoviaError):
         synovia.Model(2).add_body("b", nodes, cells, synovia.Material.anisotropic(np.eye(6)))
+
+
+def test_neo_hookean_finite_strain_equals_linear_at_small_load_and_differs_at_large():
+    """A neo-Hookean block in finite strain (Newton iteration) pressed on the floor: at a small
+    push it carries the linear block's force, at a 20 % push a different one."""
+
+    def floor_force(material, push, kinematics=None):
+        nodes, cells, parts = rectangle(0.0, 2.0, 0.0, 1.0, 8, 4)
+        m = synovia.Model(2)
+        m.add_body("block", nodes, cells, material, parts=parts)
+        if kinematics:
+            m.set_kinematics("block", kinematics)
+        m.symmetry("block", "left")
+        m.prescribe("block", "top", [0.0, -push], components=[1])
+        m.contact_plane("floor", "block", "bottom", point=[0.0, 0.0], normal=[0.0, 1.0])
+        r = m.run_static()
+        assert r.kkt["max"] < 1e-8
+        return r.pairs()["floor"]["normal_force"], r
+
+    small = 1e-5
+    f_lin, _ = floor_force(synovia.Material.plane_strain(E, NU), small)
+    f_nh, r = floor_force(synovia.Material.neo_hookean(E, NU), small, "finite")
+    assert f_nh == pytest.approx(f_lin, rel=1e-4)
+    assert r.stress("block", "cell").shape == (64, 3)
+    big = 0.2
+    f_lin, _ = floor_force(synovia.Material.plane_strain(E, NU), big)
+    f_nh, _ = floor_force(synovia.Material.neo_hookean(E, NU), big, "finite")
+    assert abs(f_nh / f_lin - 1.0) > 0.02
+    f_mr, _ = floor_force(synovia.Material.mooney_rivlin(0.5 * E / (2 * (1 + NU)), 0.0, E * NU / ((1 + NU) * (1 - 2 * NU))), big, "finite")
+    assert f_mr == pytest.approx(f_nh, rel=1e-7)  # c2 = 0: the neo-Hookean law with μ = 2c1
+    with pytest.raises(synovia.SynoviaError, match="kinematics"):
+        synovia.Model(2).set_kinematics(0, "large")
