@@ -89,7 +89,7 @@ pub fn body_stiffnesses<const D: usize>(model: &Model<D>) -> Result<Vec<DMatrix<
 }
 
 /// Geometry of cell `c` of body `b`, or the degenerate-cell error.
-fn cell_geometry<const D: usize>(
+pub(crate) fn cell_geometry<const D: usize>(
     model: &Model<D>,
     b: usize,
     c: usize,

@@ -215,6 +215,29 @@ fn cell_displacement<const D: usize>(
     }
 }
 
+/// The tangent `K_T` of cell `c` of body `b` at `displacement` into `out` (zeroed on failure),
+/// the element kernel of [`assemble_tangent`] and [`subtract_tangent_lift`].
+fn cell_tangent<const D: usize>(
+    model: &Model<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+    b: usize,
+    c: usize,
+    geo: &SimplexGeometry<D>,
+    out: &mut [Real],
+) -> Result<(), ElementFailure> {
+    let n = D * (D + 1);
+    let mut ue = [0.0; 12];
+    let mut fe = [0.0; 12];
+    cell_displacement(model, b, c, displacement, &mut ue[..n]);
+    let material = model.bodies()[b].material.as_ref();
+    let result = element_response(geo, material, kinematics[b], &ue[..n], &mut fe[..n], Some(&mut *out));
+    if result.is_err() {
+        out.iter_mut().for_each(|v| *v = 0.0);
+    }
+    result.map(|_| ())
+}
+
 fn check_kinematics<const D: usize>(
     model: &Model<D>,
     kinematics: &[Kinematics],
@@ -272,12 +295,7 @@ pub fn internal_force<const D: usize>(
     let groups = dofs.groups();
     for (b, body) in model.bodies().iter().enumerate() {
         for c in 0..body.mesh.n_cells() {
-            let pts = body.mesh.cell_points(c);
-            let geo =
-                SimplexGeometry::new(&pts).filter(|g| g.measure > 0.0).ok_or_else(|| FemError::Mesh {
-                    body: body.name.clone(),
-                    source: synovia_mesh::MeshError::DegenerateCell { cell: c, det: 0.0 },
-                })?;
+            let (geo, _) = crate::assembly::cell_geometry(model, b, c)?;
             cell_displacement(model, b, c, displacement, &mut ue);
             energy += element_response(&geo, body.material.as_ref(), kinematics[b], &ue, &mut fe, None)
                 .map_err(|e| failure(model, b, c, e))?;
@@ -310,13 +328,7 @@ pub fn assemble_tangent<const D: usize>(
     check_kinematics(model, kinematics, displacement)?;
     let first_failure = std::sync::Mutex::new(None::<(usize, usize, ElementFailure)>);
     assemble_matrix(model, dofs, matrix, |b, c, geo, out| {
-        let n = D * (D + 1);
-        let mut ue = [0.0; 12];
-        let mut fe = [0.0; 12];
-        cell_displacement(model, b, c, displacement, &mut ue[..n]);
-        let material = model.bodies()[b].material.as_ref();
-        if let Err(e) = element_response(geo, material, kinematics[b], &ue[..n], &mut fe[..n], Some(out)) {
-            out.iter_mut().for_each(|v| *v = 0.0);
+        if let Err(e) = cell_tangent(model, kinematics, displacement, b, c, geo, out) {
             if let Ok(mut f) = first_failure.lock() {
                 if f.as_ref().is_none_or(|x| (x.0, x.1) > (b, c)) {
                     *f = Some((b, c, e));
@@ -357,13 +369,7 @@ pub fn subtract_tangent_lift<const D: usize>(
     }
     let failed = std::cell::Cell::new(None::<(usize, usize, ElementFailure)>);
     crate::assembly::subtract_lift(model, dofs, delta_lifts, rhs, |b, c, geo, out| {
-        let n = D * (D + 1);
-        let mut ue = [0.0; 12];
-        let mut fe = [0.0; 12];
-        cell_displacement(model, b, c, displacement, &mut ue[..n]);
-        let material = model.bodies()[b].material.as_ref();
-        if let Err(e) = element_response(geo, material, kinematics[b], &ue[..n], &mut fe[..n], Some(out)) {
-            out.iter_mut().for_each(|v| *v = 0.0);
+        if let Err(e) = cell_tangent(model, kinematics, displacement, b, c, geo, out) {
             if failed.get().is_none() {
                 failed.set(Some((b, c, e)));
             }

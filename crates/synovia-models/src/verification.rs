@@ -143,6 +143,40 @@ fn mesh_error(body: &str) -> impl Fn(synovia_mesh::MeshError) -> FemError + '_ {
     move |source| FemError::Mesh { body: body.to_string(), source }
 }
 
+/// Calls `f(∇u_h, x, u_h(x), w |T|)` at every point of `rule` in every cell of `mesh`, for the
+/// P1 field of nodal values `u` (the error integrals of the convergence studies).
+fn for_each_quadrature_point<const D: usize>(
+    mesh: &Mesh<D>,
+    u: &[Vector<D>],
+    rule: &QuadratureRule,
+    mut f: impl FnMut(&Tensor<D>, Point<D>, Vector<D>, Real),
+) -> Result<(), FemError> {
+    let mut ue = vec![0.0; D * (D + 1)];
+    for cell in 0..mesh.n_cells() {
+        let pts = mesh.cell_points(cell);
+        let geo = SimplexGeometry::<D>::new(&pts)
+            .ok_or_else(|| FemError::InvalidParameter("degenerate cell".into()))?;
+        for (a, &nd) in mesh.cell(cell).iter().enumerate() {
+            for i in 0..D {
+                ue[D * a + i] = u[nd][i];
+            }
+        }
+        let grad_h = geo.displacement_gradient(&ue);
+        for (lam, w) in rule.barycentric.iter().zip(&rule.weights) {
+            let mut x = Point::<D>::zeros();
+            let mut uh = Vector::<D>::zeros();
+            for a in 0..=D {
+                x += pts[a] * lam[a];
+                for i in 0..D {
+                    uh[i] += lam[a] * ue[D * a + i];
+                }
+            }
+            f(&grad_h, x, uh, w * geo.measure);
+        }
+    }
+    Ok(())
+}
+
 /// Solves the bonded two-body manufactured problem in dimension `D` with `n` cells per unit
 /// length, and measures the errors.
 pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> {
@@ -209,37 +243,16 @@ pub fn bonded_mms<const D: usize>(n: usize) -> Result<ConvergenceRow, FemError> 
     for (bi, body) in model.bodies().iter().enumerate() {
         let c = if bi == 0 { &cl } else { &cr };
         h = h.max(body.mesh.max_edge_length());
-        let u = &sol.displacement[bi];
-        let mut ue = vec![0.0; D * (D + 1)];
-        for cell in 0..body.mesh.n_cells() {
-            let pts = body.mesh.cell_points(cell);
-            let geo = SimplexGeometry::<D>::new(&pts)
-                .ok_or_else(|| FemError::InvalidParameter("degenerate cell".into()))?;
-            for (a, &nd) in body.mesh.cell(cell).iter().enumerate() {
-                for i in 0..D {
-                    ue[D * a + i] = u[nd][i];
-                }
-            }
-            let eh = nalgebra::DVector::from_vec(voigt_strain::<D>(&geo.displacement_gradient(&ue)));
-            for (lam, w) in rule.barycentric.iter().zip(&rule.weights) {
-                let mut x = Point::<D>::zeros();
-                let mut uh = Vector::<D>::zeros();
-                for a in 0..=D {
-                    x += pts[a] * lam[a];
-                    for i in 0..D {
-                        uh[i] += lam[a] * ue[D * a + i];
-                    }
-                }
-                let ex = exact.value(&x);
-                let ee = nalgebra::DVector::from_vec(voigt_strain::<D>(&exact.gradient(&x)));
-                let de = &ee - &eh;
-                let wt = w * geo.measure;
-                e_en += wt * de.dot(&(c * &de));
-                n_en += wt * ee.dot(&(c * &ee));
-                e_l2 += wt * (ex - uh).norm_squared();
-                n_l2 += wt * ex.norm_squared();
-            }
-        }
+        for_each_quadrature_point(&body.mesh, &sol.displacement[bi], &rule, |grad_h, x, uh, wt| {
+            let eh = nalgebra::DVector::from_vec(voigt_strain::<D>(grad_h));
+            let ex = exact.value(&x);
+            let ee = nalgebra::DVector::from_vec(voigt_strain::<D>(&exact.gradient(&x)));
+            let de = &ee - &eh;
+            e_en += wt * de.dot(&(c * &de));
+            n_en += wt * ee.dot(&(c * &ee));
+            e_l2 += wt * (ex - uh).norm_squared();
+            n_l2 += wt * ex.norm_squared();
+        })?;
     }
     Ok(ConvergenceRow {
         n,
@@ -355,36 +368,15 @@ pub fn finite_strain_mms<const D: usize>(n: usize) -> Result<FiniteStrainRow, Fe
     let body = &model.bodies()[0];
     let rule = QuadratureRule::simplex(D, 4)?;
     let (mut e_h1, mut n_h1, mut e_l2, mut n_l2, mut max_gradient) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
-    let mut ue = vec![0.0; D * (D + 1)];
-    for cell in 0..body.mesh.n_cells() {
-        let pts = body.mesh.cell_points(cell);
-        let geo = SimplexGeometry::<D>::new(&pts)
-            .ok_or_else(|| FemError::InvalidParameter("degenerate cell".into()))?;
-        for (a, &nd) in body.mesh.cell(cell).iter().enumerate() {
-            for i in 0..D {
-                ue[D * a + i] = u[nd][i];
-            }
-        }
-        let gh = geo.displacement_gradient(&ue);
-        for (lam, w) in rule.barycentric.iter().zip(&rule.weights) {
-            let mut x = Point::<D>::zeros();
-            let mut uh = Vector::<D>::zeros();
-            for a in 0..=D {
-                x += pts[a] * lam[a];
-                for i in 0..D {
-                    uh[i] += lam[a] * ue[D * a + i];
-                }
-            }
-            let ex = exact.value(&x) * scale;
-            let ge = exact.gradient(&x) * scale;
-            max_gradient = max_gradient.max(ge.norm());
-            let wt = w * geo.measure;
-            e_h1 += wt * (ge - gh).norm_squared();
-            n_h1 += wt * ge.norm_squared();
-            e_l2 += wt * (ex - uh).norm_squared();
-            n_l2 += wt * ex.norm_squared();
-        }
-    }
+    for_each_quadrature_point(&body.mesh, u, &rule, |grad_h, x, uh, wt| {
+        let ex = exact.value(&x) * scale;
+        let ge = exact.gradient(&x) * scale;
+        max_gradient = max_gradient.max(ge.norm());
+        e_h1 += wt * (ge - grad_h).norm_squared();
+        n_h1 += wt * ge.norm_squared();
+        e_l2 += wt * (ex - uh).norm_squared();
+        n_l2 += wt * ex.norm_squared();
+    })?;
     Ok(FiniteStrainRow {
         row: ConvergenceRow {
             n,

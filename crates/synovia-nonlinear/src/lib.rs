@@ -701,9 +701,6 @@ impl<const D: usize> NonlinearContact<D> {
                 refresh = true;
             }
             let done = converged && geometry_settled;
-            if std::env::var_os("SYNOVIA_NEWTON_DEBUG").is_some() {
-                eprintln!("t={t} pass={passes} rel={relative:.2e} inc={increment:.2e} pinc={pass_increment:.2e} a={alpha} act={}", result.solution.report.active);
-            }
             warm = Some(result.solution.clone());
             if done {
                 let mut result = result;
