@@ -259,13 +259,8 @@ impl<'a> Dual<'a> {
             .clone()
             .into_par_iter()
             .map(|s| {
-                let sub = &dec.subdomains[s];
                 let sr = &sub_rows[s];
-                let mut x = if with_load { loads[s].clone() } else { vec![0.0; sub.n_dofs()] };
-                for &(pos, dof, v) in &sr.entries {
-                    x[dof] -= v * lambda[sr.rows[pos]];
-                }
-                sub.pinv_in_place(&mut x, s)?;
+                let x = subdomain_solve(dec, sub_rows, loads, s, lambda, with_load)?;
                 let mut out = vec![0.0; sr.rows.len()];
                 for &(pos, dof, v) in &sr.entries {
                     out[pos] += v * x[dof];
@@ -586,6 +581,27 @@ pub fn solve(
     Ok(TfetiSolution { u, lambda_n, lambda_t, report })
 }
 
+/// `K_s⁺ (f̂_s [with_load] − B_sᵀ λ)` of subdomain `s` (the fields of [`Dual`] it needs are
+/// passed apart: the closures over subdomains run on rayon's pool, and the communicator is not
+/// `Sync`).
+fn subdomain_solve(
+    dec: &Decomposition,
+    sub_rows: &[SubRows],
+    loads: &[Vec<f64>],
+    s: usize,
+    lambda: &[f64],
+    with_load: bool,
+) -> Result<Vec<f64>, FetiError> {
+    let sub = &dec.subdomains[s];
+    let sr = &sub_rows[s];
+    let mut x = if with_load { loads[s].clone() } else { vec![0.0; sub.n_dofs()] };
+    for &(pos, dof, v) in &sr.entries {
+        x[dof] -= v * lambda[sr.rows[pos]];
+    }
+    sub.pinv_in_place(&mut x, s)?;
+    Ok(x)
+}
+
 /// `u_s = K_s⁺ (f̂_s − B_sᵀ λ) + R_s α_s` on the owned subdomains, read back on the owner copies
 /// as reduced unknowns and gathered.
 fn recover(dual: &Dual<'_>, lambda: &[f64], alpha: &DVector<f64>) -> Result<Vec<f64>, FetiError> {
@@ -611,12 +627,7 @@ fn recover(dual: &Dual<'_>, lambda: &[f64], alpha: &DVector<f64>) -> Result<Vec<
         .into_par_iter()
         .map(|s| {
             let sub = &dec.subdomains[s];
-            let sr = &sub_rows[s];
-            let mut x = loads[s].clone();
-            for &(pos, dof, v) in &sr.entries {
-                x[dof] -= v * lambda[sr.rows[pos]];
-            }
-            sub.pinv_in_place(&mut x, s)?;
+            let mut x = subdomain_solve(dec, sub_rows, loads, s, lambda, true)?;
             for k in 0..sub.kernel.ncols() {
                 let a = alpha[coarse_off[s] + k];
                 for (xi, r) in x.iter_mut().zip(sub.kernel.column(k).iter()) {
