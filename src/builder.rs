@@ -1313,19 +1313,6 @@ impl<const D: usize> JointModel<D> {
         })
     }
 
-    /// The dynamic scheme for a nonlinear model — not available yet.
-    fn run_nonlinear_dynamic(
-        &self,
-        _dt: Real,
-        _steps: usize,
-        _start: Instant,
-        _observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
-    ) -> Result<RunResult<D>, JointError> {
-        Err(JointError::Invalid(
-            "the dynamic analysis of nonlinear materials or finite strain is not available yet; use a static or quasi-static analysis".into(),
-        ))
-    }
-
     /// The levels of a model with rigid bodies: each level poses them and finds their
     /// force-controlled coordinates ([`crate::rigid`]).
     #[allow(clippy::too_many_arguments)]
@@ -1430,7 +1417,9 @@ impl<const D: usize> JointModel<D> {
         let start = Instant::now();
         self.model.validate()?;
         if self.is_nonlinear() {
-            return self.run_nonlinear_dynamic(dt, steps, start, observer);
+            return Err(JointError::Invalid(
+                "the dynamic analysis of nonlinear materials or finite strain is not available yet; use a static or quasi-static analysis".into(),
+            ));
         }
         let solver = self.build_solver()?;
         let mut bodies = Vec::with_capacity(self.dynamic.len());
