@@ -21,6 +21,7 @@ pub mod matching;
 pub mod math;
 pub mod mesh;
 pub mod refine;
+pub mod subdivision;
 pub mod surface;
 
 pub use error::MeshError;
