@@ -12,6 +12,8 @@
 //!   pressures and KKT residuals as NumPy arrays;
 //! * [`session::PySession`] (`synovia.Session`): the re-solve session (factorise once, solve
 //!   again with new loads), its solves run with the GIL released;
+//! * [`rigid`]: rigid bodies with mixed control, rigid contact shapes (`synovia.Shape`),
+//!   STL surfaces (`synovia.Surface`, `synovia.read_stl`) and the pose inputs of sessions;
 //! * [`hertz`]: the Hertz verification problems of `synovia-models`.
 //!
 //! Every Rust error becomes a `synovia.SynoviaError` (a subclass of `Exception`) carrying the
@@ -28,6 +30,7 @@ pub mod hertz;
 pub mod history;
 pub mod model;
 pub mod result;
+pub mod rigid;
 pub mod session;
 
 pub use error::SynoviaError;
@@ -45,8 +48,11 @@ fn _synovia(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<history::PyParameter>()?;
     m.add_class::<result::PyRunResult>()?;
     m.add_class::<session::PySession>()?;
+    m.add_class::<rigid::PySurface>()?;
+    m.add_class::<rigid::PyShape>()?;
     m.add_function(wrap_pyfunction!(hertz::hertz2d, m)?)?;
     m.add_function(wrap_pyfunction!(hertz::hertz3d, m)?)?;
     m.add_function(wrap_pyfunction!(model::run_scenario, m)?)?;
+    m.add_function(wrap_pyfunction!(rigid::read_stl, m)?)?;
     Ok(())
 }

@@ -20,6 +20,7 @@ use synovia_scenario::{build::build, Scenario};
 use crate::error::{err, msg, set_callback_error, solved, take_callback_error};
 use crate::history::history;
 use crate::result::{Collector, PyRunResult, RunData};
+use crate::rigid::{self, PoseInputs, PoseSlot, PyShape, RigidSpec};
 use crate::session::PySession;
 
 // The model is shared with the thread of a `Session` and runs release the GIL: it must be
@@ -169,14 +170,14 @@ fn get_mut<const D: usize>(a: &mut Arc<JointModel<D>>) -> PyResult<&mut JointMod
     })
 }
 
-fn vector<const D: usize>(v: &[f64], what: &str) -> PyResult<Vector<D>> {
+pub(crate) fn vector<const D: usize>(v: &[f64], what: &str) -> PyResult<Vector<D>> {
     if v.len() != D {
         return Err(msg(format!("{what} must have {D} components, got {}", v.len())));
     }
     Ok(Vector::<D>::from_fn(|i, _| v[i]))
 }
 
-fn point<const D: usize>(v: &[f64], what: &str) -> PyResult<Point<D>> {
+pub(crate) fn point<const D: usize>(v: &[f64], what: &str) -> PyResult<Point<D>> {
     Ok(Point::from(vector::<D>(v, what)?))
 }
 
@@ -196,7 +197,7 @@ fn mask(components: Option<Vec<usize>>, d: usize) -> PyResult<ComponentMask> {
     }
 }
 
-fn body_id<const D: usize>(j: &JointModel<D>, body: &Bound<'_, PyAny>) -> PyResult<BodyId> {
+pub(crate) fn body_id<const D: usize>(j: &JointModel<D>, body: &Bound<'_, PyAny>) -> PyResult<BodyId> {
     if let Ok(i) = body.extract::<usize>() {
         j.model().body(BodyId(i)).map_err(err)?;
         return Ok(BodyId(i));
@@ -205,7 +206,7 @@ fn body_id<const D: usize>(j: &JointModel<D>, body: &Bound<'_, PyAny>) -> PyResu
     j.model().body_id(&name).map_err(err)
 }
 
-fn index_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<Vec<usize>>> {
+pub(crate) fn index_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<Vec<usize>>> {
     let np = obj.py().import_bound("numpy")?;
     let arr = np.call_method1("asarray", (obj,))?;
     let arr = arr.call_method1("astype", ("int64",))?;
@@ -229,7 +230,7 @@ fn index_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<
     Ok(out)
 }
 
-fn float_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<Vec<f64>>> {
+pub(crate) fn float_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<Vec<f64>>> {
     let np = obj.py().import_bound("numpy")?;
     let arr = np.call_method1("asarray", (obj, "float64"))?;
     let a: PyReadonlyArray2<f64> =
@@ -241,7 +242,7 @@ fn float_array(obj: &Bound<'_, PyAny>, cols: usize, what: &str) -> PyResult<Vec<
 }
 
 /// The values of a Python vector-like (`D` floats).
-fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+pub(crate) fn floats(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     if let Ok(v) = obj.extract::<f64>() {
         return Ok(vec![v]);
     }
@@ -435,6 +436,8 @@ pub struct PyModel {
     pub(crate) joint: Joint,
     name: Option<String>,
     warnings: Vec<String>,
+    /// The pose inputs of rigid bodies added with `pose_input=True`.
+    poses: PoseInputs,
 }
 
 impl PyModel {
@@ -460,7 +463,7 @@ impl PyModel {
             3 => Joint::D3(Arc::new(JointModel::new())),
             _ => return Err(msg(format!("dimension must be 2 or 3, got {dimension}"))),
         };
-        Ok(Self { joint, name: None, warnings: Vec::new() })
+        Ok(Self { joint, name: None, warnings: Vec::new(), poses: Vec::new() })
     }
 
     /// A model from a TOML scenario file (`docs/scenario.md`): bodies, materials, conditions,
@@ -484,7 +487,7 @@ impl PyModel {
             }
         });
         let (joint, name, warnings) = built.map_err(msg)?;
-        Ok(Self { joint, name: Some(name), warnings })
+        Ok(Self { joint, name: Some(name), warnings, poses: Vec::new() })
     }
 
     /// Dimension (2 or 3).
@@ -546,6 +549,24 @@ impl PyModel {
             let b = j.model().body(id).map_err(err)?;
             Ok(b.mesh.boundary_parts().iter().map(|p| p.name().to_string()).collect())
         })
+    }
+    /// The facets of a boundary part (node indices), shape `(k, D)`.
+    fn facets<'py>(
+        &self,
+        py: Python<'py>,
+        body: &Bound<'py, PyAny>,
+        part: &str,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<u64>>> {
+        use numpy::PyArrayMethods;
+        let d = self.dimension();
+        let v = with_joint!(self, j => {
+            let id = body_id(j, body)?;
+            let b = j.model().body(id).map_err(err)?;
+            let p = b.mesh.boundary_part(part).map_err(err)?;
+            p.facets().flat_map(|f| f.iter().map(|&i| i as u64).collect::<Vec<_>>()).collect::<Vec<u64>>()
+        });
+        let n = v.len() / d;
+        numpy::PyArray1::from_vec_bound(py, v).reshape([n, d])
     }
     /// Node coordinates of a body, shape `(n_nodes, D)`.
     fn nodes<'py>(
@@ -845,6 +866,209 @@ impl PyModel {
                 .map_err(err)?;
         contact_obstacle(j, name, body, part, Arc::new(o), friction)
     }
+    /// Adds a contact pair between a part and a fixed rigid obstacle of any `Shape` (plane,
+    /// sphere, cylinder, or a surface such as an STL file); `search_distance` bounds the
+    /// contact search.
+    #[pyo3(signature = (name, body, part, shape, friction = 0.0, search_distance = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn contact_obstacle(
+        &mut self,
+        name: &str,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        shape: PyRef<'_, PyShape>,
+        friction: f64,
+        search_distance: Option<f64>,
+    ) -> PyResult<()> {
+        with_joint_mut!(self, j => {
+            let o = rigid::shape_for(&shape)?;
+            let id = body_id(j, body)?;
+            let mut pair = ContactPair::rigid(name, id, part, o).with_friction(friction);
+            if let Some(d) = search_distance {
+                pair = pair.with_search_distance(d);
+            }
+            j.add_contact(pair).map_err(err)?;
+            Ok(())
+        })
+    }
+
+    /// Adds a rigid body with mixed control (`synovia::rigid`, a scenario's `[[rigid_body]]`):
+    /// reference point `center` (default the origin) and, in 3D, `rotation_order` (default
+    /// `"zxy"`: `R = R_z R_x R_y`). Its degrees of freedom, by name (`"tx"`, `"ty"`, `"tz"`,
+    /// `"rx"`, `"ry"`, `"rz"`; 2D `"tx"`, `"ty"`, `"rz"`), are held at 0 unless given:
+    /// `prescribe={dof: history}` (the coordinate `q(t)`, length or radians), or
+    /// `force={dof: history}` (the generalised force `F(t)`: a force along the axis, or a
+    /// moment about the angle's axis; the coordinate is found from the body's equilibrium),
+    /// with `guess={dof: history}` an optional predictor of a force-controlled coordinate.
+    /// A history is a number, a `Parameter`, an `(n, 2)` table or a callable, as elsewhere.
+    /// `pose_input=True`: every degree of freedom not in `prescribe`/`force` follows the pose
+    /// set by `Session.set_pose` / `Model.set_pose` (identity until set). Returns the rigid
+    /// body's index.
+    #[pyo3(signature = (name, center = None, rotation_order = None, prescribe = None, force = None, guess = None, pose_input = false))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_rigid_body(
+        &mut self,
+        name: &str,
+        center: Option<&Bound<'_, PyAny>>,
+        rotation_order: Option<&str>,
+        prescribe: Option<&Bound<'_, PyDict>>,
+        force: Option<&Bound<'_, PyDict>>,
+        guess: Option<&Bound<'_, PyDict>>,
+        pose_input: bool,
+    ) -> PyResult<usize> {
+        let spec = RigidSpec { name, center, rotation_order, prescribe, force, guess, pose_input };
+        match &mut self.joint {
+            Joint::D2(a) => {
+                let (id, input) = rigid::add_rigid_body(get_mut(a)?, &spec)?;
+                if let Some(i) = input {
+                    self.poses.push((name.to_string(), PoseSlot::D2(i)));
+                }
+                Ok(id)
+            }
+            Joint::D3(a) => {
+                let (id, input) = rigid::add_rigid_body(get_mut(a)?, &spec)?;
+                if let Some(i) = input {
+                    self.poses.push((name.to_string(), PoseSlot::D3(i)));
+                }
+                Ok(id)
+            }
+        }
+    }
+    /// Rigid body names, in order.
+    #[getter]
+    fn rigid_bodies(&self) -> Vec<String> {
+        with_joint!(self, j => j.rigid_bodies().iter().map(|b| b.name().to_string()).collect())
+    }
+    /// Ties a part of an elastic body to rigid body `rigid` (a rigid plate): the part moves
+    /// with the rigid body's pose and its reactions load the rigid body.
+    fn tie_to_rigid_body(&mut self, body: &Bound<'_, PyAny>, part: &str, rigid: &str) -> PyResult<()> {
+        with_joint_mut!(self, j => rigid::tie(j, body, part, rigid))
+    }
+    /// Adds a contact pair between a part and the `shape` of rigid body `rigid` (given in
+    /// the rigid body's frame, placed by its pose at every level); the contact forces load
+    /// the rigid body.
+    #[pyo3(signature = (name, body, part, rigid, shape, friction = 0.0, search_distance = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn contact_rigid_body(
+        &mut self,
+        name: &str,
+        body: &Bound<'_, PyAny>,
+        part: &str,
+        rigid: &str,
+        shape: PyRef<'_, PyShape>,
+        friction: f64,
+        search_distance: Option<f64>,
+    ) -> PyResult<()> {
+        with_joint_mut!(self, j => rigid::contact(j, name, body, part, rigid, &shape, friction, search_distance))
+    }
+    /// Sets the pose of a rigid body added with `pose_input=True` for the next runs (see
+    /// `Session.set_pose`).
+    #[pyo3(signature = (rigid, translation, quaternion = None, axis = None, angle = None, rotation = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_pose(
+        &self,
+        rigid: &str,
+        translation: &Bound<'_, PyAny>,
+        quaternion: Option<&Bound<'_, PyAny>>,
+        axis: Option<&Bound<'_, PyAny>>,
+        angle: Option<f64>,
+        rotation: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        rigid::set_pose(&self.poses, rigid, translation, quaternion, axis, angle, rotation)
+    }
+    /// Sets the friction law of a contact pair (quasi-static and dynamic runs), by name:
+    /// `"coulomb"` with `mu` (a constant coefficient, `ConstantFriction`), or
+    /// `"exponential"` with `static`, `kinetic` and `speed`
+    /// (`F_c(v) = μ_k + (μ_s − μ_k) exp(−v / v_c)`, `ExponentialFriction`; the scenario key
+    /// `friction_law`).
+    #[pyo3(signature = (pair, law, mu = None, r#static = None, kinetic = None, speed = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn friction_law(
+        &mut self,
+        pair: &str,
+        law: &str,
+        mu: Option<f64>,
+        r#static: Option<f64>,
+        kinetic: Option<f64>,
+        speed: Option<f64>,
+    ) -> PyResult<()> {
+        let need = |v: Option<f64>, what: &str, positive: bool| -> PyResult<f64> {
+            let v = v.ok_or_else(|| msg(format!("friction law `{law}` needs `{what}`")))?;
+            if !v.is_finite() || v < 0.0 || (positive && v == 0.0) {
+                let kind = if positive { "positive" } else { "non-negative" };
+                return Err(msg(format!(
+                    "friction law `{law}`: `{what}` must be finite and {kind}, got {v}"
+                )));
+            }
+            Ok(v)
+        };
+        let unused = |given: &[(&str, Option<f64>)]| -> PyResult<()> {
+            match given.iter().find(|(_, v)| v.is_some()) {
+                Some((k, _)) => Err(msg(format!("friction law `{law}` takes no `{k}`"))),
+                None => Ok(()),
+            }
+        };
+        let l: Arc<dyn synovia::contact_ops::FrictionLaw> = match law {
+            "coulomb" | "constant" => {
+                unused(&[("static", r#static), ("kinetic", kinetic), ("speed", speed)])?;
+                Arc::new(synovia::contact_ops::ConstantFriction(need(mu, "mu", false)?))
+            }
+            "exponential" => {
+                unused(&[("mu", mu)])?;
+                Arc::new(synovia::contact_ops::ExponentialFriction {
+                    static_coefficient: need(r#static, "static", false)?,
+                    kinetic_coefficient: need(kinetic, "kinetic", false)?,
+                    characteristic_speed: need(speed, "speed", true)?,
+                })
+            }
+            other => {
+                return Err(msg(format!(
+                    "unknown friction law `{other}`: use \"coulomb\" (mu) or \"exponential\" (static, kinetic, speed)"
+                )))
+            }
+        };
+        with_joint_mut!(self, j => { j.friction_law(pair, l.clone()).map_err(err)?; Ok(()) })
+    }
+    /// The friction scheme of quasi-static runs and session steps (the scenario's
+    /// `[analysis]` keys): `coulomb_fixed_point=False` (default) is Tresca friction with the
+    /// slip bound frozen from the previous level, `True` re-solves each level until the bound
+    /// `F_c |Λ_n|` stops changing (Coulomb; at most `max_fixed_point` solves, relative
+    /// tolerance `fixed_point_tolerance`); `incremental_slip` measures slip from the previous
+    /// level (default) or from the reference state; `initial_friction` adds a Tresca solve at
+    /// step 0. Unset arguments take the defaults.
+    #[pyo3(signature = (coulomb_fixed_point = None, max_fixed_point = None, fixed_point_tolerance = None, incremental_slip = None, initial_friction = None))]
+    fn quasistatic_options(
+        &mut self,
+        coulomb_fixed_point: Option<bool>,
+        max_fixed_point: Option<usize>,
+        fixed_point_tolerance: Option<f64>,
+        incremental_slip: Option<bool>,
+        initial_friction: Option<bool>,
+    ) -> PyResult<()> {
+        let mut q = synovia::time::quasistatic::QuasiStaticParams::default();
+        if let Some(v) = coulomb_fixed_point {
+            q.coulomb_fixed_point = v;
+        }
+        if let Some(v) = max_fixed_point {
+            if v < 1 {
+                return Err(msg("max_fixed_point must be at least 1"));
+            }
+            q.max_fixed_point = v;
+        }
+        if let Some(v) = fixed_point_tolerance {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(msg(format!("fixed_point_tolerance must be finite and positive, got {v}")));
+            }
+            q.fixed_point_tolerance = v;
+        }
+        if let Some(v) = incremental_slip {
+            q.incremental_slip = v;
+        }
+        if let Some(v) = initial_friction {
+            q.initial_friction = v;
+        }
+        with_joint_mut!(self, j => { j.quasistatic_params(q); Ok(()) })
+    }
     /// Chooses the contact solver by name: `"pdas-fallback"` (default), `"pdas"`,
     /// `"au-pdas"`, `"uzawa-mprgp"` or `"dual-mprgp"`.
     fn solver(&mut self, name: &str) -> PyResult<()> {
@@ -883,7 +1107,7 @@ impl PyModel {
     /// state, or the time) without refactorising. The model cannot be changed while the
     /// session is open.
     fn prepare(&self, py: Python<'_>) -> PyResult<PySession> {
-        PySession::open(py, self.joint.clone())
+        PySession::open(py, self.joint.clone(), self.poses.clone())
     }
     fn __repr__(&self) -> String {
         format!("Model(dimension={}, bodies={:?}, pairs={:?})", self.dimension(), self.bodies(), self.pairs())

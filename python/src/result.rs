@@ -390,6 +390,21 @@ impl PyRunResult {
         }
         Ok(d)
     }
+    /// The rigid-body states of one step (default: the last) as a dict `{rigid body name:
+    /// dict}`: `dofs` (coordinates `q`, lengths and radians, `dof_names` order), `reaction`
+    /// (the generalised forces `Q` the elastic bodies exert), `applied` (the applied
+    /// generalised force `F` of each force-controlled coordinate, `None` if prescribed), `force` and
+    /// `moment` (resultant on the rigid body and its moment about the moved reference point),
+    /// `balance_error`, `solves`.
+    #[pyo3(signature = (step = -1))]
+    fn rigid_bodies<'py>(&self, py: Python<'py>, step: isize) -> PyResult<Bound<'py, PyDict>> {
+        let i = self.step_index(step, self.data.records.len())?;
+        let d = PyDict::new_bound(py);
+        for r in &self.data.records[i].rigid {
+            d.set_item(&r.name, rigid_dict(py, r)?)?;
+        }
+        Ok(d)
+    }
     /// One figure of one pair over the steps, shape `(n_steps,)`: `quantity` is a scalar key
     /// of the pair dicts (`normal_force`, `contact_area`, `peak_pressure`, …).
     fn pair_history<'py>(

@@ -20,6 +20,7 @@ use synovia::session::{JointSession, SolveReport};
 use crate::error::{msg, solved, take_callback_error};
 use crate::model::Joint;
 use crate::result::{contact_rows, finish, nodal_pressure, PyRunResult, RunData};
+use crate::rigid::{self, PoseInputs};
 
 #[derive(Debug, Clone, Copy)]
 enum Cmd {
@@ -128,12 +129,14 @@ pub struct PySession {
     handle: Option<JoinHandle<()>>,
     info: Info,
     solves: usize,
+    /// The pose inputs of the model's rigid bodies (shared with the model: set between solves).
+    poses: PoseInputs,
 }
 
 impl PySession {
     /// Starts the worker thread of a session of `joint` and waits (GIL released) until it has
     /// factorised the model.
-    pub(crate) fn open(py: Python<'_>, joint: Joint) -> PyResult<Self> {
+    pub(crate) fn open(py: Python<'_>, joint: Joint, poses: PoseInputs) -> PyResult<Self> {
         let (tx, worker_rx) = channel::<Cmd>();
         let (worker_tx, rx) = channel::<Message>();
         take_callback_error();
@@ -150,7 +153,7 @@ impl PySession {
             Reply::Started(info) => info,
             _ => return Err(msg("unexpected reply of the session thread")),
         };
-        Ok(Self { tx, rx: Mutex::new(rx), handle: Some(handle), info, solves: 0 })
+        Ok(Self { tx, rx: Mutex::new(rx), handle: Some(handle), info, solves: 0, poses })
     }
 
     fn request(&self, py: Python<'_>, cmd: Cmd) -> PyResult<Reply> {
@@ -190,6 +193,31 @@ impl PySession {
     /// of `step` calls is `Model.run_quasistatic` one frame at a time.
     fn step(&mut self, py: Python<'_>, t: f64) -> PyResult<PyRunResult> {
         self.solve(py, Cmd::Step(t))
+    }
+    /// Sets the pose of rigid body `rigid` (added with `pose_input=True`) for the next
+    /// solves — a navigation tracker's frame: the `translation` of its reference point and
+    /// its rotation, in 3D one of `quaternion=[w, x, y, z]` (normalised), `axis=[x, y, z]`
+    /// with `angle` (rad, right-handed), or `rotation` (a 3 × 3 rotation matrix to 1e-9); no
+    /// rotation: the identity. 2D: `translation` `[x, y]` and `angle`. Then `solve_static(t)`
+    /// (warm-started from the last solution) or `step(t)` (the next quasi-static level,
+    /// friction measured relative to the moving body) solves at the new pose without
+    /// refactorising. Invalid input (shapes, non-finite values, a zero quaternion or axis, a
+    /// matrix that is not a rotation) raises `SynoviaError` and keeps the previous pose.
+    #[pyo3(signature = (rigid, translation, quaternion = None, axis = None, angle = None, rotation = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn set_pose(
+        &self,
+        rigid: &str,
+        translation: &Bound<'_, PyAny>,
+        quaternion: Option<&Bound<'_, PyAny>>,
+        axis: Option<&Bound<'_, PyAny>>,
+        angle: Option<f64>,
+        rotation: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        if self.handle.is_none() {
+            return Err(msg("the session is closed"));
+        }
+        rigid::set_pose(&self.poses, rigid, translation, quaternion, axis, angle, rotation)
     }
     /// Forgets the last solution and friction state (the factorisation is kept).
     fn reset(&mut self, py: Python<'_>) -> PyResult<()> {

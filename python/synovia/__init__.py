@@ -4,7 +4,9 @@ Python bindings (PyO3) of the synovia Rust library: joint models from NumPy arra
 meshes or TOML scenario files; materials; boundary conditions by part name with load histories
 (numbers, NumPy tables, Python callables, settable :class:`Parameter` values); contact pairs of
 every discretisation (node-to-node, node-to-segment / node-to-facet, dual mortar, rigid
-obstacles); contact solvers by name; static, quasi-static and dynamic runs; results as NumPy
+obstacles of any :class:`Shape`, STL surfaces); rigid bodies with mixed control (each degree of
+freedom prescribed or force-controlled, tied plates, shapes as contact partners, poses set
+between session solves); friction laws by name; contact solvers by name; static, quasi-static and dynamic runs; results as NumPy
 arrays and meshio meshes; the re-solve :class:`Session` (factorise once, solve again with new
 loads) with the GIL released during solves; and the Hertz verification problems.
 
@@ -24,10 +26,13 @@ from ._synovia import (
     Parameter,
     RunResult,
     Session,
+    Shape,
+    Surface,
     SynoviaError,
     __version__,
     hertz2d,
     hertz3d,
+    read_stl,
     run_scenario,
 )
 from ._meshio import arrays_from_meshio, result_to_meshio
@@ -40,10 +45,13 @@ __all__ = [
     "Parameter",
     "RunResult",
     "Session",
+    "Shape",
+    "Surface",
     "SynoviaError",
     "arrays_from_meshio",
     "hertz2d",
     "hertz3d",
+    "read_stl",
     "result_to_meshio",
     "run_scenario",
     "hertz_json",

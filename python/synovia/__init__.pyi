@@ -58,6 +58,57 @@ class Material:
     def mooney_rivlin(c1: float, c2: float, lam: float) -> "Material":
         """Compressible Mooney–Rivlin hyperelasticity (c1, c2, volumetric lambda)."""
 
+class Surface:
+    """A triangle surface in 3D (e.g. from an STL file): the boundary of a rigid shape."""
+
+    def __init__(self, vertices: ArrayLike, triangles: ArrayLike) -> None:
+        """From (n, 3) vertices and (m, 3) vertex indices (right-hand rule gives the normal);
+        checks finiteness, indices and non-degenerate triangles."""
+    @property
+    def vertices(self) -> FloatArray: ...
+    @property
+    def triangles(self) -> IndexArray: ...
+    @property
+    def area(self) -> float: ...
+    @property
+    def signed_volume(self) -> float:
+        """Enclosed volume, positive for a closed surface with outward normals."""
+    @property
+    def bounding_box(self) -> Optional[Tuple[List[float], List[float]]]: ...
+    @property
+    def is_closed_solid(self) -> bool:
+        """Closed, manifold, outward oriented and not crossing itself (Shape.surface(solid=True))."""
+    def scaled(self, factor: float) -> "Surface":
+        """Scaled about the origin (units: 1000 from m to mm)."""
+    def __len__(self) -> int: ...
+
+def read_stl(path: PathLike, scale: Optional[float] = None) -> Surface:
+    """Reads an ASCII or binary STL file; `scale` multiplies the coordinates."""
+
+class Shape:
+    """A rigid contact shape: a fixed obstacle (Model.contact_obstacle) or the shape of a rigid
+    body in its own frame (Model.contact_rigid_body). The signed distance is positive on the
+    elastic body's side."""
+
+    @staticmethod
+    def plane(point: ArrayLike, normal: ArrayLike) -> "Shape":
+        """Half-space bounded by the plane through `point` with outward `normal`."""
+    @staticmethod
+    def sphere(center: ArrayLike, radius: float, cavity: bool = False) -> "Shape":
+        """Ball (cavity=False) or spherical cavity (cavity=True); a disc in 2D."""
+    @staticmethod
+    def cylinder(point: ArrayLike, axis: ArrayLike, radius: float, cavity: bool = False) -> "Shape":
+        """Cylinder (3D)."""
+    @staticmethod
+    def surface(surface: Surface, solid: bool = True) -> "Shape":
+        """Bounded by a triangle surface (3D): solid=True needs a closed surface with outward
+        normals (else SynoviaError), solid=False accepts an oriented open patch."""
+    @staticmethod
+    def stl(path: PathLike, scale: Optional[float] = None, solid: bool = True) -> "Shape":
+        """Shape.surface(read_stl(path, scale), solid)."""
+    def distance(self, x: ArrayLike) -> FloatArray:
+        """Signed distance of points (n, D) in the shape's own frame."""
+
 class RunResult:
     """The result of a run or of a session solve: records, NumPy fields, KKT residuals."""
 
@@ -78,6 +129,11 @@ class RunResult:
     def pairs(self, step: int = -1) -> Dict[str, Dict[str, Any]]:
         """{pair name: {force, normal_force, tangential_force, contact_area, peak_pressure,
         mean_pressure, stick_area, slip_area, moment, centre_of_pressure, sides}} of a step."""
+    def rigid_bodies(self, step: int = -1) -> Dict[str, Dict[str, Any]]:
+        """{rigid body name: {dofs, reaction, applied, force, moment, balance_error, solves}} of a
+        step: coordinates q (lengths, radians), generalised reactions Q of the elastic bodies,
+        applied generalised forces F (None where prescribed), resultant force and moment about
+        the moved reference point."""
     def pair_history(self, pair: str, quantity: str) -> FloatArray:
         """One scalar figure of a pair over the steps, shape (n_steps,)."""
     def nodes(self, body: BodyRef) -> FloatArray:
@@ -128,6 +184,21 @@ class Session:
         """The static problem at t with the current loads, warm-started."""
     def step(self, t: float) -> RunResult:
         """One quasi-static level at t (later than the last solve)."""
+    def set_pose(
+        self,
+        rigid: str,
+        translation: ArrayLike,
+        quaternion: Optional[ArrayLike] = None,
+        axis: Optional[ArrayLike] = None,
+        angle: Optional[float] = None,
+        rotation: Optional[ArrayLike] = None,
+    ) -> None:
+        """Sets the pose of a rigid body added with pose_input=True for the next solves: the
+        translation of its reference point and, in 3D, quaternion=[w, x, y, z] (normalised),
+        axis with angle (rad), or a 3 × 3 rotation matrix (none: identity); in 2D, angle.
+        Then solve_static(t) (warm-started) or step(t) (quasi-static, friction relative to the
+        moving body) solves at that pose without refactorising. Bad input raises SynoviaError
+        and keeps the previous pose."""
     def reset(self) -> None:
         """Forgets the last solution and friction state; keeps the factorisation."""
     def close(self) -> None:
@@ -174,6 +245,8 @@ class Model:
     def parts(self, body: BodyRef) -> List[str]: ...
     def nodes(self, body: BodyRef) -> FloatArray: ...
     def cells(self, body: BodyRef) -> IndexArray: ...
+    def facets(self, body: BodyRef, part: str) -> IndexArray:
+        """The facets (node indices, (k, D)) of a boundary part."""
     def add_body(
         self,
         name: str,
@@ -250,6 +323,80 @@ class Model:
         cavity: bool = False,
         friction: float = 0.0,
     ) -> None: ...
+    def contact_obstacle(
+        self,
+        name: str,
+        body: BodyRef,
+        part: str,
+        shape: Shape,
+        friction: float = 0.0,
+        search_distance: Optional[float] = None,
+    ) -> None:
+        """Contact pair between a part and a fixed rigid obstacle of any Shape (e.g. an STL surface)."""
+    def add_rigid_body(
+        self,
+        name: str,
+        center: Optional[ArrayLike] = None,
+        rotation_order: Optional[str] = None,
+        prescribe: Optional[Mapping[str, History]] = None,
+        force: Optional[Mapping[str, History]] = None,
+        guess: Optional[Mapping[str, History]] = None,
+        pose_input: bool = False,
+    ) -> int:
+        """A rigid body with mixed control (a scenario's [[rigid_body]]): reference point
+        `center` (default origin), `rotation_order` (3D, default "zxy": R = R_z R_x R_y).
+        Degrees of freedom by name ("tx", "ty", "tz", "rx", "ry", "rz"; 2D "tx", "ty", "rz"),
+        held at 0 unless in `prescribe` (coordinate history, lengths and radians) or `force`
+        (generalised force history: force along the axis / moment about the angle's axis;
+        the coordinate follows from equilibrium), with `guess` a predictor of a
+        force-controlled coordinate. pose_input=True: the other degrees of freedom follow
+        Session.set_pose / Model.set_pose. Returns the rigid body's index."""
+    @property
+    def rigid_bodies(self) -> List[str]: ...
+    def tie_to_rigid_body(self, body: BodyRef, part: str, rigid: str) -> None:
+        """Ties a part to a rigid body (rigid plate): it moves with the pose, its reactions load the body."""
+    def contact_rigid_body(
+        self,
+        name: str,
+        body: BodyRef,
+        part: str,
+        rigid: str,
+        shape: Shape,
+        friction: float = 0.0,
+        search_distance: Optional[float] = None,
+    ) -> None:
+        """Contact pair between a part and a rigid body's shape (its own frame, placed by its pose)."""
+    def set_pose(
+        self,
+        rigid: str,
+        translation: ArrayLike,
+        quaternion: Optional[ArrayLike] = None,
+        axis: Optional[ArrayLike] = None,
+        angle: Optional[float] = None,
+        rotation: Optional[ArrayLike] = None,
+    ) -> None:
+        """Sets the pose of a rigid body with pose_input=True for the next runs (as Session.set_pose)."""
+    def friction_law(
+        self,
+        pair: str,
+        law: str,
+        mu: Optional[float] = None,
+        static: Optional[float] = None,
+        kinetic: Optional[float] = None,
+        speed: Optional[float] = None,
+    ) -> None:
+        """Friction law of a pair by name: "coulomb" (mu) or "exponential" (static, kinetic,
+        speed: F_c(v) = μ_k + (μ_s − μ_k) exp(−v / v_c)); quasi-static and dynamic runs."""
+    def quasistatic_options(
+        self,
+        coulomb_fixed_point: Optional[bool] = None,
+        max_fixed_point: Optional[int] = None,
+        fixed_point_tolerance: Optional[float] = None,
+        incremental_slip: Optional[bool] = None,
+        initial_friction: Optional[bool] = None,
+    ) -> None:
+        """Friction scheme of quasi-static runs and session steps: Tresca with the bound frozen
+        from the previous level (default) or the Coulomb fixed point (coulomb_fixed_point=True)."""
     def solver(self, name: str) -> None:
         """"pdas-fallback" (default), "pdas", "au-pdas", "uzawa-mprgp", "dual-mprgp"."""
     def nested_iteration(self, min_rows: Optional[int]) -> None: ...

@@ -1,0 +1,491 @@
+"""Rigid bodies with mixed control, STL shapes, friction laws and posed sessions built from
+Python (issue 18): the same models as scenario files give the same figures to 1e-12, a
+force-controlled plate carries its load, a posed session frame equals a fresh solve at that
+pose, and bad input raises SynoviaError with the Rust message."""
+
+import numpy as np
+import pytest
+
+import synovia
+from conftest import SCENARIOS, box
+
+MAT = synovia.Material.isotropic
+
+
+def max_rel(a, b):
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    assert a.shape == b.shape
+    scale = max(np.max(np.abs(b)) if b.size else 0.0, 1e-300)
+    return np.max(np.abs(a - b)) / scale if a.size else 0.0
+
+
+def same_runs(got, ref, tol, what):
+    """Records (pairs, rigid bodies) and the displacements of two runs agree to `tol`
+    (relative to each quantity's largest value); returns the largest difference seen."""
+    worst = 0.0
+    assert len(got.records) == len(ref.records)
+    for rec, rrec in zip(got.records, ref.records):
+        assert rec["time"] == rrec["time"]
+        for p, rp in zip(rec["pairs"], rrec["pairs"]):
+            assert p["name"] == rp["name"]
+            for k in ("normal_force", "tangential_force", "contact_area", "peak_pressure"):
+                worst = max(worst, max_rel(p[k], rp[k]))
+            worst = max(worst, max_rel(p["force"], rp["force"]))
+        for r, rr in zip(rec["rigid"], rrec["rigid"]):
+            assert r["name"] == rr["name"]
+            for k in ("dofs", "reaction", "force", "moment"):
+                worst = max(worst, max_rel(r[k], rr[k]))
+    for b in range(len(ref.bodies)):
+        worst = max(worst, max_rel(got.displacement(b), ref.displacement(b)))
+    assert worst <= tol, f"{what}: relative difference {worst:.3e} > {tol:.0e}"
+    return worst
+
+
+def copy_bodies(scenario_model, materials):
+    """A Python model with the bodies (nodes, cells, boundary parts) of a scenario model."""
+    m = synovia.Model(scenario_model.dimension)
+    for b in scenario_model.bodies:
+        parts = {p: scenario_model.facets(b, p) for p in scenario_model.parts(b)}
+        m.add_body(b, scenario_model.nodes(b), scenario_model.cells(b), materials[b], parts=parts)
+    return m
+
+
+# ----- force-controlled rigid plate: hertz3d_force.toml built from Python -----
+
+
+@pytest.fixture(scope="module")
+def hertz_force():
+    sc = synovia.Model.from_scenario(SCENARIOS / "hertz3d_force.toml")
+    m = copy_bodies(sc, {"sphere": MAT(10.0, 0.3), "block": MAT(10000.0, 0.3)})
+    m.add_rigid_body("plate", center=[0.0, 0.0, 10.0], force={"tz": -2.0})
+    m.tie_to_rigid_body("sphere", "top", "plate")
+    m.clamp("block", "bottom")
+    m.contact("sphere-block", "sphere", "contact", "block", "top", discretisation="node-to-facet")
+    m.solver("pdas")
+    return m, m.run_static(0.0), sc.run()
+
+
+def test_rigid_plate_from_python_equals_scenario(hertz_force):
+    m, got, ref = hertz_force
+    assert m.rigid_bodies == ["plate"]
+    same_runs(got, ref, 1e-12, "hertz3d_force from Python")
+
+
+def test_force_controlled_plate_carries_its_load(hertz_force):
+    _, r, _ = hertz_force
+    plate = r.rigid_bodies()["plate"]
+    assert plate["applied"] == [None, None, -2.0, None, None, None]
+    # the sphere pushes the plate up with the load: Q_z + F_z = 0
+    assert abs(plate["reaction"][2] - 2.0) <= 1e-9 * 2.0
+    assert abs(plate["force"][2] - 2.0) <= 1e-9 * 2.0
+    # ... and the block carries it: the contact resultant equals P
+    pair = r.pairs()["sphere-block"]
+    assert abs(abs(pair["force"][2]) - 2.0) <= 1e-9 * 2.0
+    assert abs(pair["normal_force"] - 2.0) <= 1e-9 * 2.0
+    assert plate["balance_error"] < 1e-9
+    assert r.records[-1]["rigid"][0] == plate
+    # the prescribed degrees of freedom stay at 0, the plate moved down
+    assert plate["dofs"][2] < 0 and all(plate["dofs"][k] == 0.0 for k in (0, 1, 3, 4, 5))
+
+
+# ----- an STL ball as a rigid body's shape: force control, prescribed motion, friction -----
+
+
+def uv_sphere(center, radius, n_lon=32, n_lat=16):
+    """A closed triangulated sphere with outward normals: vertices and triangles."""
+    c = np.asarray(center, dtype=float)
+    verts = [c + [0.0, 0.0, -radius]]
+    for i in range(1, n_lat):
+        th = np.pi * i / n_lat - np.pi / 2
+        for j in range(n_lon):
+            ph = 2 * np.pi * j / n_lon
+            verts.append(c + radius * np.array([np.cos(th) * np.cos(ph), np.cos(th) * np.sin(ph), np.sin(th)]))
+    verts.append(c + [0.0, 0.0, radius])
+    verts = np.array(verts)
+    ring = lambda i, j: 1 + (i - 1) * n_lon + (j % n_lon)  # noqa: E731
+    top = len(verts) - 1
+    tris = []
+    for j in range(n_lon):
+        tris.append((0, ring(1, j + 1), ring(1, j)))
+        tris.append((top, ring(n_lat - 1, j), ring(n_lat - 1, j + 1)))
+        for i in range(1, n_lat - 1):
+            a, b, cc, d = ring(i, j), ring(i, j + 1), ring(i + 1, j + 1), ring(i + 1, j)
+            tris += [(a, b, cc), (a, cc, d)]
+    tris = np.array(tris)
+    # orient every triangle outward
+    for k, t in enumerate(tris):
+        p = verts[t]
+        if np.dot(np.cross(p[1] - p[0], p[2] - p[0]), p.mean(axis=0) - c) < 0:
+            tris[k] = t[[0, 2, 1]]
+    return verts, tris
+
+
+def write_stl(path, verts, tris):
+    with open(path, "w") as f:
+        f.write("solid ball\n")
+        for t in tris:
+            p = verts[t]
+            n = np.cross(p[1] - p[0], p[2] - p[0])
+            n = n / np.linalg.norm(n)
+            f.write(f"facet normal {n[0]:.17g} {n[1]:.17g} {n[2]:.17g}\n outer loop\n")
+            for v in p:
+                f.write(f"  vertex {v[0]:.17g} {v[1]:.17g} {v[2]:.17g}\n")
+            f.write(" endloop\nendfacet\n")
+        f.write("endsolid ball\n")
+
+
+BALL_TOML = """
+dimension = 3
+title = "an STL ball pressed onto a block by a force, dragged and twisted"
+
+[[body]]
+name = "block"
+mesh = { generator = "box", lo = [-1.0, -1.0, 0.0], hi = [1.0, 1.0, 1.0], cells = [8, 8, 4] }
+material = { type = "isotropic", E = 1000.0, nu = 0.3 }
+
+[[boundary]]
+body = "block"
+part = "bottom"
+kind = "clamped"
+
+[[rigid_body]]
+name = "ball"
+center = [0.0, 0.0, 1.5]
+shape = { type = "stl", file = "ball_m.stl", scale = 1000.0 }
+tx = { value = 1.0, history = { table = [[0.0, 0.0], [1.0, 0.02]] } }
+tz = { force = -50.0 }
+rz = { value = 2.0, history = { table = [[0.0, 0.0], [1.0, 1.0]] } }
+
+[[contact]]
+name = "ball-block"
+body = "block"
+part = "top"
+rigid_body = "ball"
+friction = 0.2
+search_distance = 0.3
+
+[solver]
+name = "pdas"
+
+[analysis]
+type = "quasistatic"
+times = [0.0, 0.5, 1.0]
+"""
+
+
+@pytest.fixture(scope="module")
+def ball_files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("ball")
+    verts, tris = uv_sphere([0.0, 0.0, 1.5], 0.5)
+    # in metres: the model is in millimetres (scale = 1000)
+    write_stl(d / "ball_m.stl", verts / 1000.0, tris)
+    (d / "ball.toml").write_text(BALL_TOML)
+    return d
+
+
+def test_stl_rigid_body_with_friction_equals_scenario(ball_files):
+    sc = synovia.Model.from_scenario(ball_files / "ball.toml")
+    surface = synovia.read_stl(ball_files / "ball_m.stl", scale=1000.0)
+    assert len(surface) == 2 * 32 * 15 and surface.is_closed_solid
+    lo, hi = surface.bounding_box
+    np.testing.assert_allclose(lo, [-0.5, -0.5, 1.0], atol=1e-12)
+    np.testing.assert_allclose(hi, [0.5, 0.5, 2.0], atol=1e-12)
+    m = copy_bodies(sc, {"block": MAT(1000.0, 0.3)})
+    m.clamp("block", "bottom")
+    m.add_rigid_body(
+        "ball",
+        center=[0.0, 0.0, 1.5],
+        prescribe={"tx": np.array([[0.0, 0.0], [1.0, 0.02]]), "rz": [[0.0, 0.0], [1.0, np.deg2rad(2.0)]]},
+        force={"tz": -50.0},
+    )
+    shape = synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0)
+    m.contact_rigid_body("ball-block", "block", "top", "ball", shape, friction=0.2, search_distance=0.3)
+    m.solver("pdas")
+    got, ref = m.run_quasistatic([0.0, 0.5, 1.0]), sc.run()
+    same_runs(got, ref, 1e-12, "STL ball from Python")
+    for rec in got.records:
+        ball = rec["rigid"][0]
+        # force control: the contact carries the 50 N
+        assert abs(ball["reaction"][2] - 50.0) <= 1e-9 * 50.0
+        assert abs(rec["pairs"][0]["force"][2] + 50.0) <= 1e-9 * 50.0
+    # the dragged ball pulls the surface along (friction relative to the moving body)
+    assert got.records[-1]["pairs"][0]["tangential_force"] > 0.0
+    assert got.rigid_bodies()["ball"]["dofs"][0] == pytest.approx(0.02, abs=1e-15)
+
+
+def test_fixed_stl_obstacle_equals_sphere_and_open_patch(ball_files):
+    """A fixed STL ball and an analytic ball of the same radius give close contact forces; an
+    open patch needs solid=False."""
+    nodes, cells = box(-1.0, 1.0, -1.0, 1.0, 0.0, 1.0, 6)
+
+    def model(shape):
+        m = synovia.Model(3)
+        m.add_body("block", nodes, cells, MAT(1000.0, 0.3))
+        m.add_part_where("block", "top", lambda x, n: n[2] > 0.9 and x[2] > 0.999)
+        m.add_part_where("block", "bottom", lambda x, n: n[2] < -0.9 and x[2] < 1e-9)
+        m.clamp("block", "bottom")
+        m.contact_obstacle("ball", "block", "top", shape, search_distance=0.3)
+        return m.run_static()
+
+    stl = model(synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0, solid=True))
+    # the faceted ball, pushed 0.01 into the block, against the exact one
+    assert abs(stl.pairs()["ball"]["normal_force"]) <= 1e-12
+    verts, tris = uv_sphere([0.0, 0.0, 1.49], 0.5)
+    pushed = model(synovia.Shape.surface(synovia.Surface(verts, tris)))
+    exact = model(synovia.Shape.sphere([0.0, 0.0, 1.49], 0.5))
+    f_stl, f_exact = pushed.pairs()["ball"]["normal_force"], exact.pairs()["ball"]["normal_force"]
+    assert f_exact > 0 and abs(f_stl - f_exact) <= 0.05 * f_exact
+    # an open patch: refused as a solid (the Rust message), accepted as an open surface
+    patch = synovia.Surface([[-2, -2, 1.2], [2, -2, 1.2], [2, 2, 1.2], [-2, 2, 1.2]], [[0, 2, 1], [0, 3, 2]])
+    assert not patch.is_closed_solid
+    with pytest.raises(synovia.SynoviaError, match="the surface is open"):
+        synovia.Shape.surface(patch)
+    flat = synovia.Shape.surface(patch, solid=False)
+    # normals point down (into the free space below the patch): φ > 0 below
+    assert flat.distance([0.0, 0.0, 1.0])[0] == pytest.approx(0.2, abs=1e-12)
+
+
+# ----- friction laws by name -----
+
+
+def test_friction_law_by_name_equals_scenario(tmp_path):
+    """The dynamic drop of examples/scenarios/dynamic_drop2d.toml: its exponential law set
+    from Python on the same file without `friction_law` gives the file's run to 1e-12."""
+    text = (SCENARIOS / "dynamic_drop2d.toml").read_text()
+    line = "friction_law = { static = 0.5, kinetic = 0.3, speed = 50.0 }\n"
+    assert line in text
+    (tmp_path / "drop.toml").write_text(text.replace(line, ""))
+    ref = synovia.Model.from_scenario(SCENARIOS / "dynamic_drop2d.toml").run()
+    m = synovia.Model.from_scenario(tmp_path / "drop.toml")
+    plain = m.run()
+    m.friction_law("floor", "exponential", static=0.5, kinetic=0.3, speed=50.0)
+    got = m.run()
+    same_runs(got, ref, 1e-12, "exponential friction law from Python")
+    # the law matters: μ = 0.5 at rest against the constant 0.3
+    assert max_rel(plain.displacement(0), ref.displacement(0)) > 1e-6
+    # static = kinetic: the constant coefficient, as the law "coulomb"
+    m.friction_law("floor", "exponential", static=0.3, kinetic=0.3, speed=50.0)
+    same_runs(m.run(), plain, 1e-12, "exponential with μ_s = μ_k")
+    m.friction_law("floor", "coulomb", mu=0.3)
+    same_runs(m.run(), plain, 1e-12, "coulomb law")
+
+
+def test_quasistatic_friction_law_and_scheme():
+    """In quasi-static runs: "coulomb" with μ on a frictionless pair equals the pair's own
+    coefficient; the Coulomb fixed point (quasistatic_options) changes the Tresca result."""
+    nodes, cells = box(-1.0, 1.0, -1.0, 1.0, 0.0, 1.0, 4)
+
+    def model(friction):
+        m = synovia.Model(3)
+        m.add_body("block", nodes, cells, MAT(1000.0, 0.3))
+        m.add_part_where("block", "top", lambda x, n: n[2] > 0.9 and x[2] > 0.999)
+        m.add_part_where("block", "bottom", lambda x, n: n[2] < -0.9 and x[2] < 1e-9)
+        m.prescribe("block", "top", [0.05, 0.0, -0.02], history=[[0.0, 0.0], [1.0, 1.0]])
+        m.contact_obstacle("floor", "block", "bottom", synovia.Shape.plane([0, 0, 0], [0, 0, 1]), friction=friction)
+        return m
+
+    times = [0.0, 0.5, 1.0]
+    ref = model(0.3).run_quasistatic(times)
+    m = model(0.0)
+    m.friction_law("floor", "coulomb", mu=0.3)
+    same_runs(m.run_quasistatic(times), ref, 1e-12, "coulomb law in quasi-static runs")
+    assert ref.pairs()["floor"]["tangential_force"] > 0
+    c = model(0.3)
+    c.quasistatic_options(coulomb_fixed_point=True, max_fixed_point=100, fixed_point_tolerance=1e-10)
+    coulomb = c.run_quasistatic(times)
+    assert coulomb.kkt["max"] < 1e-6
+    assert max_rel(coulomb.displacement(0), ref.displacement(0)) > 1e-9
+
+
+# ----- posed sessions -----
+
+CENTRE = [0.0, 0.0, 2.0]
+# translation of the reference point, angles (rx, ry, rz) of R = R_z R_x R_y
+FRAMES = [
+    ([0.0, 0.0, -0.05], [0.0, 0.0, 0.0]),
+    ([0.01, 0.02, -0.06], [0.05, -0.03, 0.2]),
+    ([0.02, 0.03, -0.06], [0.1, -0.05, 0.4]),
+    ([0.01, 0.02, -0.055], [0.05, 0.02, 0.1]),
+]
+
+
+def rot(axis, a):
+    c, s = np.cos(a), np.sin(a)
+    return {
+        0: np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
+        1: np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+        2: np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]]),
+    }[axis]
+
+
+def quat_mul(p, q):
+    w1, x1, y1, z1 = p
+    w2, x2, y2, z2 = q
+    return np.array([
+        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+    ])
+
+
+def quat(axis, a):
+    q = np.zeros(4)
+    q[0], q[1 + axis] = np.cos(a / 2), np.sin(a / 2)
+    return q
+
+
+def ball_model(friction, **rigid):
+    """A block clamped at its bottom, a rigid ball (radius 0.5, its centre 0.48 below the
+    reference point, so rotations move it) just above its top."""
+    nodes, cells = box(-1.0, 1.0, -1.0, 1.0, 0.0, 1.0, 6)
+    m = synovia.Model(3)
+    m.add_body("block", nodes, cells, MAT(1000.0, 0.3))
+    m.add_part_where("block", "top", lambda x, n: n[2] > 0.9 and x[2] > 0.999)
+    m.add_part_where("block", "bottom", lambda x, n: n[2] < -0.9 and x[2] < 1e-9)
+    m.clamp("block", "bottom")
+    m.add_rigid_body("ball", center=CENTRE, **rigid)
+    m.contact_rigid_body("ball-block", "block", "top", "ball", synovia.Shape.sphere([0, 0, 1.52], 0.5), friction)
+    return m
+
+
+def fixed(frame):
+    t, a = frame
+    return {"tx": t[0], "ty": t[1], "tz": t[2], "rx": a[0], "ry": a[1], "rz": a[2]}
+
+
+def test_posed_frames_equal_fresh_static_solves():
+    m = ball_model(0.0, pose_input=True)
+    worst = 0.0
+    with m.prepare() as s:
+        for i, (t, a) in enumerate(FRAMES):
+            q = quat_mul(quat_mul(quat(2, a[2]), quat(0, a[0])), quat(1, a[1]))
+            r = rot(2, a[2]) @ rot(0, a[0]) @ rot(1, a[1])
+            # the three forms of the same rotation
+            if i % 3 == 0:
+                s.set_pose("ball", t, quaternion=q)
+            elif i % 3 == 1:
+                angle = 2 * np.arccos(np.clip(q[0], -1, 1))
+                s.set_pose("ball", t, axis=q[1:], angle=angle)
+            else:
+                s.set_pose("ball", t, rotation=r)
+            got = s.solve_static()
+            assert got.warm_started == (i > 0)
+            fresh = ball_model(0.0, prescribe=fixed((t, a))).run_static()
+            assert fresh.pairs()["ball-block"]["normal_force"] > 0
+            worst = max(worst, same_runs(got, fresh, 1e-10, f"frame {i}"))
+            np.testing.assert_allclose(got.rigid_bodies()["ball"]["dofs"], list(t) + list(a), atol=1e-12)
+        assert s.factorizations == 1 and s.solves == len(FRAMES)
+    print(f"posed frames vs fresh static solves: largest relative difference {worst:.2e}")
+
+
+def test_posed_steps_with_friction_equal_quasistatic_run():
+    """Frames set by quaternion and solved by session steps (friction relative to the moving
+    ball) equal the quasi-static run of the same poses as coordinate tables."""
+    times = [0.0, 1.0, 2.0, 3.0]
+    m = ball_model(0.3, pose_input=True)
+    results = []
+    with m.prepare() as s:
+        for i, (t, a) in enumerate(FRAMES):
+            q = quat_mul(quat_mul(quat(2, a[2]), quat(0, a[0])), quat(1, a[1]))
+            s.set_pose("ball", t, quaternion=2.5 * q)  # normalised by the library
+            results.append(s.solve_static(times[i]) if i == 0 else s.step(times[i]))
+    tables = {
+        name: np.array([[times[i], fixed(f)[name]] for i, f in enumerate(FRAMES)])
+        for name in ("tx", "ty", "tz", "rx", "ry", "rz")
+    }
+    ref = ball_model(0.3, prescribe=tables).run_quasistatic(times)
+    worst = 0.0
+    for i, got in enumerate(results):
+        rrec, prec = ref.records[i], got.records[0]
+        for k in ("normal_force", "tangential_force"):
+            worst = max(worst, max_rel(prec["pairs"][0][k], rrec["pairs"][0][k]))
+        worst = max(worst, max_rel(prec["rigid"][0]["dofs"], rrec["rigid"][0]["dofs"]))
+    worst = max(worst, max_rel(results[-1].displacement(0), ref.displacement(0)))
+    assert worst <= 1e-9, f"posed steps vs quasi-static run: {worst:.2e}"
+    assert all(r.records[0]["pairs"][0]["tangential_force"] > 0 for r in results[1:])
+    print(f"posed steps with friction vs quasi-static run: largest relative difference {worst:.2e}")
+
+
+def test_model_set_pose_and_2d_pose():
+    m = ball_model(0.0, pose_input=True)
+    t, a = FRAMES[2]
+    m.set_pose("ball", t, rotation=rot(2, a[2]) @ rot(0, a[0]) @ rot(1, a[1]))
+    same_runs(m.run_static(), ball_model(0.0, prescribe=fixed(FRAMES[2])).run_static(), 1e-10, "Model.set_pose")
+    # 2D: a rigid disc posed by translation and angle, against prescribed coordinates
+    from conftest import rectangle
+
+    nodes, cells, parts = rectangle(-1.0, 1.0, 0.0, 1.0, 8, 4)
+
+    def disc(**rigid):
+        m2 = synovia.Model(2)
+        m2.add_body("b", nodes, cells, synovia.Material.plane_strain(1000.0, 0.3), parts=parts)
+        m2.clamp("b", "bottom")
+        m2.add_rigid_body("disc", center=[0.0, 2.0], **rigid)
+        m2.contact_rigid_body("d", "b", "top", "disc", synovia.Shape.sphere([0.0, 1.5], 0.5))
+        return m2
+
+    p = disc(pose_input=True)
+    with p.prepare() as s:
+        s.set_pose("disc", [0.0, -0.05], angle=0.1)
+        got = s.solve_static()
+        with pytest.raises(synovia.SynoviaError, match="2D pose"):
+            s.set_pose("disc", [0.0, 0.0], quaternion=[1, 0, 0, 0])
+    same_runs(got, disc(prescribe={"ty": -0.05, "rz": 0.1}).run_static(), 1e-10, "2D pose")
+    assert got.pairs()["d"]["normal_force"] > 0
+
+
+# ----- bad input: SynoviaError with the Rust message, never a panic -----
+
+
+def test_bad_rigid_input_raises():
+    m = ball_model(0.0, pose_input=True)
+    with pytest.raises(synovia.SynoviaError, match="unknown rigid degree of freedom `tw`"):
+        m.add_rigid_body("x", prescribe={"tw": 0.0})
+    with pytest.raises(synovia.SynoviaError, match="both prescribed and force-controlled"):
+        m.add_rigid_body("x", prescribe={"tz": 0.0}, force={"tz": 1.0})
+    with pytest.raises(synovia.SynoviaError, match="rotation order `xxy` must be a permutation"):
+        m.add_rigid_body("x", rotation_order="xxy")
+    with pytest.raises(synovia.SynoviaError, match="is not finite"):
+        m.add_rigid_body("x", center=[0.0, np.nan, 0.0])
+    with pytest.raises(synovia.SynoviaError, match="two rigid bodies are called `ball`"):
+        m.add_rigid_body("ball")
+    with pytest.raises(synovia.SynoviaError, match="unknown rigid body `femur`"):
+        m.tie_to_rigid_body("block", "top", "femur")
+    with pytest.raises(synovia.SynoviaError, match="3D only"):
+        synovia.Model(2).add_rigid_body("x", rotation_order="zxy")
+    with pytest.raises(synovia.SynoviaError, match="unknown friction law `stribeck`"):
+        m.friction_law("ball-block", "stribeck", mu=0.1)
+    with pytest.raises(synovia.SynoviaError, match="no contact pair `nope`"):
+        m.friction_law("nope", "coulomb", mu=0.1)
+    with pytest.raises(synovia.SynoviaError, match="needs `speed`"):
+        m.friction_law("ball-block", "exponential", static=0.5, kinetic=0.3)
+    with pytest.raises(synovia.SynoviaError, match="cannot|No such file|not found"):
+        synovia.read_stl("/nonexistent/ball.stl")
+    m2 = synovia.Model(2)
+    with pytest.raises(synovia.SynoviaError, match="3D only"):
+        m2.add_rigid_body("c")
+        m2.contact_obstacle("c", 0, "top", synovia.Shape.cylinder([0, 0, 0], [0, 0, 1], 1.0))
+    with m.prepare() as s:
+        with pytest.raises(synovia.SynoviaError, match=r"quaternion \[w, x, y, z\] must have 4 components, got 3"):
+            s.set_pose("ball", [0, 0, 0], quaternion=[1.0, 0.0, 0.0])
+        with pytest.raises(synovia.SynoviaError, match="pose: quaternion .* is not finite"):
+            s.set_pose("ball", [0, 0, 0], quaternion=[np.nan, 0.0, 0.0, 1.0])
+        with pytest.raises(synovia.SynoviaError, match="has no direction"):
+            s.set_pose("ball", [0, 0, 0], quaternion=[0.0, 0.0, 0.0, 0.0])
+        with pytest.raises(synovia.SynoviaError, match="pose: translation .* is not finite"):
+            s.set_pose("ball", [0, np.inf, 0], axis=[0, 0, 1], angle=0.1)
+        with pytest.raises(synovia.SynoviaError, match="is not a rotation"):
+            s.set_pose("ball", [0, 0, 0], rotation=np.diag([1.0, 1.0, -1.0]))
+        with pytest.raises(synovia.SynoviaError, match="translation must have 3 components"):
+            s.set_pose("ball", [0, 0], quaternion=[1, 0, 0, 0])
+        with pytest.raises(synovia.SynoviaError, match="give one rotation"):
+            s.set_pose("ball", [0, 0, 0], quaternion=[1, 0, 0, 0], rotation=np.eye(3))
+        with pytest.raises(synovia.SynoviaError, match="has no pose input"):
+            s.set_pose("femur", [0, 0, 0])
+        # a refused pose keeps the previous one: the session still solves the identity pose
+        s.set_pose("ball", [0, 0, -0.05])
+        r = s.solve_static()
+        assert r.rigid_bodies()["ball"]["dofs"] == pytest.approx([0, 0, -0.05, 0, 0, 0], abs=1e-15)
+    with pytest.raises(synovia.SynoviaError, match="the session is closed"):
+        s.set_pose("ball", [0, 0, 0])
