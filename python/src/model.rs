@@ -1074,6 +1074,55 @@ impl PyModel {
     fn solver(&mut self, name: &str) -> PyResult<()> {
         with_joint_mut!(self, j => { j.solver(name).map_err(err)?; Ok(()) })
     }
+    /// Options of the contact solve (the scenario's `[solver]` keys): `interface_block_dofs`,
+    /// the largest contact interface factorised as a dense trailing block (0: none; large
+    /// candidate surfaces with moving patches), and `screening_band`, each solve on the
+    /// contact rows within that distance of the partner (exact, docs/performance.md).
+    #[pyo3(signature = (interface_block_dofs = None, screening_band = None))]
+    fn solver_options(
+        &mut self,
+        interface_block_dofs: Option<usize>,
+        screening_band: Option<f64>,
+    ) -> PyResult<()> {
+        with_joint_mut!(self, j => {
+            if let Some(v) = interface_block_dofs {
+                let base = synovia::linalg::InterfaceBlockParams::default();
+                j.interface_block(base.with_max_dofs(v).with_screened_dofs(base.screened_dofs.min(v)));
+            }
+            if let Some(b) = screening_band {
+                j.screening_band(Some(b)).map_err(err)?;
+            }
+            Ok(())
+        })
+    }
+    /// Reports the figures of contact pair `pair` also split by the plane through `point`
+    /// with `normal` into the sides `positive` (where the normal points) and `negative` (e.g.
+    /// lateral and medial): each pair dict then has them in `sides`. Reporting only.
+    #[pyo3(signature = (pair, point, normal, positive = "positive", negative = "negative"))]
+    fn split_pair(
+        &mut self,
+        pair: &str,
+        point: &Bound<'_, PyAny>,
+        normal: &Bound<'_, PyAny>,
+        positive: &str,
+        negative: &str,
+    ) -> PyResult<()> {
+        let d = self.dimension();
+        let three = |v: Vec<f64>, what: &str| -> PyResult<[f64; 3]> {
+            if v.len() != d {
+                return Err(msg(format!("{what} must have {d} components, got {}", v.len())));
+            }
+            Ok([v[0], v[1], v.get(2).copied().unwrap_or(0.0)])
+        };
+        let split = synovia::contact_ops::operators::PairSplit::new(
+            positive,
+            negative,
+            three(floats(point, "point")?, "point")?,
+            three(floats(normal, "normal")?, "normal")?,
+        )
+        .map_err(err)?;
+        with_joint_mut!(self, j => { j.split_pair_report(pair, split.clone()).map_err(err)?; Ok(()) })
+    }
     /// Nested iteration for cold-started contact solves (`None` turns it off; default 32).
     #[pyo3(signature = (min_rows))]
     fn nested_iteration(&mut self, min_rows: Option<usize>) -> PyResult<()> {

@@ -400,6 +400,14 @@ class Model:
     def solver(self, name: str) -> None:
         """"pdas-fallback" (default), "pdas", "au-pdas", "uzawa-mprgp", "dual-mprgp"."""
     def nested_iteration(self, min_rows: Optional[int]) -> None: ...
+    def solver_options(self, interface_block_dofs: Optional[int] = None, screening_band: Optional[float] = None) -> None:
+        """The scenario's [solver] keys: the largest dense interface block (0: none) and the
+        screening band of each solve (exact)."""
+    def split_pair(
+        self, pair: str, point: ArrayLike, normal: ArrayLike, positive: str = "positive", negative: str = "negative"
+    ) -> None:
+        """Reports a pair's figures also per side of a plane (pair dict `sides`; e.g. medial /
+        lateral). Reporting only."""
     def run_static(self, t: float = 0.0) -> RunResult: ...
     def run_quasistatic(self, times: Sequence[float], keep_steps: bool = False) -> RunResult: ...
     def run_dynamic(self, dt: float, steps: int, keep_steps: bool = False) -> RunResult: ...
