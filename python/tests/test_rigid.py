@@ -243,6 +243,10 @@ def test_fixed_stl_obstacle_equals_sphere_and_open_patch(ball_files):
     assert not patch.is_closed_solid
     with pytest.raises(synovia.SynoviaError, match="the surface is open"):
         synovia.Shape.surface(patch)
+    write_stl(ball_files / "patch.stl", np.asarray(patch.vertices), np.asarray(patch.triangles, dtype=int))
+    with pytest.raises(synovia.SynoviaError, match=r"patch\.stl: .*the surface is open"):
+        synovia.Shape.stl(ball_files / "patch.stl")
+    assert len(synovia.read_stl(ball_files / "patch.stl")) == 2
     flat = synovia.Shape.surface(patch, solid=False)
     # normals point down (into the free space below the patch): φ > 0 below
     assert flat.distance([0.0, 0.0, 1.0])[0] == pytest.approx(0.2, abs=1e-12)
