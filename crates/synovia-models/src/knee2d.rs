@@ -641,3 +641,423 @@ pub fn hertz_estimate(p: Real, r: Real, e: Real, nu: Real) -> (Real, Real) {
     let a = (4.0 * p * r / (PI * e_star)).sqrt();
     (a, 2.0 * p / (PI * a))
 }
+
+/// One pose of the cycle with hyperelastic cartilage ([`nonlinear_cycle`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct NonlinearKneeStep {
+    /// The figures of the pose as for the linear cycle; `solver_iterations` counts the Newton
+    /// iterations of the pose (each a warm-started linearised contact solve).
+    pub step: KneeStep,
+    /// Numeric factorisations of the tangent over the pose.
+    pub factorisations: usize,
+    /// The contact gap of the accepted solution evaluated on its own deformed configuration:
+    /// `max |d(x + u)|` over the active slave nodes, with `d` the signed distance along the
+    /// normal field of the deformed master surface ([`SmoothNodeToSegment`] rebuilt at
+    /// `x + u`), mm. Zero for an exact geometry fixed point.
+    pub gap_error: Real,
+    /// The largest penetration `max(0, −d(x + u))` over every slave node there, mm.
+    pub penetration: Real,
+    /// The shortest facet of the tibial cartilage surface (reference mesh), mm: the scale of
+    /// [`NonlinearKneeStep::gap_error`].
+    pub mesh_size: Real,
+}
+
+impl Knee2d {
+    /// The Newton parameters of [`nonlinear_cycle`]: the contact geometry rebuilt on the
+    /// deformed configuration until it settles (`GeometryUpdate::Converged`, relative change
+    /// of the solution per rebuild ≤ 1e-4), Aitken-relaxed from ω = 0.6, passes with a moving
+    /// geometry ended at a relative residual of 1e-5 (the last one at 1e-10), modified Newton
+    /// (the tangent kept while full steps contract the residual by 0.5). docs/nonlinear.md
+    /// gives the measurements behind these choices.
+    pub fn nonlinear_newton_params() -> synovia::nonlinear::NewtonParams {
+        synovia::nonlinear::NewtonParams::default()
+            .with_geometry_update(synovia::nonlinear::GeometryUpdate::Converged)
+            .with_geometry_tolerance(1e-4)
+            .with_geometry_relaxation(0.6)
+            .with_geometry_aitken(true)
+            .with_geometry_pass_tolerance(Some(1e-5))
+            .with_max_geometry_passes(60)
+            .with_tangent_reuse(Some(0.5))
+    }
+
+    /// The model of [`Knee2d::model`] at the pose `time` with both cartilage layers (the layers
+    /// whose material is [`Knee2d::cartilage`]) compressible neo-Hookean with the small-strain
+    /// constants `(E, ν)` of the linear model, in total Lagrangian finite strain, the bones
+    /// linear, and the contact pair [`SmoothNodeToSegment`] (tibial cartilage slave, femoral
+    /// cartilage master, [`Knee2d::search_distance`]). Returns the model, the pair and one
+    /// kinematics per body.
+    ///
+    /// # Errors
+    /// Mesh, material or model errors.
+    #[allow(clippy::type_complexity)]
+    pub fn neo_hookean_model(
+        &self,
+        time: Real,
+    ) -> Result<(Model<2>, Vec<ContactPair<2>>, Vec<synovia_fem::Kinematics>), KneeError> {
+        use synovia_fem::Kinematics;
+        let (e, nu) = self.cartilage;
+        let law: Arc<dyn synovia_material::Material<2>> = Arc::new(synovia_material::neo_hookean(e, nu)?);
+        let (mut model, _) = self.model(time)?;
+        let [_, n_fc, _, n_tc] = self.body_names;
+        let mut kinematics = vec![Kinematics::SmallStrain; model.bodies().len()];
+        for (name, layer) in [(n_fc, self.femur_layer_material), (n_tc, self.tibia_layer_material)] {
+            if layer.is_none() {
+                let id = model.body_id(name)?;
+                model.body_mut(id)?.material = law.clone();
+                kinematics[id.0] = Kinematics::FiniteStrain;
+            }
+        }
+        let pair = ContactPair::custom(
+            "tibia-femur",
+            model.body_id(n_tc)?,
+            "top",
+            Arc::new(SmoothNodeToSegment {
+                body: model.body_id(n_fc)?,
+                part: "outer".into(),
+                search_distance: self.search_distance,
+            }),
+        );
+        Ok((model, vec![pair], kinematics))
+    }
+}
+
+/// The cycle with hyperelastic cartilage (docs/nonlinear.md): each pose is the model of
+/// [`Knee2d::neo_hookean_model`] (the femur re-meshed in its pose: the flexion is a placement,
+/// as in the linear cycle, so both runs solve the same poses on the same meshes), solved by
+/// the Newton iteration of [`synovia::nonlinear::NonlinearContact`] with `params` (e.g.
+/// [`Knee2d::nonlinear_newton_params`]) under the same load control as the linear cycle: a
+/// secant iteration on the approach `δ` until the vertical contact resultant
+/// `Σ κ_r Λ_n,r n_r · e_y` equals `F(t) / w` within [`Knee2d::tolerance`]. Each secant solve
+/// starts from the previous one's converged deformed state and its contact geometry
+/// (continuation in `δ`); the first solve of a pose ramps from the reference configuration,
+/// starting at `guesses[i]` (e.g. the linear cycle's approach) or else at the previous pose's
+/// approach. With finite-strain kinematics the contact geometry (pairing, normals, gaps) is that
+/// of the deformed configuration, rebuilt until it settles; [`NonlinearKneeStep::gap_error`]
+/// measures what is left of it.
+///
+/// # Errors
+/// Model, Newton or contact failures; no load balance within 40 solves.
+pub fn nonlinear_cycle(
+    knee: &Knee2d,
+    times: &[Real],
+    guesses: &[Real],
+    solver: &dyn ContactSolver,
+    params: synovia::nonlinear::NewtonParams,
+) -> Result<Vec<NonlinearKneeStep>, KneeError> {
+    use synovia::nonlinear::NonlinearContact;
+    let force = iso14243_axial_force()?;
+    let flexion = iso14243_flexion()?;
+    let mut steps = Vec::with_capacity(times.len());
+    // the last pose's approach and its guess
+    let mut last_approach: Option<(Real, Option<Real>)> = None;
+    for (i, &time) in times.iter().enumerate() {
+        let start = Instant::now();
+        let (model, pairs, kinematics) = knee.neo_hookean_model(time)?;
+        let mut nl = NonlinearContact::new(&model, &pairs, &kinematics, ElasticParams::default(), params)?;
+        let load_n = force.value(time);
+        let target = load_n / knee.width;
+        let tolerance = knee.tolerance * target;
+        let (mut solves, mut newton, mut factorisations) = (0usize, 0usize, 0usize);
+        let mut solve = |d: Real,
+                         nl: &mut NonlinearContact<2>|
+         -> Result<(Real, synovia::nonlinear::NonlinearResult<2>), KneeError> {
+            let r = nl.step_to(&model, d, solver)?;
+            solves += 1;
+            newton += r.report.total_iterations;
+            factorisations += r.report.factorisations;
+            let f = traction_resultant(nl.geometry(), &r.contact.solution.lambda_n)[1].abs();
+            Ok((f, r))
+        };
+        // the guess scaled by the last pose's ratio of approach to guess (the nonlinear layer
+        // is stiffer than the linear one by a factor that changes slowly along the cycle)
+        let mut d0 = match (guesses.get(i).copied().filter(|g| *g > 0.0), last_approach) {
+            (Some(g), Some((d, Some(g_last)))) => g * d / g_last,
+            (Some(g), _) => g,
+            (None, Some((d, _))) => d,
+            (None, None) => 0.05,
+        };
+        let (mut f0, mut r0) = solve(d0, &mut nl)?;
+        while f0 <= 0.0 {
+            d0 *= 2.0;
+            if d0 > 10.0 {
+                return Err(format!("t = {time}: no contact up to an approach of {d0} mm").into());
+            }
+            (f0, r0) = solve(d0, &mut nl)?;
+        }
+        let (d1, r1) = if (f0 - target).abs() <= tolerance {
+            (d0, r0)
+        } else {
+            // first step: a thin layer's force grows roughly as δ^(3/2)
+            let mut d1 = d0 * (target / f0).powf(2.0 / 3.0).clamp(0.5, 2.0);
+            let (mut f1, mut r1) = solve(d1, &mut nl)?;
+            let mut iter = 0;
+            while (f1 - target).abs() > tolerance {
+                iter += 1;
+                if iter > 40 {
+                    return Err(format!("t = {time}: load balance not reached: {f1} vs {target} N/mm").into());
+                }
+                let slope = (f1 - f0) / (d1 - d0);
+                let mut d2 =
+                    if slope > 0.0 && slope.is_finite() { d1 + (target - f1) / slope } else { 1.5 * d1 };
+                if d2 <= 0.0 {
+                    d2 = 0.5 * d1;
+                }
+                let (f2, r2) = solve(d2, &mut nl)?;
+                (d0, f0) = (d1, f1);
+                (d1, f1, r1) = (d2, f2, r2);
+            }
+            (d1, r1)
+        };
+        last_approach = Some((d1, guesses.get(i).copied().filter(|g| *g > 0.0)));
+        let contact = &r1.contact;
+        let geo = nl.geometry();
+        let force_v = traction_resultant(geo, &contact.solution.lambda_n);
+        let active: Vec<usize> = (0..geo.len()).filter(|&r| contact.solution.lambda_n[r] > 0.0).collect();
+        let xs = active.iter().map(|&r| geo.nodes[r].position[0]);
+        let contact_length =
+            xs.clone().fold(Real::NEG_INFINITY, Real::max) - xs.fold(Real::INFINITY, Real::min);
+        let (peak_r, peak) = contact
+            .solution
+            .lambda_n
+            .iter()
+            .copied()
+            .enumerate()
+            .fold((0, 0.0), |(ri, m), (r, l)| if l > m { (r, l) } else { (ri, m) });
+        // the gaps of the solution on its own deformed configuration: d(x + u) = d_total − [u] · n
+        let disp = &contact.displacement;
+        let deformed = ContactGeometry::new_deformed(&model, &pairs, disp)?;
+        let active_nodes: std::collections::HashSet<usize> =
+            active.iter().map(|&r| geo.nodes[r].node.1).collect();
+        let (mut gap_error, mut penetration) = (0.0_f64, 0.0_f64);
+        for node in &deformed.nodes {
+            let jump = node.jump(disp).ok_or("contact node outside the displacement field")?;
+            let d = node.gap - jump.dot(&node.normal);
+            penetration = penetration.max(-d);
+            if active_nodes.contains(&node.node.1) {
+                gap_error = gap_error.max(d.abs());
+            }
+        }
+        let tibia = model.body(model.body_id(knee.body_names[3])?)?;
+        let mesh_size = tibia
+            .mesh
+            .boundary_part("top")?
+            .facets()
+            .filter_map(|f| match f {
+                [a, b] => Some((tibia.mesh.node(*a) - tibia.mesh.node(*b)).norm()),
+                _ => None,
+            })
+            .fold(Real::INFINITY, Real::min);
+        steps.push(NonlinearKneeStep {
+            step: KneeStep {
+                time,
+                flexion_deg: flexion.value(time).to_degrees(),
+                load_n,
+                load_per_mm: target,
+                contact_force_per_mm: force_v[1].abs(),
+                contact_shear_per_mm: force_v[0],
+                balance_error: (force_v[1].abs() - target).abs() / target,
+                peak_pressure: peak,
+                contact_length,
+                peak_x: geo.nodes.get(peak_r).map_or(0.0, |n| n.position[0]),
+                approach: d1,
+                solves,
+                solver_iterations: newton,
+                kkt: contact.kkt.max(),
+                seconds: start.elapsed().as_secs_f64(),
+            },
+            factorisations,
+            gap_error,
+            penetration: penetration.max(0.0),
+            mesh_size,
+        });
+    }
+    Ok(steps)
+}
+
+/// Node-to-segment contact (2D) with a **continuous master normal** for finite-strain runs,
+/// where the contact geometry is rebuilt on the deformed configuration (docs/nonlinear.md).
+///
+/// The built-in [`synovia_contact::discretisation::NodeToSegment`] uses the normal of the
+/// master segment a slave node projects onto. That normal jumps at every master vertex, so the
+/// geometry as a function of the deformation is discontinuous: on the loaded `knee2d` poses a
+/// slave node near a vertex is pushed by one segment's normal onto the next segment and back,
+/// and the geometry fixed point does not exist (docs/nonlinear.md, measured). Here the master
+/// normal is interpolated along the segment from the unit nodal normals `n_a`, `n_b` of the
+/// master surface at the positions of the context,
+///
+/// ```text
+/// ñ(ξ) = (1 − ξ) n_a + ξ n_b,   n(ξ) = ñ(ξ) / |ñ(ξ)|,   x(ξ) = (1 − ξ) x_a + ξ x_b,
+/// ```
+///
+/// and the master point of a slave node `x_s` is where the normal field passes through it,
+/// `(x_s − x(ξ)) × ñ(ξ) = 0` with `ξ ∈ [0, 1]` (a quadratic in `ξ`), on the facing segment
+/// (`n(ξ) · n_s < 0`) closest to `x_s`. The row then has the normal `−n(ξ)`, master weights
+/// `(1 − ξ, ξ)` and the gap `d = (x_s − x(ξ)) · n(ξ)`. At a vertex both segments give the same
+/// point and normal, so the rows depend continuously on the positions. On the undeformed flat
+/// or circular surfaces of `knee2d` it gives the same rows as the built-in discretisation up
+/// to the discretisation of the circle (the nodal normal of an arc is its radial direction).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SmoothNodeToSegment {
+    /// The master body.
+    pub body: BodyId,
+    /// Its contact part.
+    pub part: String,
+    /// Largest `|x_s − x(ξ)|` of a paired slave node (mm).
+    pub search_distance: Real,
+}
+
+impl SmoothNodeToSegment {
+    /// The master point `(ξ, x(ξ), n(ξ))` of `x` on the segment `a → b` with unit nodal normals
+    /// `na`, `nb` (see the type docs), if the normal field passes through `x` over the segment.
+    fn project(
+        x: &Point<2>,
+        (xa, xb): (&Point<2>, &Point<2>),
+        (na, nb): (&Vector<2>, &Vector<2>),
+    ) -> Option<(Real, Point<2>, Vector<2>)> {
+        let cross = |u: &Vector<2>, v: &Vector<2>| u[0] * v[1] - u[1] * v[0];
+        let a = x - xa;
+        let e = xb - xa;
+        let dn = nb - na;
+        // f(ξ) = (a − ξ e) × (n_a + ξ dn) = c0 + c1 ξ + c2 ξ²
+        let c0 = cross(&a, na);
+        let c1 = cross(&a, &dn) - cross(&e, na);
+        let c2 = -cross(&e, &dn);
+        let scale = e.norm() * (1.0 + dn.norm());
+        let mut roots = Vec::with_capacity(2);
+        if c2.abs() <= 1e-14 * scale {
+            if c1.abs() > 0.0 {
+                roots.push(-c0 / c1);
+            }
+        } else {
+            let disc = c1 * c1 - 4.0 * c2 * c0;
+            if disc >= 0.0 {
+                let s = disc.sqrt();
+                // the numerically stable pair of roots
+                let q = -0.5 * (c1 + c1.signum() * s);
+                if q != 0.0 {
+                    roots.push(q / c2);
+                    roots.push(c0 / q);
+                } else {
+                    roots.push(0.0);
+                }
+            }
+        }
+        let tol = 1e-12;
+        roots
+            .into_iter()
+            .filter(|xi| xi.is_finite() && *xi >= -tol && *xi <= 1.0 + tol)
+            .filter_map(|xi| {
+                let xi = xi.clamp(0.0, 1.0);
+                let n = na * (1.0 - xi) + nb * xi;
+                let len = n.norm();
+                (len > 0.0).then(|| (xi, xa + e * xi, n / len))
+            })
+            .min_by(|p, q| (x - p.1).norm().total_cmp(&(x - q.1).norm()))
+    }
+}
+
+impl synovia_contact::ContactDiscretisation<2> for SmoothNodeToSegment {
+    fn kind(&self) -> &str {
+        "node-to-segment (smooth normal)"
+    }
+
+    fn partner_part(&self) -> Option<(BodyId, &str)> {
+        Some((self.body, &self.part))
+    }
+
+    fn rows(
+        &self,
+        cx: &synovia_contact::PairContext<'_, 2>,
+    ) -> Result<Vec<synovia_contact::ContactRow<2>>, synovia_contact::ContactError> {
+        if self.body == cx.body() {
+            return Err(cx.invalid("self-contact is not supported"));
+        }
+        if !(self.search_distance.is_finite() && self.search_distance > 0.0) {
+            return Err(cx.invalid(format!("search distance {} must be positive", self.search_distance)));
+        }
+        let other = cx.model().body(self.body)?;
+        let facets: Vec<Vec<usize>> =
+            other.mesh.boundary_part(&self.part)?.facets().map(<[usize]>::to_vec).collect();
+        let (Some(pos_k), Some(pos_l)) = (cx.positions(cx.body()), cx.positions(self.body)) else {
+            return Err(cx.invalid("unknown body"));
+        };
+        let normals: std::collections::HashMap<usize, Vector<2>> =
+            synovia_mesh::mesh::nodal_normals_at(pos_l, facets.iter().map(Vec::as_slice))
+                .into_iter()
+                .collect();
+        let mut rows = Vec::new();
+        for &(i, ns) in cx.normals() {
+            let x = &pos_k[i];
+            let mut best: Option<(Real, usize, usize, Real, Vector<2>, Point<2>)> = None;
+            for f in &facets {
+                let [a, b] = f[..] else { continue };
+                let (Some(na), Some(nb)) = (normals.get(&a), normals.get(&b)) else { continue };
+                let Some((xi, xm, n)) = Self::project(x, (&pos_l[a], &pos_l[b]), (na, nb)) else {
+                    continue;
+                };
+                let dist = (x - xm).norm();
+                if n.dot(&ns) >= 0.0 || dist > self.search_distance {
+                    continue;
+                }
+                if best.as_ref().is_none_or(|bst| dist < bst.0) {
+                    best = Some((dist, a, b, xi, n, xm));
+                }
+            }
+            let Some((_, a, b, xi, n_l, xm)) = best else { continue };
+            let n = -n_l;
+            let master: Vec<(BodyId, usize, Real)> = [(a, 1.0 - xi), (b, xi)]
+                .into_iter()
+                .filter(|(_, w)| *w > 0.0)
+                .map(|(j, w)| (self.body, j, w))
+                .collect();
+            rows.push(synovia_contact::ContactRow {
+                node: i,
+                partner: None,
+                master,
+                normal: n,
+                weight: cx.weight(i),
+                gap: (xm - x).dot(&n),
+            });
+        }
+        if rows.is_empty() {
+            return Err(cx.invalid(format!("no slave node has a master point on part `{}`", self.part)));
+        }
+        Ok(rows)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The master point of [`SmoothNodeToSegment`] on two segments of a unit arc (vertices at
+    /// 80°, 90°, 100°, radial nodal normals): a point on the shared vertex's normal gets the
+    /// same point and normal from both segments, and inside a segment the interpolated normal
+    /// passes through the point.
+    #[test]
+    fn smooth_projection_is_continuous_at_a_vertex() {
+        let at = |deg: Real| Vector::<2>::new(deg.to_radians().cos(), deg.to_radians().sin());
+        let p = at;
+        let x = Point::<2>::new(0.0, 1.2);
+        let a = SmoothNodeToSegment::project(&x, (&p(80.0), &p(90.0)), (&at(80.0), &at(90.0)))
+            .expect("segment 1");
+        let b = SmoothNodeToSegment::project(&x, (&p(90.0), &p(100.0)), (&at(90.0), &at(100.0)))
+            .expect("segment 2");
+        assert!((a.0 - 1.0).abs() < 1e-12 && b.0.abs() < 1e-12, "ξ {} and {}", a.0, b.0);
+        assert!((a.1 - b.1).norm() < 1e-12 && (a.2 - b.2).norm() < 1e-12);
+        let y = Point::<2>::new(0.1, 1.1);
+        let (xi, xm, n) =
+            SmoothNodeToSegment::project(&y, (&p(80.0), &p(90.0)), (&at(80.0), &at(90.0))).expect("inside");
+        let d = y - xm;
+        assert!(xi > 0.0 && xi < 1.0, "ξ = {xi}");
+        assert!((d[0] * n[1] - d[1] * n[0]).abs() < 1e-12, "the normal field misses the point");
+        assert!(d.dot(&n) > 0.09 && d.dot(&n) < 0.11, "gap {}", d.dot(&n));
+        // a point beyond the segment's normal fan has no master point on it
+        assert!(SmoothNodeToSegment::project(
+            &Point::<2>::new(-0.3, 1.1),
+            (&p(80.0), &p(90.0)),
+            (&at(80.0), &at(90.0))
+        )
+        .is_none());
+    }
+}

@@ -115,6 +115,24 @@ pub struct NewtonParams {
     pub geometry_relaxation: Real,
     /// Finite strain: when the contact geometry is rebuilt ([`GeometryUpdate`]).
     pub geometry_update: GeometryUpdate,
+    /// Modified Newton: `Some(ρ)` keeps the factorised tangent of an earlier iterate (also
+    /// across levels) while each full step reduces the residual at least by the factor `ρ`,
+    /// and refactorises `K_T` at the current iterate otherwise; `None` (default) refactorises
+    /// at every iteration (Newton's method). With a kept tangent `K̂` the iteration solves the
+    /// contact problem with `A = K̂` and `F̄ = F_ext − F_int(u_k) + K̂ ũ_k`: its fixed point is
+    /// the same solution, reached at a linear rate, and an iteration costs a residual and a
+    /// re-solve on the kept factorisation instead of an assembly and a numeric factorisation.
+    pub tangent_reuse: Option<Real>,
+    /// Finite strain: Aitken's dynamic relaxation of the geometry fixed point (default
+    /// `false`): the relaxation factor of rebuild `k + 1` is
+    /// `ω_{k+1} = −ω_k r_k · (r_{k+1} − r_k) / |r_{k+1} − r_k|²` (clamped to `[0.05, 1]`), with
+    /// `r_k = x_k − x_{g,k}` the lag of the geometry's configuration behind the iterate, starting
+    /// from [`Self::geometry_relaxation`].
+    pub geometry_aitken: bool,
+    /// Finite strain: the relative residual that ends a pass of Newton iterations whose
+    /// geometry has not settled yet (default `None`: [`Self::tolerance`]); the last pass is
+    /// always converged to [`Self::tolerance`].
+    pub geometry_pass_tolerance: Option<Real>,
 }
 
 /// When a finite-strain solve rebuilds the contact geometry on the deformed configuration.
@@ -130,6 +148,14 @@ pub enum GeometryUpdate {
     /// steps keep the lag small; for node-to-segment pairs whose re-pairing switches segments
     /// the converged fixed point may not exist).
     PerLevel,
+    /// Never: the contact geometry (pairing, normals, gaps) stays that of the model's
+    /// reference configuration, and the gaps follow the displacements to first order,
+    /// `d − B_hn u` — the *small-sliding* contact of the linear model, with the finite-strain
+    /// material. Right when the surfaces slide little against each other relative to their
+    /// curvature (gap error `≈ |u_t|² / 2R` for a relative sliding `u_t` over a radius `R`);
+    /// the Newton iteration keeps its quadratic convergence because the constraint operator is
+    /// fixed.
+    Reference,
 }
 
 impl Default for NewtonParams {
@@ -144,6 +170,9 @@ impl Default for NewtonParams {
             max_geometry_passes: 20,
             geometry_relaxation: 0.5,
             geometry_update: GeometryUpdate::Converged,
+            tangent_reuse: None,
+            geometry_aitken: false,
+            geometry_pass_tolerance: None,
         }
     }
 }
@@ -169,6 +198,32 @@ impl NewtonParams {
         self.geometry_update = geometry_update;
         self
     }
+    /// Sets [`Self::tangent_reuse`] (modified Newton with the contraction bound `rho`).
+    pub fn with_tangent_reuse(mut self, rho: Option<Real>) -> Self {
+        self.tangent_reuse = rho;
+        self
+    }
+    /// Sets [`Self::geometry_relaxation`] (the first relaxation factor with
+    /// [`Self::geometry_aitken`]).
+    pub fn with_geometry_relaxation(mut self, omega: Real) -> Self {
+        self.geometry_relaxation = omega;
+        self
+    }
+    /// Sets [`Self::geometry_aitken`].
+    pub fn with_geometry_aitken(mut self, aitken: bool) -> Self {
+        self.geometry_aitken = aitken;
+        self
+    }
+    /// Sets [`Self::geometry_pass_tolerance`].
+    pub fn with_geometry_pass_tolerance(mut self, tolerance: Option<Real>) -> Self {
+        self.geometry_pass_tolerance = tolerance;
+        self
+    }
+    /// Sets [`Self::max_geometry_passes`].
+    pub fn with_max_geometry_passes(mut self, passes: usize) -> Self {
+        self.max_geometry_passes = passes;
+        self
+    }
     /// Sets [`Self::geometry_tolerance`].
     pub fn with_geometry_tolerance(mut self, geometry_tolerance: Real) -> Self {
         self.geometry_tolerance = geometry_tolerance;
@@ -186,6 +241,20 @@ impl NewtonParams {
     }
 
     fn check(&self) -> Result<(), NonlinearError> {
+        if let Some(p) = self.geometry_pass_tolerance {
+            if !(p > 0.0 && p < 1.0) {
+                return Err(NonlinearError::InvalidParameter(format!(
+                    "the pass tolerance of the geometry fixed point must lie in (0, 1), got {p}"
+                )));
+            }
+        }
+        if let Some(rho) = self.tangent_reuse {
+            if !(rho > 0.0 && rho < 1.0) {
+                return Err(NonlinearError::InvalidParameter(format!(
+                    "the contraction bound of tangent reuse must lie in (0, 1), got {rho}"
+                )));
+            }
+        }
         if !(self.tolerance > 0.0 && self.tolerance < 1.0) || self.max_iterations == 0 {
             return Err(NonlinearError::InvalidParameter(format!(
                 "Newton tolerance must lie in (0, 1) and max_iterations be positive, got {} and {}",
@@ -275,6 +344,10 @@ pub struct NonlinearContact<const D: usize> {
     kinematics: Vec<Kinematics>,
     params: NewtonParams,
     state: State<D>,
+    /// The factorised matrix is a tangent (of some earlier iterate) that a modified Newton
+    /// iteration may keep: false until the first factorisation at a loaded state and after
+    /// a rebuilt geometry or a failed level.
+    tangent_kept: bool,
 }
 
 fn norm(x: &[Real]) -> Real {
@@ -324,6 +397,7 @@ impl<const D: usize> NonlinearContact<D> {
                 contact_force: vec![0.0; n],
                 result: None,
             },
+            tangent_kept: false,
         })
     }
 
@@ -362,6 +436,7 @@ impl<const D: usize> NonlinearContact<D> {
         let n = self.dofs.n_dofs();
         self.state =
             State { time: t0, scale: 0.0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None };
+        self.tangent_kept = false;
     }
 
     fn finite_strain(&self) -> bool {
@@ -425,6 +500,7 @@ impl<const D: usize> NonlinearContact<D> {
                     target = 1.0;
                 }
                 Err(e) => {
+                    self.tangent_kept = false;
                     let recoverable = matches!(
                         e,
                         NonlinearError::NoConvergence { .. }
@@ -529,23 +605,52 @@ impl<const D: usize> NonlinearContact<D> {
         // finite strain: the contact geometry is frozen during a pass of Newton iterations (so
         // each pass converges quadratically on a fixed constraint operator) and rebuilt on the
         // deformed configuration between passes, until a rebuild no longer moves the solution
-        let finite = self.finite_strain();
+        let finite = self.finite_strain() && self.params.geometry_update != GeometryUpdate::Reference;
         let mut refresh = finite;
         // the configuration the contact geometry is built on, relaxed toward the iterate
         let mut geometry_at: Option<Vec<Vec<Vector<D>>>> = None;
+        let mut omega = self.params.geometry_relaxation;
+        let mut previous_lag: Option<Vec<Real>> = None;
         let mut first_of_pass = true;
         let mut pass_increment = 0.0;
         let mut passes = 0usize;
-        for _ in 0..self.params.max_iterations * (1 + self.params.max_geometry_passes) {
+        let passes_allowed = match self.params.geometry_update {
+            GeometryUpdate::Converged if finite => 1 + self.params.max_geometry_passes,
+            _ => 1,
+        };
+        // consecutive steps the line search took without a decrease of the residual
+        let mut forced_steps = 0usize;
+        for _ in 0..self.params.max_iterations * passes_allowed {
             report.total_iterations += 1;
             if refresh {
-                let omega = self.params.geometry_relaxation;
                 let at = match geometry_at.take() {
-                    Some(g) => g
-                        .iter()
-                        .zip(&disp)
-                        .map(|(gb, db)| gb.iter().zip(db).map(|(x, y)| x + (y - x) * omega).collect())
-                        .collect(),
+                    Some(g) => {
+                        // the lag r = x_k − x_g of the geometry's configuration
+                        let lag: Vec<Real> = g
+                            .iter()
+                            .zip(&disp)
+                            .flat_map(|(gb, db)| {
+                                gb.iter()
+                                    .zip(db)
+                                    .flat_map(|(x, y)| (y - x).iter().copied().collect::<Vec<_>>())
+                            })
+                            .collect();
+                        if self.params.geometry_aitken {
+                            if let Some(prev) = &previous_lag {
+                                let dr: Vec<Real> = lag.iter().zip(prev).map(|(a, b)| a - b).collect();
+                                let dd: Real = dr.iter().map(|v| v * v).sum();
+                                if dd > 0.0 {
+                                    let rd: Real = prev.iter().zip(&dr).map(|(a, b)| a * b).sum();
+                                    omega = (-omega * rd / dd).clamp(0.05, 1.0);
+                                }
+                            }
+                            previous_lag = Some(lag);
+                        }
+                        g.iter()
+                            .zip(&disp)
+                            .map(|(gb, db)| gb.iter().zip(db).map(|(x, y)| x + (y - x) * omega).collect())
+                            .collect()
+                    }
                     None => disp.clone(),
                 };
                 self.contact.update_geometry(model, &self.pairs, &at)?;
@@ -556,30 +661,36 @@ impl<const D: usize> NonlinearContact<D> {
             }
             let kin = &self.kinematics;
             let at = &disp;
+            let reuse = self.params.tangent_reuse.is_some() && self.tangent_kept;
             // K_T away from equilibrium (strong compression, the geometric stiffness of
             // compressive stresses) may be indefinite: then K_T + γ D (D = diag K_T, γ = 1e-4,
             // 1e-3, …, 1) — a damped Newton step, still a descent direction
             let mut shift = 0.0;
-            loop {
-                let result = self.contact.refactorise(|dofs, m| {
-                    assemble_tangent(model, dofs, kin, at, m)?;
-                    if shift > 0.0 {
-                        for (k, d) in m.diagonal().into_iter().enumerate() {
-                            m.add(k, k, shift * d.abs())?;
+            if !reuse {
+                loop {
+                    let result = self.contact.refactorise(|dofs, m| {
+                        assemble_tangent(model, dofs, kin, at, m)?;
+                        if shift > 0.0 {
+                            for (k, d) in m.diagonal().into_iter().enumerate() {
+                                m.add(k, k, shift * d.abs())?;
+                            }
                         }
+                        Ok(())
+                    });
+                    report.factorisations += 1;
+                    match result {
+                        Ok(()) => {
+                            self.tangent_kept = true;
+                            break;
+                        }
+                        Err(ContactError::Fem(FemError::Linalg(
+                            synovia_linalg::LinalgError::NotPositiveDefinite { .. },
+                        ))) if shift < 1.0 => {
+                            shift = if shift == 0.0 { 1e-4 } else { shift * 10.0 };
+                            tracing::debug!(shift, "indefinite tangent: shifted");
+                        }
+                        Err(e) => return Err(e.into()),
                     }
-                    Ok(())
-                });
-                report.factorisations += 1;
-                match result {
-                    Ok(()) => break,
-                    Err(ContactError::Fem(FemError::Linalg(
-                        synovia_linalg::LinalgError::NotPositiveDefinite { .. },
-                    ))) if shift < 1.0 => {
-                        shift = if shift == 0.0 { 1e-4 } else { shift * 10.0 };
-                        tracing::debug!(shift, "indefinite tangent: shifted");
-                    }
-                    Err(e) => return Err(e.into()),
                 }
             }
             report.shifted_tangents += usize::from(shift > 0.0);
@@ -612,7 +723,13 @@ impl<const D: usize> NonlinearContact<D> {
             // at the tolerance is accepted (no decrease can be asked of rounding noise)
             let settled =
                 self.params.tolerance * norm(&f_ext).max(norm(&f_int)).max(norm(&c_star)).max(r_start);
+            // the first step on a geometry rebuilt at a loaded configuration (a later pass, or
+            // the first pass of a level that starts from a converged loaded state): the merit
+            // `‖R‖` of the old geometry was at its minimum there, so any move toward the new
+            // geometry's solution raises it; the step is taken whole, as the predictor
+            let rebuilt = finite && first_of_pass && (passes > 1 || self.state.scale > 0.0);
             let mut alpha = 1.0;
+            let mut forced = false;
             let accepted = loop {
                 let u_try: Vec<Real> = (0..n).map(|i| u[i] + alpha * delta[i]).collect();
                 let c_try: Vec<Real> = (0..n).map(|i| c[i] + alpha * (c_star[i] - c[i])).collect();
@@ -620,15 +737,18 @@ impl<const D: usize> NonlinearContact<D> {
                 match internal_force(model, &self.dofs, &self.kinematics, &disp_try) {
                     Ok((f_try, e_try)) => {
                         let r_try = norm(&residual_of(&f_try, &c_try));
-                        // the merit of the old geometry does not judge the first step on a
-                        // rebuilt one: it is taken whole, as the predictor
                         if !self.params.line_search
                             || predictor
-                            || (first_of_pass && passes > 1)
+                            || rebuilt
                             || r_try <= settled
                             || r_try <= (1.0 - 1e-4 * alpha) * r_norm
                             || alpha < 1.0 / 64.0
                         {
+                            forced = self.params.line_search
+                                && !predictor
+                                && !rebuilt
+                                && r_try > settled
+                                && r_try > (1.0 - 1e-4 * alpha) * r_norm;
                             break Some((u_try, c_try, disp_try, f_try, e_try, r_try));
                         }
                     }
@@ -649,6 +769,21 @@ impl<const D: usize> NonlinearContact<D> {
                     reason: "the line search found no admissible step".into(),
                 });
             };
+            // a Newton direction that fails to decrease the residual three times running (a
+            // tangent shifted far from the true one, a stalled active set) is a failed level:
+            // the cut-back takes a smaller step instead of creeping along it
+            forced_steps = if forced && !reuse { forced_steps + 1 } else { 0 };
+            if forced_steps >= 3 {
+                return Err(NonlinearError::NoConvergence {
+                    time: t,
+                    cutbacks: 0,
+                    step: 0.0,
+                    reason: format!(
+                        "the line search found no decrease of the residual in 3 iterations running (relative residual {:e})",
+                        r_norm / norm(&f_ext).max(norm(&f_int)).max(norm(&c)).max(r_start).max(Real::MIN_POSITIVE)
+                    ),
+                });
+            }
             let increment = alpha * norm(&delta) / norm(&u_new).max(Real::MIN_POSITIVE);
             predictor = false;
             u = u_new;
@@ -656,6 +791,12 @@ impl<const D: usize> NonlinearContact<D> {
             disp = disp_new;
             f_int = f_new;
             let energy = e_new;
+            // modified Newton: the tangent is kept while full steps contract the residual
+            // by the bound ρ (a line-searched or slow step asks for a fresh one)
+            if let Some(rho) = self.params.tangent_reuse {
+                let contracted = alpha == 1.0 && r_new <= rho * r_norm;
+                self.tangent_kept = contracted || r_new <= settled;
+            }
             r_norm = r_new;
             let force_scale = norm(&f_ext).max(norm(&f_int)).max(norm(&c)).max(r_start);
             let relative = if force_scale > 0.0 { r_norm / force_scale } else { 0.0 };
@@ -679,13 +820,18 @@ impl<const D: usize> NonlinearContact<D> {
             let converged = relative <= self.params.tolerance
                 || force_scale == 0.0
                 || (alpha == 1.0 && increment <= self.params.tolerance);
+            // a pass whose geometry is still moving ends at the looser pass tolerance
+            let pass_converged = converged
+                || (finite
+                    && pass_increment > self.params.geometry_tolerance
+                    && self.params.geometry_pass_tolerance.is_some_and(|p| relative <= p));
             // a converged pass ends the level when the geometry it started from was already
             // that of the solution (its first step moved the iterate by less than the
             // tolerance); otherwise the geometry is rebuilt for another pass
             let geometry_settled = !finite
                 || pass_increment <= self.params.geometry_tolerance
                 || self.params.geometry_update == GeometryUpdate::PerLevel;
-            if converged && !geometry_settled {
+            if pass_converged && !geometry_settled {
                 if passes > self.params.max_geometry_passes {
                     return Err(NonlinearError::NoConvergence {
                         time: t,

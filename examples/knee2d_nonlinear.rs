@@ -1,0 +1,98 @@
+//! # The sagittal knee with hyperelastic cartilage: linear vs neo-Hookean over the gait cycle
+//!
+//! The `knee2d` model ([`synovia_models::knee2d`], docs/knee2d.md) run twice over the same
+//! poses of the ISO 14243-1 cycle, in one process: with linear (small-strain) cartilage (the
+//! `knee2d` cycle: femur in its body frame, one factorisation), and with compressible
+//! neo-Hookean cartilage in total Lagrangian finite strain (same small-strain constants,
+//! E = 10 MPa, ν = 0.45; bone linear), the contact geometry rebuilt on the deformed
+//! configuration ([`synovia_models::knee2d::nonlinear_cycle`]). Each pose is load-controlled to
+//! the ISO force by the secant iteration on the femur's approach. Prints per pose the peak
+//! cartilage pressure, contact length and approach of both runs, the Newton work and the gap
+//! left on the deformed configuration, then the cost of each run and one JSON line
+//! (docs/nonlinear.md).
+//!
+//! Run: `cargo run --release --example knee2d_nonlinear [STEPS]` (default 40 uniform steps + the
+//! 13 % peak = 41 poses, the poses of the `knee2d` example).
+
+use std::time::Instant;
+
+use synovia::pdas::Pdas;
+use synovia_models::knee2d::{cycle_times, nonlinear_cycle, Knee2d, KneeError};
+
+fn main() -> Result<(), KneeError> {
+    let n: usize = std::env::args().nth(1).map(|s| s.parse()).transpose()?.unwrap_or(40);
+    let knee = Knee2d::default();
+    let times = cycle_times(n);
+    let solver = Pdas::default();
+    // ## Step 1: the linear cycle (one factorisation, femur in its body frame)
+    let t0 = Instant::now();
+    let linear = knee.run(&times, &solver, |_| Ok(()))?;
+    let linear_s = t0.elapsed().as_secs_f64();
+    // ## Step 2: neo-Hookean cartilage, finite strain, deformed contact geometry; each pose
+    // starts from the linear approach
+    let guesses: Vec<f64> = linear.iter().map(|s| s.approach).collect();
+    let t1 = Instant::now();
+    let nonlinear = nonlinear_cycle(&knee, &times, &guesses, &solver, Knee2d::nonlinear_newton_params())?;
+    let nonlinear_s = t1.elapsed().as_secs_f64();
+    // ## Step 3: the comparison
+    println!(
+        "{:>6} {:>8} {:>9} {:>9} {:>7} {:>8} {:>8} {:>8} {:>8} {:>6} {:>5} {:>9} {:>7}",
+        "t",
+        "F (N)",
+        "p lin",
+        "p NH",
+        "NH/lin",
+        "len lin",
+        "len NH",
+        "d lin",
+        "d NH",
+        "Newton",
+        "fact",
+        "gap/h",
+        "KKT NH"
+    );
+    let mut max_ratio: f64 = 0.0;
+    let mut min_ratio = f64::INFINITY;
+    for (l, h) in linear.iter().zip(&nonlinear) {
+        let s = &h.step;
+        let ratio = s.peak_pressure / l.peak_pressure;
+        max_ratio = max_ratio.max(ratio);
+        min_ratio = min_ratio.min(ratio);
+        println!(
+            "{:>6.3} {:>8.1} {:>9.4} {:>9.4} {:>7.4} {:>8.3} {:>8.3} {:>8.4} {:>8.4} {:>6} {:>5} {:>9.2e} {:>7.1e}",
+            l.time,
+            l.load_n,
+            l.peak_pressure,
+            s.peak_pressure,
+            ratio,
+            l.contact_length,
+            s.contact_length,
+            l.approach,
+            s.approach,
+            s.solver_iterations,
+            h.factorisations,
+            h.gap_error / h.mesh_size,
+            s.kkt
+        );
+    }
+    let peak = |v: &mut dyn Iterator<Item = f64>| v.fold(0.0, f64::max);
+    let balance = peak(&mut linear.iter().chain(nonlinear.iter().map(|h| &h.step)).map(|s| s.balance_error));
+    let kkt = peak(&mut linear.iter().chain(nonlinear.iter().map(|h| &h.step)).map(|s| s.kkt));
+    let gap = peak(&mut nonlinear.iter().map(|h| h.gap_error / h.mesh_size));
+    let penetration = peak(&mut nonlinear.iter().map(|h| h.penetration));
+    let h = nonlinear.iter().map(|h| h.mesh_size).fold(f64::INFINITY, f64::min);
+    let newton: usize = nonlinear.iter().map(|h| h.step.solver_iterations).sum();
+    let factorisations: usize = nonlinear.iter().map(|h| h.factorisations).sum();
+    let solves: usize = nonlinear.iter().map(|h| h.step.solves).sum();
+    let cost_ratio = nonlinear_s / linear_s;
+    println!(
+        "linear {linear_s:.2} s, neo-Hookean {nonlinear_s:.2} s ({cost_ratio:.1}x): {solves} secant solves, {newton} Newton iterations, {factorisations} factorisations"
+    );
+    println!(
+        "{{\"problem\":\"knee2d_nonlinear\",\"poses\":{},\"peak_pressure_linear_mpa\":{:.4},\"peak_pressure_neo_hookean_mpa\":{:.4},\"min_peak_ratio\":{min_ratio:.4},\"max_peak_ratio\":{max_ratio:.4},\"max_balance_error\":{balance:.3e},\"max_kkt\":{kkt:.3e},\"max_gap_error_per_h\":{gap:.3e},\"h_mm\":{h:.4},\"max_penetration_mm\":{penetration:.3e},\"newton_iterations\":{newton},\"factorisations\":{factorisations},\"linear_s\":{linear_s:.3},\"nonlinear_s\":{nonlinear_s:.3},\"cost_ratio\":{cost_ratio:.2}}}",
+        times.len(),
+        peak(&mut linear.iter().map(|s| s.peak_pressure)),
+        peak(&mut nonlinear.iter().map(|h| h.step.peak_pressure)),
+    );
+    Ok(())
+}
