@@ -83,6 +83,15 @@ fn main() -> Result<(), Error> {
     });
     // the model (synovia_models::tkr3d); the options of this example set its fields
     let mut model = Tkr3d { fine, free_ml, free_adduction, ..Tkr3d::default() };
+    // `--femur-subdivision N`: levels of Loop subdivision of the femoral STL (default 2; 0: the
+    // decimated facets as they are)
+    if let Some(v) = std::env::args().skip_while(|a| a != "--femur-subdivision").nth(1) {
+        model.femur_subdivision = v.parse()?;
+    }
+    // `--data DIR`: another copy of the data folder (the STL surfaces, kinematics and meshes)
+    if let Some(dir) = std::env::args().skip_while(|a| a != "--data").nth(1) {
+        model.data_dir = dir.into();
+    }
     // `--contact-min-ny c`: candidate facets with `n_y > c` (default 0.5, at most 60° from
     // horizontal)
     if let Some(v) = std::env::args().skip_while(|a| a != "--contact-min-ny").nth(1) {

@@ -184,6 +184,11 @@ impl<const D: usize> SignedDistance<D> for PosedObstacle<D> {
         let (d, g) = self.shape.distance_and_gradient(&pose.to_body(x));
         (d, pose.rotation * g)
     }
+    fn distance_and_gradient_within(&self, x: &Point<D>, reach: Real) -> (Real, Vector<D>) {
+        let pose = self.pose.get();
+        let (d, g) = self.shape.distance_and_gradient_within(&pose.to_body(x), reach);
+        (d, pose.rotation * g)
+    }
     fn validate(&self) -> Result<(), String> {
         let p = self.pose.get();
         if !(p.rotation.iter().chain(p.translation.iter()).all(|v| v.is_finite())) {

@@ -132,3 +132,60 @@ fn tessellated_ball_reproduces_the_analytic_ball_within_the_tessellation_error()
     assert!(errors[1] < errors[0] / 4.0, "errors {errors:?}");
     assert!(errors[1] < 0.02, "errors {errors:?}");
 }
+
+/// A smoothed solid (Loop subdivision of a coarse tessellation): within `δ` of its control
+/// surface, with normals nearer the sphere's, and its bounded query (`distance_and_gradient_within`, used beyond a
+/// pair's search distance) is exact up to `reach` — inside the solid too — and a lower bound
+/// above `reach` beyond it.
+#[test]
+fn smoothed_solid_turns_with_the_sphere_and_its_bounded_query_is_exact_within_reach() {
+    let centre = Point::<3>::new(0.3, -0.2, 0.1);
+    let sphere = SphereObstacle::new(centre, R, false).expect("sphere");
+    let control = TriangleSurface::icosphere(centre, R, 2).expect("icosphere");
+    let coarse = SurfaceObstacle::solid(control.clone()).expect("control solid");
+    let smooth = SurfaceObstacle::smoothed_solid(control, 2, 0.5).expect("smoothed");
+    assert_eq!(smooth.surface().len(), 320 * 16);
+    let delta = smooth.smoothing_bound().expect("bound");
+    assert!(delta > 0.0 && delta < 0.5, "δ = {delta}");
+    // the smoothed surface stays within δ of the control surface, and its normals (the
+    // gradient near the surface) turn with the sphere's instead of jumping at facet edges
+    let pts = points(400);
+    let (mut turn_coarse, mut turn_smooth): (Real, Real) = (0.0, 0.0);
+    for x in &pts {
+        let (dc, ds) = (coarse.distance(x), smooth.distance(x));
+        assert!((dc - ds).abs() <= delta, "{dc} vs {ds}");
+        if sphere.distance(x).abs() < 0.3 {
+            let exact = sphere.gradient(x);
+            turn_coarse = turn_coarse.max(coarse.gradient(x).angle(&exact));
+            turn_smooth = turn_smooth.max(smooth.gradient(x).angle(&exact));
+        }
+    }
+    assert!(turn_smooth < 0.5 * turn_coarse, "normal error: smoothed {turn_smooth} vs control {turn_coarse}");
+    // bounded queries against the exact one, near, far and deep inside (reach 0.2 < R)
+    for reach in [0.2, 1.0] {
+        let (mut exact, mut bounded) = (0, 0);
+        for x in pts.iter().chain([centre].iter()) {
+            let (d, g) = smooth.distance_and_gradient(x);
+            let (db, gb) = smooth.distance_and_gradient_within(x, reach);
+            assert!((gb.norm() - 1.0).abs() < 1e-12);
+            if d <= reach {
+                assert_eq!((d, g), (db, gb), "within reach {reach} at {x:?}");
+                exact += 1;
+            } else {
+                assert!(db > reach && db <= d, "{db} not in ({reach}, {d}]");
+                bounded += usize::from(db < d);
+            }
+        }
+        assert!(exact > 50 && bounded > 50, "reach {reach}: {exact} exact, {bounded} bounded");
+    }
+    // a posed smoothed solid answers in the world frame
+    let rotation = nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), 0.4);
+    let shift = Vector::<3>::new(1.0, 0.5, -0.2);
+    let posed = smooth.clone().with_pose(rotation, shift);
+    for x in pts.iter().take(50) {
+        let moved = rotation * x + shift;
+        let (a, b) =
+            (smooth.distance_and_gradient_within(x, 0.2), posed.distance_and_gradient_within(&moved, 0.2));
+        assert!((a.0 - b.0).abs() < 1e-12 && (rotation * a.1 - b.1).norm() < 1e-12);
+    }
+}

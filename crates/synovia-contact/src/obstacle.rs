@@ -21,6 +21,16 @@ pub trait SignedDistance<const D: usize>: Send + Sync + fmt::Debug {
     fn distance_and_gradient(&self, x: &Point<D>) -> (Real, Vector<D>) {
         (self.distance(x), self.gradient(x))
     }
+    /// A query bounded by `reach`: `(φ(x), ∇φ(x))` exactly where `φ(x) ≤ reach` (inside the
+    /// obstacle too); where `φ(x) > reach`, any `d` with `reach < d ≤ φ(x)` and a unit vector
+    /// (a lower bound of the distance: what a contact row beyond its search distance needs,
+    /// [`RigidObstacle::search_distance`](crate::discretisation::RigidObstacle)). Shapes whose
+    /// exact query costs more the farther the point (a finely tessellated surface) answer far
+    /// points from a coarser one. Default: [`SignedDistance::distance_and_gradient`].
+    fn distance_and_gradient_within(&self, x: &Point<D>, reach: Real) -> (Real, Vector<D>) {
+        let _ = reach;
+        self.distance_and_gradient(x)
+    }
     /// Checks the obstacle's parameters (finite, positive radius, unit directions); the
     /// error names the offending parameter. [`ContactGeometry::new`](crate::operators::ContactGeometry::new) calls it for every rigid
     /// pair and reports a failure as [`ContactError::InvalidPair`]. Default: no check.

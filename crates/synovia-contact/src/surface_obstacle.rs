@@ -53,6 +53,9 @@ pub struct SurfaceObstacle {
     edge_normals: HashMap<(usize, usize), Vector3<Real>>,
     rotation: Rotation3<Real>,
     translation: Vector3<Real>,
+    /// A smoothed surface's control surface and the bound `δ` on the distance between the two
+    /// ([`SurfaceObstacle::smoothed_solid`]).
+    coarse: Option<(Box<SurfaceObstacle>, Real)>,
 }
 
 impl SurfaceObstacle {
@@ -76,6 +79,54 @@ impl SurfaceObstacle {
     pub fn solid(surface: TriangleSurface) -> Result<Self, ContactError> {
         surface.check_closed_solid().map_err(surface_error)?;
         Ok(Self::build(surface))
+    }
+
+    /// An obstacle bounded by the closed `control` surface smoothed by `levels` levels of Loop
+    /// subdivision ([`TriangleSurface::loop_subdivided`], edges sharper than `crease_angle`
+    /// (radians) kept): a decimated implant STL without the creases at its edges.
+    ///
+    /// The control surface is kept for far queries
+    /// ([`SignedDistance::distance_and_gradient_within`]): every vertex of the smoothed surface
+    /// is a point of the same-numbered midpoint subdivision of the control surface moved by
+    /// at most `m`, and every point of a triangle is within its longest edge `h` of its
+    /// vertices, so the two surfaces are within `δ = m + h` of each other (Hausdorff) and their
+    /// signed distances differ by at most `δ`; where the control surface is farther than
+    /// `reach + δ`, the smoothed one is farther than `reach`, and `φ_control − δ` is the lower
+    /// bound returned.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`]: the control surface is no closed solid
+    /// ([`SurfaceObstacle::solid`]), the subdivision's parameters are invalid, or the smoothed
+    /// surface is no closed solid (it crosses itself: fewer levels or a smaller crease angle).
+    pub fn smoothed_solid(
+        control: TriangleSurface,
+        levels: usize,
+        crease_angle: Real,
+    ) -> Result<Self, ContactError> {
+        control.check_closed_solid().map_err(surface_error)?;
+        let smooth = control.loop_subdivided(levels, crease_angle).map_err(surface_error)?;
+        if levels == 0 {
+            return Ok(Self::build(smooth));
+        }
+        let linear = control.midpoint_subdivided(levels).map_err(surface_error)?;
+        let moved =
+            linear.vertices().iter().zip(smooth.vertices()).map(|(a, b)| (a - b).norm()).fold(0.0, Real::max);
+        let longest = (0..smooth.len())
+            .map(|t| {
+                let [a, b, c] = smooth.corners(t);
+                (a - b).norm().max((b - c).norm()).max((c - a).norm())
+            })
+            .fold(0.0, Real::max);
+        smooth.check_closed_solid().map_err(surface_error)?;
+        let mut obstacle = Self::build(smooth);
+        obstacle.coarse = Some((Box::new(Self::build(control)), moved + longest));
+        Ok(obstacle)
+    }
+
+    /// The bound `δ` on the distance between a smoothed surface and its control surface
+    /// ([`SurfaceObstacle::smoothed_solid`]; `None` for other obstacles).
+    pub fn smoothing_bound(&self) -> Option<Real> {
+        self.coarse.as_ref().map(|(_, delta)| *delta)
     }
 
     fn build(surface: TriangleSurface) -> Self {
@@ -117,6 +168,7 @@ impl SurfaceObstacle {
             edge_normals,
             rotation: Rotation3::identity(),
             translation: Vector3::zeros(),
+            coarse: None,
         }
     }
 
@@ -144,18 +196,24 @@ impl SurfaceObstacle {
     /// (see the [module documentation](self)).
     pub fn closest_point(&self, x: &Point<3>) -> SurfacePoint {
         let local = self.rotation.inverse() * (x - self.translation);
+        let (c, t, distance, gradient_local) = self.closest_local(&local);
+        SurfacePoint {
+            point: self.rotation * c + self.translation,
+            triangle: t,
+            distance,
+            gradient: self.rotation * gradient_local,
+        }
+    }
+
+    /// The closest point, its triangle, `φ` and `∇φ` of a point in the surface's own frame.
+    fn closest_local(&self, local: &Vector3<Real>) -> (Vector3<Real>, usize, Real, Vector3<Real>) {
         let query = [local.x, local.y, local.z];
         let Some(entry) = self.tree.nearest_neighbor(&query) else {
             // the constructors reject empty surfaces; stay total anyway
-            return SurfacePoint {
-                point: *x,
-                triangle: 0,
-                distance: Real::INFINITY,
-                gradient: Vector::<3>::z(),
-            };
+            return (*local, 0, Real::INFINITY, Vector3::z());
         };
         let t = entry.facet;
-        let (w, c) = closest(&entry.corners[..3], &local);
+        let (w, c) = closest(&entry.corners[..3], local);
         let tri = self.surface.triangles()[t];
         let on: Vec<usize> = (0..3).filter(|&k| w[k] > 0.0).collect();
         let pseudo = match on.as_slice() {
@@ -174,12 +232,7 @@ impl SurfaceObstacle {
         } else {
             pseudo.try_normalize(0.0).unwrap_or(self.face_normals[t])
         };
-        SurfacePoint {
-            point: self.rotation * c + self.translation,
-            triangle: t,
-            distance: side * len,
-            gradient: self.rotation * gradient_local,
-        }
+        (c, t, side * len, gradient_local)
     }
 }
 
@@ -197,6 +250,20 @@ impl SignedDistance<3> for SurfaceObstacle {
     fn distance_and_gradient(&self, x: &Point<3>) -> (Real, Vector<3>) {
         let p = self.closest_point(x);
         (p.distance, p.gradient)
+    }
+    /// Smoothed surfaces ([`SurfaceObstacle::smoothed_solid`]) answer points farther than
+    /// `reach + δ` from the control surface with `φ_control − δ` (the closest-point search on
+    /// a fine surface visits more triangles the farther the point); others as
+    /// [`SignedDistance::distance_and_gradient`].
+    fn distance_and_gradient_within(&self, x: &Point<3>, reach: Real) -> (Real, Vector<3>) {
+        if let Some((coarse, delta)) = &self.coarse {
+            let local = self.rotation.inverse() * (x - self.translation);
+            let (_, _, d, g) = coarse.closest_local(&local);
+            if d - delta > reach {
+                return (d - delta, self.rotation * g);
+            }
+        }
+        self.distance_and_gradient(x)
     }
     fn validate(&self) -> Result<(), String> {
         if self.translation.iter().chain(self.rotation.matrix().iter()).all(|v| v.is_finite()) {

@@ -55,14 +55,40 @@ impl TriangleSurface {
         self.check_manifold()?;
         let mut surface = self.clone();
         for _ in 0..levels {
-            surface = surface.loop_level(crease_angle.cos())?;
+            surface = surface.loop_level(Some(crease_angle.cos()))?;
+        }
+        Ok(surface)
+    }
+
+    /// `levels` levels of midpoint subdivision: the same triangles and vertex numbering as
+    /// [`TriangleSurface::loop_subdivided`] (vertex `i` of both is the same point of the
+    /// scheme), with the points left where they are (each triangle split at its edge
+    /// midpoints): the same geometry, finer. Vertex by vertex, the distance between the two
+    /// surfaces' points bounds how far subdivision moved the surface (used by
+    /// `SurfaceObstacle::smoothed_solid`).
+    ///
+    /// # Errors
+    /// As [`TriangleSurface::loop_subdivided`].
+    pub fn midpoint_subdivided(&self, levels: usize) -> Result<Self, SurfaceError> {
+        self.check_manifold()?;
+        if levels > 4 {
+            return Err(SurfaceError::InvalidParameter(format!(
+                "{levels} levels of subdivision asked; at most 4 (256 times the triangles)"
+            )));
+        }
+        let mut surface = self.clone();
+        for _ in 0..levels {
+            surface = surface.loop_level(None)?;
         }
         Ok(surface)
     }
 
     /// One level of [`TriangleSurface::loop_subdivided`] on a checked manifold; an edge is a
-    /// crease when the cosine between its triangles' normals is below `crease_cos`.
-    fn loop_level(&self, crease_cos: Real) -> Result<Self, SurfaceError> {
+    /// crease when the cosine between its triangles' normals is below `crease_cos`; `None`:
+    /// midpoint subdivision (no point moves).
+    fn loop_level(&self, crease_cos: Option<Real>) -> Result<Self, SurfaceError> {
+        let crease_cos = crease_cos.unwrap_or(Real::INFINITY);
+        let linear = crease_cos.is_infinite();
         let v = self.vertices();
         let tris = self.triangles();
         let normals: Vec<Vector<3>> = (0..tris.len()).map(|t| self.normal(t)).collect();
@@ -121,6 +147,7 @@ impl TriangleSurface {
         }
         let mut vertices: Vec<Point<3>> = (0..n_v)
             .map(|p| match (creases[p], valence[p]) {
+                _ if linear => v[p],
                 (_, 0) => v[p],
                 (0, n) => {
                     let n = n as Real;
@@ -204,6 +231,19 @@ mod tests {
         let (e2, e3, e4) = (error_at(2), error_at(3), error_at(4));
         eprintln!("distance to the sphere: {e2:.3e} {e3:.3e} {e4:.3e}");
         assert!(e2 < 0.03 && e3 / e2 < 0.3 && e4 / e3 < 0.3, "{e2} {e3} {e4}");
+    }
+
+    #[test]
+    fn midpoint_subdivision_keeps_the_geometry_and_numbers_points_as_loop() {
+        let sphere = TriangleSurface::icosphere(Point::<3>::zeros(), 1.0, 1).expect("icosphere");
+        let linear = sphere.midpoint_subdivided(2).expect("midpoints");
+        let smooth = sphere.loop_subdivided(2, 0.5).expect("loop");
+        assert_eq!(linear.triangles(), smooth.triangles());
+        assert!((linear.area() - sphere.area()).abs() < 1e-12 * sphere.area());
+        assert!((linear.signed_volume() - sphere.signed_volume()).abs() < 1e-12);
+        // Loop moves each point by less than the control mesh's edge length
+        let moved = linear.vertices().iter().zip(smooth.vertices()).map(|(a, b)| (a - b).norm());
+        assert!(moved.fold(0.0, Real::max) < 0.1);
     }
 
     #[test]

@@ -97,6 +97,13 @@ pub const FRICTION: Real = 0.04;
 /// Rows with a larger gap (mm) are left out of each contact solve until they come into contact.
 pub const SCREENING_BAND: Real = 0.5;
 
+/// Default levels of Loop subdivision of the femoral surface ([`Tkr3d::femur_subdivision`]).
+pub const FEMUR_SUBDIVISION: usize = 0;
+/// Dihedral angle above which an edge of the femoral surface stays a sharp crease under
+/// subdivision (30°: the rims and the box cuts of the component, not the articular surface,
+/// whose facets meet at a few degrees).
+pub const FEMUR_CREASE_ANGLE: Real = std::f64::consts::PI / 6.0;
+
 /// How the femur's superior–inferior translation (degree of freedom 1) is set.
 #[derive(Debug, Clone)]
 pub enum Superior {
@@ -133,6 +140,11 @@ pub struct Tkr3d {
     /// Force-control parameters (tolerances; with freed degrees of freedom the example uses
     /// fresh Jacobians, 500 solves and 1e-8).
     pub control: ForceControlParams,
+    /// Levels of Loop subdivision of the femoral surface before it is used (0: the STL as it
+    /// is). The decimated STL has facets of 1.25 mm (median edge, up to 2.9 mm), creases of a
+    /// few degrees at each edge; two levels (0.31 mm) make it smooth on the scale of the
+    /// insert's meshes (docs/tkr3d.md, "Mesh convergence"; `synovia_mesh::subdivision`).
+    pub femur_subdivision: usize,
 }
 
 impl Default for Tkr3d {
@@ -148,6 +160,7 @@ impl Default for Tkr3d {
             dense_interface: false,
             superior: Superior::IsoForce,
             control: ForceControlParams::default(),
+            femur_subdivision: FEMUR_SUBDIVISION,
         }
     }
 }
@@ -209,8 +222,13 @@ impl Tkr3d {
         joint.define_part("insert", "contact", move |x, n| n[1] > min_ny && x[1] > 1.0)?;
 
         // the femoral component: rigid, bounded by its closed surface (metres → mm)
+        // (Loop-subdivided: its edges stay sharp where its facets meet at more than 30°)
         let femur_surface = read_stl(self.data_dir.join("femoral_component.stl"))?.scaled(1000.0)?;
-        let shape: Arc<dyn SignedDistance<3>> = Arc::new(SurfaceObstacle::solid(femur_surface)?);
+        let shape: Arc<dyn SignedDistance<3>> = Arc::new(SurfaceObstacle::smoothed_solid(
+            femur_surface,
+            self.femur_subdivision,
+            FEMUR_CREASE_ANGLE,
+        )?);
 
         // the pose over the cycle: time = fraction of the cycle (the table's time is in percent)
         let table = self.kinematics()?;

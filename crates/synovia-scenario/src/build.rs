@@ -1537,7 +1537,8 @@ fn obstacle<const D: usize>(
     let why = format!("obstacle `{kind}`");
     let why = why.as_str();
     let present = present!(s; "point" => point, "normal" => normal, "center" => center, "radius" => radius,
-        "axis" => axis, "cavity" => cavity, "file" => file, "scale" => scale, "solid" => solid);
+        "axis" => axis, "cavity" => cavity, "file" => file, "scale" => scale, "solid" => solid,
+        "subdivide" => subdivide, "crease_angle_deg" => crease_angle_deg);
     let cavity = s.cavity.as_ref().is_some_and(|c| *c.get_ref());
     let any: Box<dyn Any> = match kind {
         "plane" => {
@@ -1578,7 +1579,7 @@ fn obstacle<const D: usize>(
             if D != 3 {
                 return Err(cx.err(key(k, "type"), s.kind.span(), "an `stl` surface is 3D"));
             }
-            cx.only(k, &present, &["file", "scale", "solid"], why)?;
+            cx.only(k, &present, &["file", "scale", "solid", "subdivide", "crease_angle_deg"], why)?;
             let f = cx.req(&s.file, k, "file", &span, why)?;
             let fk = key(k, "file");
             let path = cx.src.resolve(f.get_ref());
@@ -1590,7 +1591,34 @@ fn obstacle<const D: usize>(
                     surface.scaled(factor).map_err(|e| cx.err(key(k, "scale"), sc.span(), e.to_string()))?;
             }
             let solid = s.solid.as_ref().is_none_or(|v| *v.get_ref());
-            let obstacle = if solid {
+            // `subdivide`: Loop subdivision (a solid keeps its control surface for far queries)
+            let mut smoothing = None;
+            if let Some(levels) = &s.subdivide {
+                let n = usize::try_from(*levels.get_ref()).map_err(|_| {
+                    cx.err(key(k, "subdivide"), levels.span(), "levels of subdivision must be 0 to 4")
+                })?;
+                let angle = match &s.crease_angle_deg {
+                    Some(a) => cx.finite(a, &key(k, "crease_angle_deg"))?,
+                    None => 30.0,
+                }
+                .to_radians();
+                if solid {
+                    smoothing = Some((n, angle));
+                } else {
+                    surface = surface
+                        .loop_subdivided(n, angle)
+                        .map_err(|e| cx.err(key(k, "subdivide"), levels.span(), e.to_string()))?;
+                }
+            } else if let Some(a) = &s.crease_angle_deg {
+                return Err(cx.err(
+                    key(k, "crease_angle_deg"),
+                    a.span(),
+                    "`crease_angle_deg` needs `subdivide`",
+                ));
+            }
+            let obstacle = if let Some((n, angle)) = smoothing {
+                synovia::contact_ops::SurfaceObstacle::smoothed_solid(surface, n, angle)
+            } else if solid {
                 synovia::contact_ops::SurfaceObstacle::solid(surface)
             } else {
                 synovia::contact_ops::SurfaceObstacle::new(surface)

@@ -589,6 +589,12 @@ pub struct ObstacleSpec {
     /// `stl`: `true` (default) requires a closed, manifold surface (inside = negative
     /// distance); `false` accepts an open patch (distance signed by the facet normals).
     pub solid: Option<Sp<bool>>,
+    /// `stl`: levels of Loop subdivision (0–4, default 0) that smooth a faceted surface
+    /// (`TriangleSurface::loop_subdivided`, docs/scenario.md).
+    pub subdivide: Option<Sp<i64>>,
+    /// `stl` with `subdivide`: edges whose facets meet at more than this angle (degrees,
+    /// default 30) stay sharp.
+    pub crease_angle_deg: Option<Sp<f64>>,
     pub point: Option<Sp<Vec<f64>>>,
     pub normal: Option<Sp<Vec<f64>>>,
     pub center: Option<Sp<Vec<f64>>>,

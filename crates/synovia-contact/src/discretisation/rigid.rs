@@ -50,8 +50,15 @@ impl<const D: usize> ContactDiscretisation<D> for RigidObstacle<D> {
         self.obstacle.validate().map_err(|m| cx.invalid(format!("obstacle: {m}")))?;
         let pos_k = cx.positions(cx.body()).ok_or_else(|| cx.invalid("unknown body"))?;
         // the obstacle queries (closest points on a surface) are independent per node
-        let queries: Vec<(Real, Vector<D>)> =
-            cx.normals().par_iter().map(|&(i, _)| self.obstacle.distance_and_gradient(&pos_k[i])).collect();
+        // (beyond the search distance only "farther than it" matters: a bounded query)
+        let queries: Vec<(Real, Vector<D>)> = cx
+            .normals()
+            .par_iter()
+            .map(|&(i, _)| match self.search_distance {
+                Some(reach) => self.obstacle.distance_and_gradient_within(&pos_k[i], reach),
+                None => self.obstacle.distance_and_gradient(&pos_k[i]),
+            })
+            .collect();
         let mut rows = Vec::with_capacity(cx.normals().len());
         for (&(i, nk), &(phi, grad)) in cx.normals().iter().zip(&queries) {
             let gl = grad.norm();
