@@ -721,19 +721,24 @@ impl Knee2d {
     }
 }
 
-/// The cycle with hyperelastic cartilage (docs/nonlinear.md): each pose is the model of
-/// [`Knee2d::neo_hookean_model`] (the femur re-meshed in its pose: the flexion is a placement,
-/// as in the linear cycle, so both runs solve the same poses on the same meshes), solved by
-/// the Newton iteration of [`synovia::nonlinear::NonlinearContact`] with `params` (e.g.
-/// [`Knee2d::nonlinear_newton_params`]) under the same load control as the linear cycle: a
-/// secant iteration on the approach `δ` until the vertical contact resultant
-/// `Σ κ_r Λ_n,r n_r · e_y` equals `F(t) / w` within [`Knee2d::tolerance`]. Each secant solve
-/// starts from the previous one's converged deformed state and its contact geometry
-/// (continuation in `δ`); the first solve of a pose ramps from the reference configuration,
-/// starting at `guesses[i]` (e.g. the linear cycle's approach) or else at the previous pose's
-/// approach. With finite-strain kinematics the contact geometry (pairing, normals, gaps) is that
-/// of the deformed configuration, rebuilt until it settles; [`NonlinearKneeStep::gap_error`]
-/// measures what is left of it.
+/// The cycle with hyperelastic cartilage (docs/nonlinear.md): the model of
+/// [`Knee2d::neo_hookean_model`] built **once**, at the first pose, and one
+/// [`synovia::nonlinear::NonlinearContact`] (one symbolic analysis) for the cycle. Between
+/// poses the femur's two meshes are rotated about the condyle centre `c` by the change of
+/// flexion `Δθ`, `x ↦ c + R(Δθ)(x − c)` (the re-meshed pose of [`Knee2d::model`] up to
+/// rounding, so both runs solve the same poses on the same meshes), and the converged
+/// deformed state is carried along with them ([`synovia::nonlinear::NonlinearContact::map_state`]:
+/// femoral displacements `u ↦ R(Δθ)(u − t) + t` with `t = (0, −δ)` the arc's translation,
+/// contact forces `c ↦ R(Δθ) c`), so every pose continues from the previous pose's solution
+/// instead of ramping from the reference configuration. Each pose is solved by the Newton
+/// iteration with `params` (e.g. [`Knee2d::nonlinear_newton_params`]) under the same load
+/// control as the linear cycle: a secant iteration on the approach `δ` until the vertical
+/// contact resultant `Σ κ_r Λ_n,r n_r · e_y` equals `F(t) / w` within [`Knee2d::tolerance`],
+/// started at `guesses[i]` (e.g. the linear cycle's approach) scaled by the last pose's
+/// ratio of approach to guess, and stepped with the last pose's slope `dF/dδ`. With
+/// finite-strain kinematics the contact geometry (pairing, normals, gaps) is that of the
+/// deformed configuration, rebuilt until it settles; [`NonlinearKneeStep::gap_error`] measures
+/// what is left of it.
 ///
 /// # Errors
 /// Model, Newton or contact failures; no load balance within 40 solves.
@@ -748,20 +753,43 @@ pub fn nonlinear_cycle(
     let force = iso14243_axial_force()?;
     let flexion = iso14243_flexion()?;
     let mut steps = Vec::with_capacity(times.len());
-    // the last pose's approach and its guess
+    let Some(&first) = times.first() else { return Ok(steps) };
+    let setup = Instant::now();
+    let (mut model, pairs, kinematics) = knee.neo_hookean_model(first)?;
+    let femur = [model.body_id(knee.body_names[0])?, model.body_id(knee.body_names[1])?];
+    let mut nl = NonlinearContact::new(&model, &pairs, &kinematics, ElasticParams::default(), params)?;
+    let mut setup_s = setup.elapsed().as_secs_f64();
+    let mut theta_model = flexion.value(first);
+    let centre = knee.condyle_centre();
+    // the last pose's approach and its guess, and the slope dF/dδ of its last secant step
     let mut last_approach: Option<(Real, Option<Real>)> = None;
+    let mut last_slope: Option<(Real, Real)> = None;
     for (i, &time) in times.iter().enumerate() {
         let start = Instant::now();
-        let (model, pairs, kinematics) = knee.neo_hookean_model(time)?;
-        let mut nl = NonlinearContact::new(&model, &pairs, &kinematics, ElasticParams::default(), params)?;
+        let theta = flexion.value(time);
         let load_n = force.value(time);
         let target = load_n / knee.width;
         let tolerance = knee.tolerance * target;
+        // the femur placed in this pose, its deformed state carried along
+        if theta != theta_model {
+            let place = BodyPlacement::planar_rotation(centre, theta - theta_model)?;
+            for &b in &femur {
+                model.body_mut(b)?.mesh.map_nodes(|x| place.position(x))?;
+            }
+            let shift = Vector::<2>::new(0.0, -nl.time());
+            let moved = |b: BodyId| femur.contains(&b);
+            nl.map_state(
+                |b, u| if moved(b) { place.to_global(&(u - shift)) + shift } else { *u },
+                |b, c| if moved(b) { place.to_global(c) } else { *c },
+            );
+            theta_model = theta;
+        }
         let (mut solves, mut newton, mut factorisations) = (0usize, 0usize, 0usize);
+        let model_ref = &model;
         let mut solve = |d: Real,
                          nl: &mut NonlinearContact<2>|
          -> Result<(Real, synovia::nonlinear::NonlinearResult<2>), KneeError> {
-            let r = nl.step_to(&model, d, solver)?;
+            let r = nl.step_to(model_ref, d, solver)?;
             solves += 1;
             newton += r.report.total_iterations;
             factorisations += r.report.factorisations;
@@ -787,8 +815,15 @@ pub fn nonlinear_cycle(
         let (d1, r1) = if (f0 - target).abs() <= tolerance {
             (d0, r0)
         } else {
-            // first step: a thin layer's force grows roughly as δ^(3/2)
-            let mut d1 = d0 * (target / f0).powf(2.0 / 3.0).clamp(0.5, 2.0);
+            // first step: the last pose's slope carried to this load (a thin layer's force
+            // grows roughly as δ^(3/2), so dF/dδ ∝ F^(1/3)), or (first pose) that power law
+            let mut d1 = match last_slope {
+                Some((slope, f_last)) if slope > 0.0 && f_last > 0.0 => {
+                    let slope = slope * (f0 / f_last).cbrt();
+                    (d0 + (target - f0) / slope).clamp(0.5 * d0, 2.0 * d0)
+                }
+                _ => d0 * (target / f0).powf(2.0 / 3.0).clamp(0.5, 2.0),
+            };
             let (mut f1, mut r1) = solve(d1, &mut nl)?;
             let mut iter = 0;
             while (f1 - target).abs() > tolerance {
@@ -805,6 +840,10 @@ pub fn nonlinear_cycle(
                 let (f2, r2) = solve(d2, &mut nl)?;
                 (d0, f0) = (d1, f1);
                 (d1, f1, r1) = (d2, f2, r2);
+            }
+            let slope = (f1 - f0) / (d1 - d0);
+            if slope > 0.0 && slope.is_finite() {
+                last_slope = Some((slope, f1));
             }
             (d1, r1)
         };
@@ -863,7 +902,7 @@ pub fn nonlinear_cycle(
                 solves,
                 solver_iterations: newton,
                 kkt: contact.kkt.max(),
-                seconds: start.elapsed().as_secs_f64(),
+                seconds: start.elapsed().as_secs_f64() + std::mem::take(&mut setup_s),
             },
             factorisations,
             gap_error,
