@@ -34,6 +34,10 @@ use synovia_models::tkr3d::Tkr3d;
 
 type Error = Box<dyn std::error::Error>;
 
+/// Threshold of the `film_area` columns (MPa): the lower limit of Fuji Prescale LW film, with
+/// which published TKR contact areas are measured (docs/tkr3d.md).
+const FILM_THRESHOLD_MPA: f64 = 2.5;
+
 /// Figures of one pose.
 struct Pose {
     percent: f64,
@@ -45,6 +49,8 @@ struct Pose {
     contact_force: f64,
     friction_force: f64,
     area: f64,
+    /// Contact area above the film threshold `FILM_THRESHOLD_MPA`: pair, medial, lateral.
+    film_area: [f64; 3],
     peak: f64,
     medial: Side,
     lateral: Side,
@@ -158,7 +164,7 @@ fn main() -> Result<(), Error> {
                 cop: s.centre_of_pressure,
             })
         };
-        let pose = Pose {
+        let mut pose = Pose {
             percent: 100.0 * t,
             load: -rigid.applied[1].unwrap_or(0.0),
             si_mm: rigid.dofs[1],
@@ -168,6 +174,7 @@ fn main() -> Result<(), Error> {
             contact_force: pair.normal_force,
             friction_force: pair.tangential_force,
             area: pair.contact_area,
+            film_area: [0.0; 3],
             peak: pair.peak_pressure,
             medial: side("medial"),
             lateral: side("lateral"),
@@ -198,6 +205,10 @@ fn main() -> Result<(), Error> {
             return Err(format!("pose {i}: KKT residual {:.2e} > 1e-8 ({detail})", pose.kkt).into());
         }
         let result = session.result().ok_or("no result")?;
+        // the area a pressure-sensitive film would show (pair, lateral = positive side, medial)
+        let film = synovia::time::results::contact_area_above(session.geometry(), result, FILM_THRESHOLD_MPA);
+        let film = film.first().ok_or("no pair")?;
+        pose.film_area = [film[0], film.get(2).copied().unwrap_or(0.0), film.get(1).copied().unwrap_or(0.0)];
         // the contact state (`--stress`: also the stress and strain fields, docs/output.md)
         let vtu = if stress {
             synovia::output::contact_vtu(session.model(), session.geometry(), result, Encoding::Zlib)?
@@ -215,7 +226,7 @@ fn main() -> Result<(), Error> {
     let max = |f: &dyn Fn(&Pose) -> f64| poses.iter().map(f).fold(0.0, f64::max);
     let peak = poses.iter().max_by(|a, b| a.peak.total_cmp(&b.peak)).ok_or("no poses")?;
     println!(
-        "{{\"example\":\"tkr3d\",\"mesh\":\"{}\",\"poses\":{},\"dofs\":{dofs},\"max_force_balance_error\":{:.3e},\"max_kkt\":{:.3e},\"peak_pressure_mpa\":{:.3},\"peak_pressure_at_percent\":{:.0},\"max_contact_area_mm2\":{:.1},\"max_medial_force_n\":{:.1},\"max_lateral_force_n\":{:.1},\"friction\":{friction},\"max_friction_force_n\":{:.1},\"setup_s\":{setup_s:.2},\"total_s\":{:.2}}}",
+        "{{\"example\":\"tkr3d\",\"mesh\":\"{}\",\"poses\":{},\"dofs\":{dofs},\"max_force_balance_error\":{:.3e},\"max_kkt\":{:.3e},\"peak_pressure_mpa\":{:.3},\"peak_pressure_at_percent\":{:.0},\"max_contact_area_mm2\":{:.1},\"max_film_area_mm2\":{:.1},\"max_medial_force_n\":{:.1},\"max_lateral_force_n\":{:.1},\"friction\":{friction},\"max_friction_force_n\":{:.1},\"setup_s\":{setup_s:.2},\"total_s\":{:.2}}}",
         model.mesh_file(),
         poses.len(),
         max(&|p| p.balance),
@@ -223,6 +234,7 @@ fn main() -> Result<(), Error> {
         peak.peak,
         peak.percent,
         max(&|p| p.area),
+        max(&|p| p.film_area[0]),
         max(&|p| p.medial.force),
         max(&|p| p.lateral.force),
         max(&|p| p.friction_force),
@@ -233,13 +245,13 @@ fn main() -> Result<(), Error> {
 
 fn csv_text(poses: &[Pose]) -> String {
     let mut s = String::from(
-        "cycle [%],axial_force [N],si_translation [mm],si_measured [mm],force_balance_error [-],kkt [-],contact_force [N],friction_force [N],contact_area [mm^2],peak_pressure [MPa],medial_force [N],medial_area [mm^2],medial_peak_pressure [MPa],medial_cop_x [mm],medial_cop_z [mm],lateral_force [N],lateral_area [mm^2],lateral_peak_pressure [MPa],lateral_cop_x [mm],lateral_cop_z [mm],solves [-],seconds [s]\n",
+        "cycle [%],axial_force [N],si_translation [mm],si_measured [mm],force_balance_error [-],kkt [-],contact_force [N],friction_force [N],contact_area [mm^2],peak_pressure [MPa],medial_force [N],medial_area [mm^2],medial_peak_pressure [MPa],medial_cop_x [mm],medial_cop_z [mm],lateral_force [N],lateral_area [mm^2],lateral_peak_pressure [MPa],lateral_cop_x [mm],lateral_cop_z [mm],solves [-],seconds [s],film_area [mm^2],medial_film_area [mm^2],lateral_film_area [mm^2]\n",
     );
     let cop = |c: Option<[f64; 3]>, k: usize| c.map_or(String::new(), |c| format!("{:.4}", c[k]));
     for p in poses {
         let _ = writeln!(
             s,
-            "{},{},{},{},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{:e},{:e},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             p.percent,
             p.load,
             p.si_mm,
@@ -261,7 +273,10 @@ fn csv_text(poses: &[Pose]) -> String {
             cop(p.lateral.cop, 0),
             cop(p.lateral.cop, 2),
             p.solves,
-            p.seconds
+            p.seconds,
+            p.film_area[0],
+            p.film_area[1],
+            p.film_area[2]
         );
     }
     s

@@ -31,6 +31,19 @@ fn a_force_controlled_pose_carries_the_iso_load_and_a_prescribed_one_reproduces_
     let sides: f64 = pair.sides.iter().map(|s| s.normal_force).sum();
     assert!((sides - pair.normal_force).abs() <= 1e-9 * pair.normal_force);
     let si = femur.dofs[1];
+    // the area above a pressure threshold: the record's area at 0, per side too, shrinking as
+    // the threshold grows, nothing above the peak
+    let (geometry, result) = (session.geometry(), session.result().expect("result"));
+    let at = |p_min: f64| synovia_time::results::contact_area_above(geometry, result, p_min)[0].clone();
+    let zero = at(0.0);
+    assert_eq!(zero.len(), 3);
+    assert!((zero[0] - pair.contact_area).abs() <= 1e-12 * pair.contact_area);
+    for (a, side) in zero[1..].iter().zip(&pair.sides) {
+        assert!((a - side.contact_area).abs() <= 1e-12 * pair.contact_area, "{a} vs {}", side.contact_area);
+    }
+    let (film, half) = (at(2.5), at(0.5 * pair.peak_pressure));
+    assert!(zero[0] > film[0] && film[0] > half[0] && half[0] > 0.0, "{zero:?} {film:?} {half:?}");
+    assert_eq!(at(pair.peak_pressure)[0], 0.0);
     drop(session);
 
     // the same pose with the translation prescribed at the value found: the same load

@@ -263,6 +263,40 @@ fn records_where<const D: usize>(
     out
 }
 
+/// The contact area above a pressure threshold, per pair and per side of a split pair (as
+/// [`pair_records`]: `[pair, positive side, negative side]` for a split pair, `[pair]`
+/// otherwise): `Σ κ_r` over the contact nodes with `Λ_n,r > p_min`. With `p_min = 0` it is
+/// [`PairRecord::contact_area`]. Pressure-sensitive film measures this (Fuji Prescale LW: from
+/// 2.5 MPa); a computed area without a threshold also counts the fringe of a conforming
+/// contact where the pressure falls to zero, which the element size decides
+/// (docs/tkr3d.md, "Mesh convergence").
+pub fn contact_area_above<const D: usize>(
+    geometry: &ContactGeometry<D>,
+    result: &StaticContactResult<D>,
+    p_min: Real,
+) -> Vec<Vec<Real>> {
+    geometry
+        .pairs
+        .iter()
+        .enumerate()
+        .map(|(p, (_, range))| {
+            let split = geometry.report_splits.get(p).and_then(Option::as_ref);
+            let mut areas = vec![0.0; if split.is_some() { 3 } else { 1 }];
+            for r in range.clone() {
+                let node = &geometry.nodes[r];
+                if result.solution.lambda_n.get(r).copied().unwrap_or(0.0) > p_min {
+                    areas[0] += node.weight;
+                    if let Some(split) = split {
+                        let side = if split.is_positive(node.position.as_slice()) { 1 } else { 2 };
+                        areas[side] += node.weight;
+                    }
+                }
+            }
+            areas
+        })
+        .collect()
+}
+
 impl PairRecord {
     #[must_use]
     fn with_force<const D: usize>(mut self, f: &Vector<D>) -> Self {
