@@ -43,3 +43,73 @@ fn neo_hookean_knee_matches_linear_at_light_load_and_differs_at_the_peak() {
         linear[1].approach
     );
 }
+
+/// `SpatialField` reproduces a linear field exactly inside the mesh (P1 interpolation) and
+/// takes the nearest node's value outside it.
+#[test]
+fn spatial_field_interpolates_linear_fields_exactly() {
+    use synovia::mesh::math::{Point, Vector};
+    use synovia_models::knee2d::SpatialField;
+    let centre = Point::<2>::new(0.0, 22.5);
+    let mesh = synovia::mesh::generators::layered_arc_2d(centre, &[20.0, 22.5], (-2.5, -1.0), 40, &[3])
+        .expect("arc")
+        .pop()
+        .expect("layer");
+    let f = |x: &Point<2>| Vector::<2>::new(0.3 * x[0] - 0.1 * x[1] + 1.0, 0.2 * x[1] + 0.05 * x[0]);
+    let values: Vec<Vector<2>> = mesh.nodes().iter().map(f).collect();
+    let field = SpatialField::new(&mesh, &values, centre);
+    // points strictly inside the layer, between nodes
+    for k in 0..50 {
+        let a = -2.45 + 1.4 * k as f64 / 49.0;
+        let r = 20.3 + 1.9 * ((k * 7) % 11) as f64 / 10.0;
+        let x = Point::<2>::new(centre[0] + r * a.cos(), centre[1] + r * a.sin());
+        let v = field.value(&x);
+        // the chord of a P1 arc cuts off a sliver near the outer/inner circle: stay inside
+        assert!((v - f(&x)).norm() < 1e-9, "at {x:?}: {v:?} vs {:?}", f(&x));
+    }
+    // outside the sector: the nearest node's value
+    let far = Point::<2>::new(centre[0] + 21.0 * 0.5_f64.cos(), centre[1] + 21.0 * 0.5_f64.sin());
+    let nearest =
+        mesh.nodes().iter().min_by(|p, q| (*p - far).norm().total_cmp(&(*q - far).norm())).expect("node");
+    assert!((field.value(&far) - f(nearest)).norm() < 1e-12);
+}
+
+/// The state carried between poses (`nonlinear_cycle_with`): keeping the femur's field in
+/// space and rotating it with the femur are two starts of the same Newton problem, so both
+/// give the same poses; the field kept in space is the better start (fewer Newton
+/// iterations over the poses after the first).
+#[test]
+fn carried_state_gives_the_same_poses_either_way() {
+    use synovia_models::knee2d::{nonlinear_cycle_with, Carry};
+    let knee = Knee2d::coarse();
+    let solver = synovia::solvers::by_name("pdas").expect("solver");
+    let times = [0.1, 0.13, 0.16];
+    let linear = knee.run(&times, solver.as_ref(), |_| Ok(())).expect("linear cycle");
+    let guesses: Vec<f64> = linear.iter().map(|s| s.approach).collect();
+    let run = |carry| {
+        nonlinear_cycle_with(
+            &knee,
+            &times,
+            &guesses,
+            solver.as_ref(),
+            Knee2d::nonlinear_newton_params(),
+            carry,
+        )
+        .expect("neo-Hookean cycle")
+    };
+    let (space, rotate) = (run(Carry::InSpace), run(Carry::Rotate));
+    for (a, b) in space.iter().zip(&rotate) {
+        let (pa, pb) = (a.step.peak_pressure, b.step.peak_pressure);
+        assert!((pa - pb).abs() <= 2e-4 * pb, "t = {}: peak {pa} vs {pb}", a.step.time);
+        assert!(a.step.balance_error <= 1e-3 && a.step.kkt <= 1e-8);
+    }
+    let newton = |r: &[synovia_models::knee2d::NonlinearKneeStep]| -> usize {
+        r[1..].iter().map(|h| h.step.solver_iterations).sum()
+    };
+    println!(
+        "Newton iterations after the first pose: in space {}, rotated {}",
+        newton(&space),
+        newton(&rotate)
+    );
+    assert!(newton(&space) <= newton(&rotate));
+}

@@ -749,6 +749,33 @@ pub fn nonlinear_cycle(
     solver: &dyn ContactSolver,
     params: synovia::nonlinear::NewtonParams,
 ) -> Result<Vec<NonlinearKneeStep>, KneeError> {
+    nonlinear_cycle_with(knee, times, guesses, solver, params, Carry::InSpace)
+}
+
+/// How [`nonlinear_cycle_with`] carries the converged state of one pose to the next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Carry {
+    /// The femur's deformed shape rotated with its mesh: `u ↦ R(Δθ)(u − t) + t`,
+    /// `t = (0, −δ)`, contact forces `c ↦ R(Δθ) c`.
+    Rotate,
+    /// The femur's displacement field kept in space: the new displacement of a node at
+    /// `x' = c + R(Δθ)(x − c)` is the old field interpolated (P1) at `x'`
+    /// (`u'(x') = u(x')`, [`SpatialField`]); the deformed contact zone stays under the load.
+    InSpace,
+}
+
+/// [`nonlinear_cycle`] with the state carried between poses by `carry`.
+///
+/// # Errors
+/// As [`nonlinear_cycle`].
+pub fn nonlinear_cycle_with(
+    knee: &Knee2d,
+    times: &[Real],
+    guesses: &[Real],
+    solver: &dyn ContactSolver,
+    params: synovia::nonlinear::NewtonParams,
+    carry: Carry,
+) -> Result<Vec<NonlinearKneeStep>, KneeError> {
     use synovia::nonlinear::NonlinearContact;
     let force = iso14243_axial_force()?;
     let flexion = iso14243_flexion()?;
@@ -773,14 +800,36 @@ pub fn nonlinear_cycle(
         // the femur placed in this pose, its deformed state carried along
         if theta != theta_model {
             let place = BodyPlacement::planar_rotation(centre, theta - theta_model)?;
+            let carry = match carry {
+                Carry::Rotate => None,
+                Carry::InSpace => {
+                    let lifts = nl.dofs().lifts(&model, nl.time())?;
+                    let disp = nl.dofs().expand(nl.reduced(), &lifts)?;
+                    Some(
+                        femur
+                            .iter()
+                            .map(|&b| Ok(SpatialField::new(&model.body(b)?.mesh, &disp[b.0], centre)))
+                            .collect::<Result<Vec<_>, KneeError>>()?,
+                    )
+                }
+            };
             for &b in &femur {
                 model.body_mut(b)?.mesh.map_nodes(|x| place.position(x))?;
             }
             let shift = Vector::<2>::new(0.0, -nl.time());
-            let moved = |b: BodyId| femur.contains(&b);
+            let slot = |b: BodyId| femur.iter().position(|f| *f == b);
+            let model_ref = &model;
             nl.map_state(
-                |b, u| if moved(b) { place.to_global(&(u - shift)) + shift } else { *u },
-                |b, c| if moved(b) { place.to_global(c) } else { *c },
+                |b, i, u| match (slot(b), &carry) {
+                    (Some(k), Some(fields)) => model_ref
+                        .body(b)
+                        .ok()
+                        .and_then(|body| body.mesh.nodes().get(i))
+                        .map_or(*u, |x| fields[k].value(x)),
+                    (Some(_), None) => place.to_global(&(u - shift)) + shift,
+                    (None, _) => *u,
+                },
+                |b, _, c| if slot(b).is_some() && carry.is_none() { place.to_global(c) } else { *c },
             );
             theta_model = theta;
         }
@@ -911,6 +960,80 @@ pub fn nonlinear_cycle(
         });
     }
     Ok(steps)
+}
+
+/// A nodal field of a P1 triangle mesh of an annular sector about `centre`, evaluated at any
+/// point by linear interpolation on the cell that contains it,
+/// `v(x) = Σ_a φ_a(x) v_a` (barycentric `φ_a`), or the value of the nearest node for a point
+/// outside the mesh. Cells are found through bins of the polar angle about `centre`.
+#[derive(Debug, Clone)]
+pub struct SpatialField {
+    nodes: Vec<Point<2>>,
+    cells: Vec<[usize; 3]>,
+    values: Vec<Vector<2>>,
+    centre: Point<2>,
+    start: Real,
+    width: Real,
+    bins: Vec<Vec<usize>>,
+}
+
+impl SpatialField {
+    /// The field `values` (one per node) on `mesh`, binned about `centre`.
+    pub fn new(mesh: &synovia_mesh::Mesh<2>, values: &[Vector<2>], centre: Point<2>) -> Self {
+        let nodes: Vec<Point<2>> = mesh.nodes().to_vec();
+        let cells: Vec<[usize; 3]> = mesh.cells().filter_map(|c| <[usize; 3]>::try_from(c).ok()).collect();
+        let angle = |x: &Point<2>| (x[1] - centre[1]).atan2(x[0] - centre[0]);
+        let (lo, hi) = nodes
+            .iter()
+            .map(angle)
+            .fold((Real::INFINITY, Real::NEG_INFINITY), |(l, h), a| (l.min(a), h.max(a)));
+        let n_bins = cells.len().clamp(1, 1024);
+        let width = ((hi - lo) / n_bins as Real).max(Real::EPSILON);
+        let mut bins = vec![Vec::new(); n_bins];
+        for (k, c) in cells.iter().enumerate() {
+            let a = c.map(|i| angle(&nodes[i]));
+            let (amin, amax) = (
+                a.iter().copied().fold(Real::INFINITY, Real::min),
+                a.iter().copied().fold(Real::NEG_INFINITY, Real::max),
+            );
+            if amax - amin > PI {
+                continue;
+            }
+            let first = (((amin - lo) / width).floor().max(0.0) as usize).min(n_bins - 1);
+            let last = (((amax - lo) / width).floor().max(0.0) as usize).min(n_bins - 1);
+            for bin in &mut bins[first..=last] {
+                bin.push(k);
+            }
+        }
+        Self { nodes, cells, values: values.to_vec(), centre, start: lo, width, bins }
+    }
+
+    /// `v(x)` (see the type docs).
+    pub fn value(&self, x: &Point<2>) -> Vector<2> {
+        let a = (x[1] - self.centre[1]).atan2(x[0] - self.centre[0]);
+        let bin = (a - self.start) / self.width;
+        if bin >= 0.0 && (bin as usize) < self.bins.len() {
+            for &k in &self.bins[bin as usize] {
+                let [i, j, l] = self.cells[k];
+                let (p, q, r) = (self.nodes[i], self.nodes[j], self.nodes[l]);
+                let det = (q[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (q[1] - p[1]);
+                if det == 0.0 {
+                    continue;
+                }
+                let s = ((x[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (x[1] - p[1])) / det;
+                let t = ((q[0] - p[0]) * (x[1] - p[1]) - (x[0] - p[0]) * (q[1] - p[1])) / det;
+                let tol = -1e-10;
+                if s >= tol && t >= tol && 1.0 - s - t >= tol {
+                    return self.values[i] * (1.0 - s - t) + self.values[j] * s + self.values[l] * t;
+                }
+            }
+        }
+        self.nodes
+            .iter()
+            .zip(&self.values)
+            .min_by(|u, v| (u.0 - x).norm().total_cmp(&(v.0 - x).norm()))
+            .map_or_else(Vector::<2>::zeros, |(_, v)| *v)
+    }
 }
 
 /// Node-to-segment contact (2D) with a **continuous master normal** for finite-strain runs,

@@ -442,29 +442,31 @@ impl<const D: usize> NonlinearContact<D> {
     /// Maps the converged state to a moved reference configuration, so that the next level
     /// continues from it instead of the reference (e.g. a body re-placed between poses by a
     /// rigid motion of its mesh, the model's nodes moved by the caller). For every dof group
-    /// with basis `N` (orthonormal columns) and origin body `b`, the group's displacement and
-    /// reduced contact force
+    /// with basis `N` (orthonormal columns) and origin node `(b, i)`, the group's displacement
+    /// and reduced contact force
     ///
     /// ```text
-    /// u = N ũ,  c = N c̃   become   ũ' = Nᵀ f_u(b, u),   c̃' = Nᵀ f_c(b, c)
+    /// u = N ũ,  c = N c̃   become   ũ' = Nᵀ f_u(b, i, u),   c̃' = Nᵀ f_c(b, i, c)
     /// ```
     ///
     /// (the lifts are not part of `ũ`: `f_u` acts on the free part of the displacement). For
     /// a rigid rotation `R` of a body's mesh about a point, with the body's prescribed
-    /// displacement a translation `t`, `f_u(u) = R (u − t) + t` and `f_c(c) = R c` carry the
-    /// deformed shape along with the mesh. The tangent is refactorised at the next iteration
-    /// and the contact geometry rebuilt; the state's time and load factor are kept.
+    /// displacement a translation `t`, `f_u = R (u − t) + t` and `f_c = R c` carry the
+    /// deformed shape along with the mesh; `f_u` may also interpolate a displacement field
+    /// at the node's new position. The tangent is refactorised at the next iteration and the
+    /// contact geometry rebuilt; the state's time and load factor are kept.
     pub fn map_state(
         &mut self,
-        f_u: impl Fn(synovia_fem::BodyId, &Vector<D>) -> Vector<D>,
-        f_c: impl Fn(synovia_fem::BodyId, &Vector<D>) -> Vector<D>,
+        f_u: impl Fn(synovia_fem::BodyId, usize, &Vector<D>) -> Vector<D>,
+        f_c: impl Fn(synovia_fem::BodyId, usize, &Vector<D>) -> Vector<D>,
     ) {
         for grp in self.dofs.groups() {
             let (u, c) = (0..grp.n_dofs).fold((Vector::<D>::zeros(), Vector::<D>::zeros()), |(u, c), k| {
                 let i = grp.first_dof + k;
                 (u + grp.basis[k] * self.state.reduced[i], c + grp.basis[k] * self.state.contact_force[i])
             });
-            let (u, c) = (f_u(grp.origin.0, &u), f_c(grp.origin.0, &c));
+            let (b, node) = grp.origin;
+            let (u, c) = (f_u(b, node, &u), f_c(b, node, &c));
             for k in 0..grp.n_dofs {
                 let i = grp.first_dof + k;
                 self.state.reduced[i] = grp.basis[k].dot(&u);
