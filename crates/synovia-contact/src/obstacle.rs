@@ -26,7 +26,8 @@ pub trait SignedDistance<const D: usize>: Send + Sync + fmt::Debug {
     /// (a lower bound of the distance: what a contact row beyond its search distance needs,
     /// [`RigidObstacle::search_distance`](crate::discretisation::RigidObstacle)). Shapes whose
     /// exact query costs more the farther the point (a finely tessellated surface) answer far
-    /// points from a coarser one. Default: [`SignedDistance::distance_and_gradient`].
+    /// points from a coarser one (docs/model.md (5.23)). Default:
+    /// [`SignedDistance::distance_and_gradient`].
     fn distance_and_gradient_within(&self, x: &Point<D>, reach: Real) -> (Real, Vector<D>) {
         let _ = reach;
         self.distance_and_gradient(x)
