@@ -74,19 +74,21 @@ fn spatial_field_interpolates_linear_fields_exactly() {
     assert!((field.value(&far) - f(nearest)).norm() < 1e-12);
 }
 
-/// The state carried between poses (`nonlinear_cycle_with`): keeping the femur's field in
-/// space and rotating it with the femur are two starts of the same Newton problem, so both
-/// give the same poses; the field kept in space is the better start (fewer Newton
-/// iterations over the poses after the first).
+/// The state carried between poses and the load control (`nonlinear_cycle_with`): keeping
+/// the femur's field in space or rotating it with the femur are two starts of the same Newton
+/// problem, and the secant iteration on the approach or the load control inside the Newton
+/// iteration two ways to the same balanced pose, so all give the same poses (to the geometry
+/// tolerance); the field kept in space is the better start, and the load control solves each
+/// pose after the first in one Newton solve.
 #[test]
-fn carried_state_gives_the_same_poses_either_way() {
-    use synovia_models::knee2d::{nonlinear_cycle_with, Carry};
+fn carried_state_and_load_control_give_the_same_poses() {
+    use synovia_models::knee2d::{nonlinear_cycle_with, Carry, NonlinearKneeStep};
     let knee = Knee2d::coarse();
     let solver = synovia::solvers::by_name("pdas").expect("solver");
     let times = [0.1, 0.13, 0.16];
     let linear = knee.run(&times, solver.as_ref(), |_| Ok(())).expect("linear cycle");
     let guesses: Vec<f64> = linear.iter().map(|s| s.approach).collect();
-    let run = |carry| {
+    let run = |carry, control| {
         nonlinear_cycle_with(
             &knee,
             &times,
@@ -94,22 +96,31 @@ fn carried_state_gives_the_same_poses_either_way() {
             solver.as_ref(),
             Knee2d::nonlinear_newton_params(),
             carry,
+            control,
         )
         .expect("neo-Hookean cycle")
     };
-    let (space, rotate) = (run(Carry::InSpace), run(Carry::Rotate));
-    for (a, b) in space.iter().zip(&rotate) {
-        let (pa, pb) = (a.step.peak_pressure, b.step.peak_pressure);
-        assert!((pa - pb).abs() <= 2e-4 * pb, "t = {}: peak {pa} vs {pb}", a.step.time);
-        assert!(a.step.balance_error <= 1e-3 && a.step.kkt <= 1e-8);
+    let space = run(Carry::InSpace, false);
+    let rotate = run(Carry::Rotate, false);
+    let controlled = run(Carry::InSpace, true);
+    for other in [&rotate, &controlled] {
+        for (a, b) in space.iter().zip(other.iter()) {
+            let (pa, pb) = (a.step.peak_pressure, b.step.peak_pressure);
+            assert!((pa - pb).abs() <= 1e-3 * pa, "t = {}: peak {pa} vs {pb}", a.step.time);
+            assert!(b.step.balance_error <= 1e-3 && b.step.kkt <= 1e-8, "t = {}", b.step.time);
+            assert!(b.gap_error <= 1e-3 * b.mesh_size, "t = {}: gap {}", b.step.time, b.gap_error);
+        }
     }
-    let newton = |r: &[synovia_models::knee2d::NonlinearKneeStep]| -> usize {
-        r[1..].iter().map(|h| h.step.solver_iterations).sum()
-    };
+    let newton = |r: &[NonlinearKneeStep]| -> usize { r[1..].iter().map(|h| h.step.solver_iterations).sum() };
     println!(
-        "Newton iterations after the first pose: in space {}, rotated {}",
+        "Newton iterations after the first pose: in space {}, rotated {}, load control {}",
         newton(&space),
-        newton(&rotate)
+        newton(&rotate),
+        newton(&controlled)
     );
     assert!(newton(&space) <= newton(&rotate));
+    // the first pose ramps with the secant iteration; every later one under load control, one solve
+    assert!(!controlled[0].load_controlled && space.iter().all(|h| !h.load_controlled));
+    assert!(controlled[1..].iter().all(|h| h.load_controlled && h.step.solves == 1));
+    assert!(newton(&controlled) < newton(&space));
 }

@@ -660,6 +660,9 @@ pub struct NonlinearKneeStep {
     /// The shortest facet of the tibial cartilage surface (reference mesh), mm: the scale of
     /// [`NonlinearKneeStep::gap_error`].
     pub mesh_size: Real,
+    /// The pose was solved under load control inside the Newton iteration
+    /// ([`nonlinear_cycle_with`]); `false`: by the secant iteration on `δ`.
+    pub load_controlled: bool,
 }
 
 impl Knee2d {
@@ -749,7 +752,7 @@ pub fn nonlinear_cycle(
     solver: &dyn ContactSolver,
     params: synovia::nonlinear::NewtonParams,
 ) -> Result<Vec<NonlinearKneeStep>, KneeError> {
-    nonlinear_cycle_with(knee, times, guesses, solver, params, Carry::InSpace)
+    nonlinear_cycle_with(knee, times, guesses, solver, params, Carry::InSpace, true)
 }
 
 /// How [`nonlinear_cycle_with`] carries the converged state of one pose to the next.
@@ -764,7 +767,12 @@ pub enum Carry {
     InSpace,
 }
 
-/// [`nonlinear_cycle`] with the state carried between poses by `carry`.
+/// [`nonlinear_cycle`] with the state carried between poses by `carry`, and with
+/// `load_control` the poses after the first solved under load control inside the Newton
+/// iteration ([`synovia::nonlinear::NonlinearContact::step_controlled`]: every iteration
+/// chooses the approach `δ` at which its linearised problem balances `F(t) / w`), falling back
+/// to the secant iteration on `δ` around whole Newton solves if that fails; without it, the
+/// secant iteration for every pose.
 ///
 /// # Errors
 /// As [`nonlinear_cycle`].
@@ -775,6 +783,7 @@ pub fn nonlinear_cycle_with(
     solver: &dyn ContactSolver,
     params: synovia::nonlinear::NewtonParams,
     carry: Carry,
+    control: bool,
 ) -> Result<Vec<NonlinearKneeStep>, KneeError> {
     use synovia::nonlinear::NonlinearContact;
     let force = iso14243_axial_force()?;
@@ -834,6 +843,7 @@ pub fn nonlinear_cycle_with(
             theta_model = theta;
         }
         let (mut solves, mut newton, mut factorisations) = (0usize, 0usize, 0usize);
+        let mut extra = (0usize, 0usize, 0usize);
         let model_ref = &model;
         let mut solve = |d: Real,
                          nl: &mut NonlinearContact<2>|
@@ -853,49 +863,84 @@ pub fn nonlinear_cycle_with(
             (None, Some((d, _))) => d,
             (None, None) => 0.05,
         };
-        let (mut f0, mut r0) = solve(d0, &mut nl)?;
-        while f0 <= 0.0 {
-            d0 *= 2.0;
-            if d0 > 10.0 {
-                return Err(format!("t = {time}: no contact up to an approach of {d0} mm").into());
-            }
-            (f0, r0) = solve(d0, &mut nl)?;
-        }
-        let (d1, r1) = if (f0 - target).abs() <= tolerance {
-            (d0, r0)
-        } else {
-            // first step: the last pose's slope carried to this load (a thin layer's force
-            // grows roughly as δ^(3/2), so dF/dδ ∝ F^(1/3)), or (first pose) that power law
-            let mut d1 = match last_slope {
-                Some((slope, f_last)) if slope > 0.0 && f_last > 0.0 => {
-                    let slope = slope * (f0 / f_last).cbrt();
-                    (d0 + (target - f0) / slope).clamp(0.5 * d0, 2.0 * d0)
-                }
-                _ => d0 * (target / f0).powf(2.0 / 3.0).clamp(0.5, 2.0),
+        // load control inside the Newton iteration from the previous pose's state (the approach
+        // chosen per iteration on the linearised problem); the secant iteration on δ around
+        // whole Newton solves when it fails, and for the first pose
+        let mut controlled = None;
+        if let (true, Some((slope, f_last))) = (control, last_slope) {
+            let resultant = |g: &ContactGeometry<2>, l: &[Real]| traction_resultant(g, l)[1].abs();
+            let mut ctl = synovia::nonlinear::LoadControl {
+                resultant: &resultant,
+                target,
+                tolerance,
+                slope: slope * (target / f_last).cbrt(),
             };
-            let (mut f1, mut r1) = solve(d1, &mut nl)?;
-            let mut iter = 0;
-            while (f1 - target).abs() > tolerance {
-                iter += 1;
-                if iter > 40 {
-                    return Err(format!("t = {time}: load balance not reached: {f1} vs {target} N/mm").into());
+            match nl.step_controlled(&model, d0, solver, &mut ctl) {
+                Ok(r) => {
+                    extra.0 += 1;
+                    extra.1 += r.report.total_iterations;
+                    extra.2 += r.report.factorisations;
+                    last_slope = Some((ctl.slope, target));
+                    controlled = Some((r.time, r));
+                }
+                // the state is unchanged: the secant iteration below
+                Err(_) => {}
+            }
+        }
+        let was_controlled = controlled.is_some();
+        let (d1, r1) = if let Some(done) = controlled {
+            done
+        } else {
+            let (mut f0, mut r0) = solve(d0, &mut nl)?;
+            while f0 <= 0.0 {
+                d0 *= 2.0;
+                if d0 > 10.0 {
+                    return Err(format!("t = {time}: no contact up to an approach of {d0} mm").into());
+                }
+                (f0, r0) = solve(d0, &mut nl)?;
+            }
+            let (d1, r1) = if (f0 - target).abs() <= tolerance {
+                (d0, r0)
+            } else {
+                // first step: the last pose's slope carried to this load (a thin layer's force
+                // grows roughly as δ^(3/2), so dF/dδ ∝ F^(1/3)), or (first pose) that power law
+                let mut d1 = match last_slope {
+                    Some((slope, f_last)) if slope > 0.0 && f_last > 0.0 => {
+                        let slope = slope * (f0 / f_last).cbrt();
+                        (d0 + (target - f0) / slope).clamp(0.5 * d0, 2.0 * d0)
+                    }
+                    _ => d0 * (target / f0).powf(2.0 / 3.0).clamp(0.5, 2.0),
+                };
+                let (mut f1, mut r1) = solve(d1, &mut nl)?;
+                let mut iter = 0;
+                while (f1 - target).abs() > tolerance {
+                    iter += 1;
+                    if iter > 40 {
+                        return Err(
+                            format!("t = {time}: load balance not reached: {f1} vs {target} N/mm").into()
+                        );
+                    }
+                    let slope = (f1 - f0) / (d1 - d0);
+                    let mut d2 =
+                        if slope > 0.0 && slope.is_finite() { d1 + (target - f1) / slope } else { 1.5 * d1 };
+                    if d2 <= 0.0 {
+                        d2 = 0.5 * d1;
+                    }
+                    let (f2, r2) = solve(d2, &mut nl)?;
+                    (d0, f0) = (d1, f1);
+                    (d1, f1, r1) = (d2, f2, r2);
                 }
                 let slope = (f1 - f0) / (d1 - d0);
-                let mut d2 =
-                    if slope > 0.0 && slope.is_finite() { d1 + (target - f1) / slope } else { 1.5 * d1 };
-                if d2 <= 0.0 {
-                    d2 = 0.5 * d1;
+                if slope > 0.0 && slope.is_finite() {
+                    last_slope = Some((slope, f1));
                 }
-                let (f2, r2) = solve(d2, &mut nl)?;
-                (d0, f0) = (d1, f1);
-                (d1, f1, r1) = (d2, f2, r2);
-            }
-            let slope = (f1 - f0) / (d1 - d0);
-            if slope > 0.0 && slope.is_finite() {
-                last_slope = Some((slope, f1));
-            }
+                (d1, r1)
+            };
             (d1, r1)
         };
+        solves += extra.0;
+        newton += extra.1;
+        factorisations += extra.2;
         last_approach = Some((d1, guesses.get(i).copied().filter(|g| *g > 0.0)));
         let contact = &r1.contact;
         let geo = nl.geometry();
@@ -957,6 +1002,7 @@ pub fn nonlinear_cycle_with(
             gap_error,
             penetration: penetration.max(0.0),
             mesh_size,
+            load_controlled: was_controlled,
         });
     }
     Ok(steps)

@@ -321,6 +321,31 @@ pub struct NonlinearResult<const D: usize> {
     pub report: NewtonReport,
 }
 
+/// Load control of a level ([`NonlinearContact::step_controlled`]): the level's time `t`
+/// (e.g. the approach of a prescribed boundary) is an unknown with the equation
+/// `R(t) = target` on a resultant `R` of the contact multipliers (e.g. `Σ κ_r Λ_n,r n_r · e`).
+pub struct LoadControl<'a, const D: usize> {
+    /// The resultant `R(geometry, Λ_n)`.
+    pub resultant: &'a dyn Fn(&ContactGeometry<D>, &[Real]) -> Real,
+    /// Its target value.
+    pub target: Real,
+    /// Absolute tolerance on `|R − target|` (each iteration's linearised problem is balanced to
+    /// a tenth of it).
+    pub tolerance: Real,
+    /// `dR/dt`: the first secant step's slope, updated with every secant step taken.
+    pub slope: Real,
+}
+
+impl<const D: usize> std::fmt::Debug for LoadControl<'_, D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LoadControl")
+            .field("target", &self.target)
+            .field("tolerance", &self.tolerance)
+            .field("slope", &self.slope)
+            .finish_non_exhaustive()
+    }
+}
+
 /// The converged state the next level starts from.
 #[derive(Debug, Clone)]
 struct State<const D: usize> {
@@ -518,8 +543,8 @@ impl<const D: usize> NonlinearContact<D> {
         let mut halvings = 0usize;
         loop {
             let (time, scale) = point(target);
-            match self.newton(model, time, scale, solver, &mut report) {
-                Ok((result, energy, iterations, reduced, force)) => {
+            match self.newton(model, time, scale, solver, &mut report, None) {
+                Ok((result, energy, iterations, reduced, force, _)) => {
                     report.sublevels += 1;
                     self.state =
                         State { time, scale, reduced, contact_force: force, result: Some(result.clone()) };
@@ -569,6 +594,70 @@ impl<const D: usize> NonlinearContact<D> {
         }
     }
 
+    /// Solves a level under load control from a converged loaded state: Newton's method as in
+    /// [`Self::step_to`], where every iteration also chooses the level's time `t` by a secant
+    /// iteration on the linearised problem (frozen tangent and geometry), so that its
+    /// multipliers satisfy `R(t) = target` ([`LoadControl`]):
+    ///
+    /// ```text
+    /// t_{j+1} = t_j + (target − R(t_j)) / s_j,   s_j = (R(t_j) − R(t_{j−1})) / (t_j − t_{j−1}),
+    /// ```
+    ///
+    /// each trial `t_j` a contact solve of `K_T δũ = f_ext(t_j) − f_int − Pᵀ K_T Δu_p(t_j) − c`
+    /// on the kept factorisation. At convergence the equilibrium residual is at the tolerance
+    /// and `|R − target| ≤ tolerance / 10`. Starts at `t_guess`; commits the state at the final
+    /// `t` (the result's `time`). No cut-back: on failure the state is unchanged and the caller
+    /// may fall back to [`Self::step_to`] on `t`.
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] from an unloaded state (ramp with
+    /// [`Self::step_to`] first) or a non-finite guess or target;
+    /// [`NonlinearError::NoConvergence`] when Newton or the secant fails.
+    pub fn step_controlled(
+        &mut self,
+        model: &Model<D>,
+        t_guess: Real,
+        solver: &dyn ContactSolver,
+        control: &mut LoadControl<'_, D>,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
+        if self.state.scale < 1.0 {
+            return Err(NonlinearError::InvalidParameter(
+                "load control starts from a converged loaded level".into(),
+            ));
+        }
+        if !(t_guess.is_finite()
+            && control.target.is_finite()
+            && control.slope.is_finite()
+            && control.slope != 0.0)
+        {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "load control: guess {t_guess}, target {}, slope {} must be finite (slope non-zero)",
+                control.target, control.slope
+            )));
+        }
+        let start = Instant::now();
+        let mut report = NewtonReport::default();
+        match self.newton(model, t_guess, 1.0, solver, &mut report, Some(control)) {
+            Ok((result, energy, iterations, reduced, force, t)) => {
+                report.sublevels = 1;
+                report.iterations = iterations;
+                report.time_s = start.elapsed().as_secs_f64();
+                self.state = State {
+                    time: t,
+                    scale: 1.0,
+                    reduced,
+                    contact_force: force,
+                    result: Some(result.clone()),
+                };
+                Ok(NonlinearResult { time: t, contact: result, strain_energy: energy, report })
+            }
+            Err(e) => {
+                self.tangent_kept = false;
+                Err(e)
+            }
+        }
+    }
+
     /// Runs the levels `times` (in order; a level before the state's time is reached by going
     /// back along the histories, e.g. unloading) with [`Self::step_to`],
     /// calling `observer` after each.
@@ -601,10 +690,14 @@ impl<const D: usize> NonlinearContact<D> {
         scale: Real,
         solver: &dyn ContactSolver,
         report: &mut NewtonReport,
-    ) -> Result<(StaticContactResult<D>, Real, Vec<NewtonIteration>, Vec<Real>, Vec<Real>), NonlinearError>
-    {
+        mut control: Option<&mut LoadControl<'_, D>>,
+    ) -> Result<
+        (StaticContactResult<D>, Real, Vec<NewtonIteration>, Vec<Real>, Vec<Real>, Real),
+        NonlinearError,
+    > {
+        let mut t = t;
         let n = self.dofs.n_dofs();
-        let lifts: Vec<Vector<D>> = self.dofs.lifts(model, t)?.into_iter().map(|l| l * scale).collect();
+        let mut lifts: Vec<Vector<D>> = self.dofs.lifts(model, t)?.into_iter().map(|l| l * scale).collect();
         let mut f_ext = vec![0.0; n];
         add_loads(model, &self.dofs, t, self.params.load_degree, &mut f_ext)?;
         f_ext.iter_mut().for_each(|f| *f *= scale);
@@ -618,6 +711,8 @@ impl<const D: usize> NonlinearContact<D> {
         };
         let delta_lifts: Vec<Vector<D>> = lifts.iter().zip(&lifts_old).map(|(a, b)| a - b).collect();
         let mut predictor = delta_lifts.iter().any(|d| d.norm_squared() > 0.0);
+        // the lifts of the current iterate (load control moves `t`, so the lifts with it)
+        let mut current_lifts = lifts_old.clone();
         let mut disp = self.dofs.expand(&u, &lifts_old)?;
         let (mut f_int, _) = internal_force(model, &self.dofs, &self.kinematics, &disp)?;
         let mut c = self.state.contact_force.clone();
@@ -631,10 +726,10 @@ impl<const D: usize> NonlinearContact<D> {
         };
         let previous_disp = if friction { previous.map(|p| p.displacement.clone()) } else { None };
         let mut warm: Option<ContactSolution> = previous.map(|p| p.solution.clone());
-        let residual_of = |f_int: &[Real], c: &[Real]| -> Vec<Real> {
+        let residual_of = |f_ext: &[Real], f_int: &[Real], c: &[Real]| -> Vec<Real> {
             (0..n).map(|i| f_ext[i] - f_int[i] - c[i]).collect()
         };
-        let mut r_norm = norm(&residual_of(&f_int, &c));
+        let mut r_norm = norm(&residual_of(&f_ext, &f_int, &c));
         // the force scale of the level: its initial residual (e.g. the forces of a prescribed
         // displacement's jump, which leave the reduced rows once balanced)
         let mut r_start = r_norm;
@@ -734,23 +829,98 @@ impl<const D: usize> NonlinearContact<D> {
             let k = self.contact.elastic().stiffness();
             let mut ku = vec![0.0; n];
             k.mul_vec(&u, &mut ku);
-            let mut load: Vec<Real> = (0..n).map(|i| f_ext[i] - f_int[i] + ku[i]).collect();
-            if predictor {
-                let before = load.clone();
-                subtract_tangent_lift(model, &self.dofs, kin, at, &delta_lifts, &mut load)?;
-                let lift_force: Vec<Real> = (0..n).map(|i| load[i] - before[i]).collect();
-                r_start = r_start.max(norm(&lift_force));
-            }
             let rows = self.contact.geometry().len();
-            let warm_start = warm.as_ref().filter(|w| w.lambda_n.len() == rows);
-            let result = self.contact.solve_load(
-                &load,
-                &lifts,
-                solver,
-                slip_bound.as_deref().filter(|g| g.len() == rows),
-                previous_disp.as_deref(),
-                warm_start,
-            )?;
+            let (load, result) = if let Some(ctl) = control.as_deref_mut() {
+                // load control: the level's time `t` of this iteration is the one at which the
+                // linearised problem's resultant equals the target (secant on `t`; each trial a
+                // contact solve on the kept factorisation)
+                let resultant = ctl.resultant;
+                let trial = |tt: Real,
+                             warm: Option<&ContactSolution>|
+                 -> Result<
+                    (Real, Vec<Real>, Vec<Vector<D>>, Vec<Real>, Real, StaticContactResult<D>),
+                    NonlinearError,
+                > {
+                    let lt: Vec<Vector<D>> =
+                        self.dofs.lifts(model, tt)?.into_iter().map(|l| l * scale).collect();
+                    let mut fe = vec![0.0; n];
+                    add_loads(model, &self.dofs, tt, self.params.load_degree, &mut fe)?;
+                    fe.iter_mut().for_each(|f| *f *= scale);
+                    let mut ld: Vec<Real> = (0..n).map(|i| fe[i] - f_int[i] + ku[i]).collect();
+                    let dl: Vec<Vector<D>> = lt.iter().zip(&current_lifts).map(|(a, b)| a - b).collect();
+                    let mut lift_force = 0.0;
+                    if dl.iter().any(|d| d.norm_squared() > 0.0) {
+                        let before = ld.clone();
+                        subtract_tangent_lift(model, &self.dofs, kin, at, &dl, &mut ld)?;
+                        lift_force = norm(&(0..n).map(|i| ld[i] - before[i]).collect::<Vec<_>>());
+                    }
+                    let res = self.contact.solve_load(
+                        &ld,
+                        &lt,
+                        solver,
+                        slip_bound.as_deref().filter(|g| g.len() == rows),
+                        previous_disp.as_deref(),
+                        warm.filter(|w| w.lambda_n.len() == rows),
+                    )?;
+                    let f = resultant(self.contact.geometry(), &res.solution.lambda_n);
+                    Ok((f, ld, lt, fe, lift_force, res))
+                };
+                let inner = 0.1 * ctl.tolerance;
+                let (mut ta, mut tb) = (t, t);
+                let mut b = trial(tb, warm.as_ref())?;
+                let mut fa = b.0;
+                for _ in 0..30 {
+                    if (b.0 - ctl.target).abs() <= inner {
+                        break;
+                    }
+                    if tb != ta {
+                        let s = (b.0 - fa) / (tb - ta);
+                        if s > 0.0 && s.is_finite() {
+                            ctl.slope = s;
+                        }
+                    }
+                    let tc = tb + (ctl.target - b.0) / ctl.slope;
+                    if !tc.is_finite() {
+                        break;
+                    }
+                    (ta, fa) = (tb, b.0);
+                    tb = tc;
+                    b = trial(tb, Some(&b.5.solution))?;
+                }
+                if (b.0 - ctl.target).abs() > inner {
+                    return Err(NonlinearError::NoConvergence {
+                        time: tb,
+                        cutbacks: 0,
+                        step: 0.0,
+                        reason: format!("load control: resultant {} for the target {}", b.0, ctl.target),
+                    });
+                }
+                let (_, ld, lt, fe, lift_force, res) = b;
+                predictor = lift_force > 0.0;
+                r_start = r_start.max(lift_force);
+                t = tb;
+                lifts = lt;
+                f_ext = fe;
+                (ld, res)
+            } else {
+                let mut load: Vec<Real> = (0..n).map(|i| f_ext[i] - f_int[i] + ku[i]).collect();
+                if predictor {
+                    let before = load.clone();
+                    subtract_tangent_lift(model, &self.dofs, kin, at, &delta_lifts, &mut load)?;
+                    let lift_force: Vec<Real> = (0..n).map(|i| load[i] - before[i]).collect();
+                    r_start = r_start.max(norm(&lift_force));
+                }
+                let warm_start = warm.as_ref().filter(|w| w.lambda_n.len() == rows);
+                let result = self.contact.solve_load(
+                    &load,
+                    &lifts,
+                    solver,
+                    slip_bound.as_deref().filter(|g| g.len() == rows),
+                    previous_disp.as_deref(),
+                    warm_start,
+                )?;
+                (load, result)
+            };
             let u_star = &result.solution.u;
             let mut k_star = vec![0.0; n];
             k.mul_vec(u_star, &mut k_star);
@@ -773,7 +943,7 @@ impl<const D: usize> NonlinearContact<D> {
                 let disp_try = self.dofs.expand(&u_try, &lifts)?;
                 match internal_force(model, &self.dofs, &self.kinematics, &disp_try) {
                     Ok((f_try, e_try)) => {
-                        let r_try = norm(&residual_of(&f_try, &c_try));
+                        let r_try = norm(&residual_of(&f_ext, &f_try, &c_try));
                         if !self.params.line_search
                             || predictor
                             || rebuilt
@@ -823,6 +993,7 @@ impl<const D: usize> NonlinearContact<D> {
             }
             let increment = alpha * norm(&delta) / norm(&u_new).max(Real::MIN_POSITIVE);
             predictor = false;
+            current_lifts.clone_from(&lifts);
             u = u_new;
             c = c_new;
             disp = disp_new;
@@ -889,7 +1060,7 @@ impl<const D: usize> NonlinearContact<D> {
                 let mut result = result;
                 result.displacement = disp;
                 result.solution.u = u.clone();
-                return Ok((result, energy, iterations, u, c));
+                return Ok((result, energy, iterations, u, c, t));
             }
         }
         let last = iterations.last().map_or(Real::NAN, |i| i.residual);
