@@ -875,16 +875,13 @@ pub fn nonlinear_cycle_with(
                 tolerance,
                 slope: slope * (target / f_last).cbrt(),
             };
-            match nl.step_controlled(&model, d0, solver, &mut ctl) {
-                Ok(r) => {
-                    extra.0 += 1;
-                    extra.1 += r.report.total_iterations;
-                    extra.2 += r.report.factorisations;
-                    last_slope = Some((ctl.slope, target));
-                    controlled = Some((r.time, r));
-                }
-                // the state is unchanged: the secant iteration below
-                Err(_) => {}
+            // on failure the state is unchanged: the secant iteration below
+            if let Ok(r) = nl.step_controlled(&model, d0, solver, &mut ctl) {
+                extra.0 += 1;
+                extra.1 += r.report.total_iterations;
+                extra.2 += r.report.factorisations;
+                last_slope = Some((ctl.slope, target));
+                controlled = Some((r.time, r));
             }
         }
         let was_controlled = controlled.is_some();
