@@ -166,19 +166,37 @@ impl PyShape {
     /// The rigid body bounded by a triangle `surface` (3D, `SurfaceObstacle`):
     /// `solid=True` (default) needs a closed surface with outward normals (the free space is
     /// outside); `solid=False` accepts an open, consistently oriented patch whose normals
-    /// point into the free space. The surface is checked here.
+    /// point into the free space. The surface is checked here. `subdivide=n` (0–4) smooths a
+    /// faceted surface by `n` levels of Loop subdivision, edges whose facets meet at more
+    /// than `crease_angle_deg` (default 30) kept sharp (a solid keeps its control surface for
+    /// queries beyond a pair's search distance: `SurfaceObstacle::smoothed_solid`).
     #[staticmethod]
-    #[pyo3(signature = (surface, solid = true))]
-    fn surface(py: Python<'_>, surface: PyRef<'_, PySurface>, solid: bool) -> PyResult<Self> {
-        surface_shape(py, TriangleSurface::clone(&surface.surface), solid, None)
+    #[pyo3(signature = (surface, solid = true, subdivide = 0, crease_angle_deg = 30.0))]
+    fn surface(
+        py: Python<'_>,
+        surface: PyRef<'_, PySurface>,
+        solid: bool,
+        subdivide: usize,
+        crease_angle_deg: f64,
+    ) -> PyResult<Self> {
+        let smoothing = (subdivide, crease_angle_deg.to_radians());
+        surface_shape(py, TriangleSurface::clone(&surface.surface), solid, smoothing, None)
     }
-    /// `Shape.surface(read_stl(path, scale), solid)`: the rigid body bounded by the surface of
-    /// an STL file.
+    /// `Shape.surface(read_stl(path, scale), solid, subdivide, crease_angle_deg)`: the rigid
+    /// body bounded by the surface of an STL file.
     #[staticmethod]
-    #[pyo3(signature = (path, scale = None, solid = true))]
-    fn stl(py: Python<'_>, path: PathBuf, scale: Option<f64>, solid: bool) -> PyResult<Self> {
+    #[pyo3(signature = (path, scale = None, solid = true, subdivide = 0, crease_angle_deg = 30.0))]
+    fn stl(
+        py: Python<'_>,
+        path: PathBuf,
+        scale: Option<f64>,
+        solid: bool,
+        subdivide: usize,
+        crease_angle_deg: f64,
+    ) -> PyResult<Self> {
         let s = read_stl(py, path.clone(), scale)?;
-        surface_shape(py, TriangleSurface::clone(&s.surface), solid, Some(&path))
+        let smoothing = (subdivide, crease_angle_deg.to_radians());
+        surface_shape(py, TriangleSurface::clone(&s.surface), solid, smoothing, Some(&path))
     }
     /// The signed distance `φ(x)` of points `x` (`(n, D)` or one point) to the shape
     /// (positive on the elastic body's side), in the shape's own frame.
@@ -215,15 +233,17 @@ fn surface_shape(
     py: Python<'_>,
     surface: TriangleSurface,
     solid: bool,
+    (levels, crease_angle): (usize, f64),
     file: Option<&std::path::Path>,
 ) -> PyResult<PyShape> {
     let built = py.allow_threads(move || {
         if solid {
-            SurfaceObstacle::solid(surface).map_err(|e| {
+            SurfaceObstacle::smoothed_solid(surface, levels, crease_angle).map_err(|e| {
                 format!("{e} (a solid surface must be closed; solid=False accepts an open patch)")
             })
         } else {
-            SurfaceObstacle::new(surface).map_err(|e| e.to_string())
+            let smooth = surface.loop_subdivided(levels, crease_angle).map_err(|e| e.to_string())?;
+            SurfaceObstacle::new(smooth).map_err(|e| e.to_string())
         }
     });
     let obstacle = built.map_err(|e| match file {

@@ -100,12 +100,22 @@ class Shape:
     def cylinder(point: ArrayLike, axis: ArrayLike, radius: float, cavity: bool = False) -> "Shape":
         """Cylinder (3D)."""
     @staticmethod
-    def surface(surface: Surface, solid: bool = True) -> "Shape":
+    def surface(
+        surface: Surface, solid: bool = True, subdivide: int = 0, crease_angle_deg: float = 30.0
+    ) -> "Shape":
         """Bounded by a triangle surface (3D): solid=True needs a closed surface with outward
-        normals (else SynoviaError), solid=False accepts an oriented open patch."""
+        normals (else SynoviaError), solid=False accepts an oriented open patch. subdivide=n
+        (0-4) smooths a faceted surface by n levels of Loop subdivision, keeping edges whose
+        facets meet at more than crease_angle_deg sharp."""
     @staticmethod
-    def stl(path: PathLike, scale: Optional[float] = None, solid: bool = True) -> "Shape":
-        """Shape.surface(read_stl(path, scale), solid)."""
+    def stl(
+        path: PathLike,
+        scale: Optional[float] = None,
+        solid: bool = True,
+        subdivide: int = 0,
+        crease_angle_deg: float = 30.0,
+    ) -> "Shape":
+        """Shape.surface(read_stl(path, scale), solid, subdivide, crease_angle_deg)."""
     def distance(self, x: ArrayLike) -> FloatArray:
         """Signed distance of points (n, D) in the shape's own frame."""
 

@@ -216,6 +216,39 @@ def test_stl_rigid_body_with_friction_equals_scenario(ball_files):
     assert got.rigid_bodies()["ball"]["dofs"][0] == pytest.approx(0.02, abs=1e-15)
 
 
+def test_smoothed_stl_rigid_body_equals_scenario(ball_files):
+    """subdivide / crease_angle_deg of Shape.stl equal the scenario keys (Loop-subdivided
+    surface), and the smoothing changes the figures; bad levels raise SynoviaError."""
+    toml = BALL_TOML.replace('scale = 1000.0 }', 'scale = 1000.0, subdivide = 2, crease_angle_deg = 40.0 }')
+    assert toml != BALL_TOML
+    (ball_files / "ball_smooth.toml").write_text(toml)
+    sc = synovia.Model.from_scenario(ball_files / "ball_smooth.toml")
+
+    def model(**smoothing):
+        m = copy_bodies(sc, {"block": MAT(1000.0, 0.3)})
+        m.clamp("block", "bottom")
+        m.add_rigid_body(
+            "ball",
+            center=[0.0, 0.0, 1.5],
+            prescribe={"tx": np.array([[0.0, 0.0], [1.0, 0.02]]), "rz": [[0.0, 0.0], [1.0, np.deg2rad(2.0)]]},
+            force={"tz": -50.0},
+        )
+        shape = synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0, **smoothing)
+        m.contact_rigid_body("ball-block", "block", "top", "ball", shape, friction=0.2, search_distance=0.3)
+        m.solver("pdas")
+        return m.run_quasistatic([0.0, 0.5, 1.0])
+
+    got, ref = model(subdivide=2, crease_angle_deg=40.0), sc.run()
+    same_runs(got, ref, 1e-12, "smoothed STL ball from Python")
+    faceted = model()
+    # the smoothed ball (Loop shrinks it slightly) sits lower at the same force
+    tz = [r["rigid"][0]["dofs"][2] for r in got.records]
+    tz_faceted = [r["rigid"][0]["dofs"][2] for r in faceted.records]
+    assert all(a < b - 1e-3 for a, b in zip(tz, tz_faceted)), (tz, tz_faceted)
+    with pytest.raises(synovia.SynoviaError, match="at most 4"):
+        synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0, subdivide=5)
+
+
 def test_fixed_stl_obstacle_equals_sphere_and_open_patch(ball_files):
     """A fixed STL ball and an analytic ball of the same radius give close contact forces; an
     open patch needs solid=False."""

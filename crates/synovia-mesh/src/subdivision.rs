@@ -127,7 +127,11 @@ impl TriangleSurface {
         let mut valence = vec![0usize; n_v];
         let mut crease_neighbours = vec![[0usize; 2]; n_v];
         let mut creases = vec![0usize; n_v];
-        for (&(a, b), e) in &edges {
+        // in the order the edges were numbered (a map's order would change the sums' rounding
+        // from run to run)
+        let mut ordered: Vec<(&(usize, usize), &Edge)> = edges.iter().collect();
+        ordered.sort_unstable_by_key(|(_, e)| e.index);
+        for (&(a, b), e) in ordered {
             let crease = e.count == 1 || normals[e.triangles[0]].dot(&normals[e.triangles[1]]) < crease_cos;
             edge_points[e.index] = if crease {
                 (v[a] + v[b]) / 2.0
