@@ -235,6 +235,11 @@ mod tests {
         let (e2, e3, e4) = (error_at(2), error_at(3), error_at(4));
         eprintln!("distance to the sphere: {e2:.3e} {e3:.3e} {e4:.3e}");
         assert!(e2 < 0.03 && e3 / e2 < 0.3 && e4 / e3 < 0.3, "{e2} {e3} {e4}");
+        // the same surface every time, to the last bit (a run repeated gives the same figures)
+        let first = sphere.loop_subdivided(2, 0.5).expect("subdivided");
+        for _ in 0..4 {
+            assert_eq!(sphere.loop_subdivided(2, 0.5).expect("subdivided"), first);
+        }
     }
 
     #[test]
