@@ -13,7 +13,10 @@ use std::time::Instant;
 use synovia_contact::obstacle::SphereObstacle;
 use synovia_contact::operators::ContactPair;
 use synovia_fem::model::Model;
-use synovia_feti::{Decomposition, DecompositionParams, Gluing, ModelProblem, SingleProcess, TfetiParams};
+use synovia_feti::{
+    Decomposition, DecompositionParams, Gluing, ModelProblem, Partitioner, Preconditioner, SingleProcess,
+    TfetiParams,
+};
 use synovia_material::plane_strain;
 use synovia_mesh::generators::{rectangle, Grading};
 use synovia_mesh::math::{Point, Vector};
@@ -25,6 +28,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let kmax = args.get(1).copied().unwrap_or(8);
     let linear = std::env::args().any(|a| a == "linear");
     let gluing = if std::env::args().any(|a| a == "star") { Gluing::Star } else { Gluing::Orthonormal };
+    let partitioner =
+        if std::env::args().any(|a| a == "bisection") { Partitioner::Bisection } else { Partitioner::Metis };
     let mut rows = Vec::new();
     for k in (2..=kmax).step_by(2) {
         let n = k * hh;
@@ -50,7 +55,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let t0 = Instant::now();
         let dec = Decomposition::new(
             &model,
-            &DecompositionParams::default().with_subdomains(k * k).with_gluing(gluing),
+            &DecompositionParams::default()
+                .with_subdomains(k * k)
+                .with_gluing(gluing)
+                .with_partitioner(partitioner),
             &SingleProcess,
         )?;
         let decompose_s = t0.elapsed().as_secs_f64();
@@ -63,18 +71,57 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             if let Some(v) = a.strip_prefix("eta=").and_then(|v| v.parse().ok()) {
                 params.eta_factor = v;
             }
+            if let Some(v) = a.strip_prefix("m=").and_then(|v| v.parse().ok()) {
+                params.m_factor = v;
+            }
+            match a.as_str() {
+                "prec=none" => params.preconditioner = Preconditioner::None,
+                "prec=lumped" => params.preconditioner = Preconditioner::Lumped,
+                "prec=dirichlet" => params.preconditioner = Preconditioner::Dirichlet,
+                _ => {}
+            }
         }
         let s0 = frictionless.solve(&dec, &SingleProcess, &params)?;
+        let spectrum = if std::env::args().any(|a| a == "spectrum") {
+            let eq = synovia_feti::face_spectrum(
+                &dec,
+                &SingleProcess,
+                &frictionless.load,
+                &frictionless.normal,
+                None,
+                &params,
+                None,
+                2000,
+            )?;
+            let active: Vec<bool> = s0.lambda_n.iter().map(|&l| l > 0.0).collect();
+            let sol = synovia_feti::face_spectrum(
+                &dec,
+                &SingleProcess,
+                &frictionless.load,
+                &frictionless.normal,
+                None,
+                &params,
+                Some(&active),
+                2000,
+            )?;
+            serde_json::json!({"equality": {"rows": eq.rows, "pfp": eq.norm_pfp, "extreme": eq.extreme, "condition": eq.condition, "cg": eq.cg_steps},
+                "solution_face": {"rows": sol.rows, "extreme": sol.extreme, "condition": sol.condition, "cg": sol.cg_steps}})
+        } else {
+            serde_json::Value::Null
+        };
         // Tresca bounds g_c = 0.3 κ-weighted pressure of the frictionless solution
         let gc: Vec<f64> = s0.lambda_n.iter().map(|p| 0.3 * p + if linear { 1.0 } else { 0.0 }).collect();
         let tresca = ModelProblem::new(&model, &pairs, 0.0, Some(&gc), None)?;
         let s = tresca.solve(&dec, &SingleProcess, &params)?;
         let r = &s.report;
         let row = serde_json::json!({
-            "k": k, "gluing": format!("{gluing:?}"), "subdomains": r.subdomains, "H_over_h": hh, "dofs": dec.n_reduced(),
+            "k": k, "gluing": format!("{gluing:?}"), "preconditioner": format!("{:?}", params.preconditioner), "partitioner": format!("{partitioner:?}"), "subdomains": r.subdomains, "H_over_h": hh, "dofs": dec.n_reduced(),
             "primal": dec.n_primal(), "dual": r.dual, "coarse": r.coarse_dim,
-            "frictionless": {"outer": s0.report.outer_iterations, "inner": s0.report.inner_iterations, "f_products": s0.report.f_products},
-            "tresca": {"outer": r.outer_iterations, "inner": r.inner_iterations, "f_products": r.f_products,
+            "frictionless": {"outer": s0.report.outer_iterations, "inner": s0.report.inner_iterations, "f_products": s0.report.f_products,
+                "per_outer": s0.report.inner_per_outer, "steps_cg_exp_prop": s0.report.inner_steps},
+            "spectrum": spectrum,
+            "tresca": {"outer": r.outer_iterations, "inner": r.inner_iterations, "f_products": r.f_products, "prec_products": r.preconditioner_products,
+                        "per_outer": r.inner_per_outer, "steps_cg_exp_prop": r.inner_steps,
                         "active": s.lambda_n.iter().filter(|&&l| l > 0.0).count(),
                         "slip": s.lambda_t.iter().filter(|l| l.abs() >= 1.0 - 1e-8).count()},
             "decompose_s": decompose_s, "tresca_setup_s": r.setup_s, "tresca_solve_s": r.solve_s,

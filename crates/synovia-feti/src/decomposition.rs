@@ -26,7 +26,7 @@ use synovia_fem::DofMap;
 
 use crate::comm::Communicator;
 use crate::error::FetiError;
-use crate::partition::partition_cells;
+use crate::partition::{partition_cells, Partitioner};
 use crate::subdomain::Subdomain;
 
 /// How a model is cut.
@@ -39,6 +39,8 @@ pub struct DecompositionParams {
     pub subdomains: usize,
     /// How the copies of a node are glued (default [`Gluing::Orthonormal`]).
     pub gluing: Gluing,
+    /// How the cells are cut (default [`Partitioner::Metis`]).
+    pub partitioner: Partitioner,
 }
 
 /// The gluing rows at nodes shared by several subdomains (module docs).
@@ -54,7 +56,7 @@ pub enum Gluing {
 
 impl Default for DecompositionParams {
     fn default() -> Self {
-        Self { subdomains: 8, gluing: Gluing::default() }
+        Self { subdomains: 8, gluing: Gluing::default(), partitioner: Partitioner::default() }
     }
 }
 
@@ -62,6 +64,11 @@ impl DecompositionParams {
     /// Sets [`Self::subdomains`].
     pub fn with_subdomains(mut self, subdomains: usize) -> Self {
         self.subdomains = subdomains;
+        self
+    }
+    /// Sets [`Self::partitioner`].
+    pub fn with_partitioner(mut self, partitioner: Partitioner) -> Self {
+        self.partitioner = partitioner;
         self
     }
     /// Sets [`Self::gluing`].
@@ -98,6 +105,8 @@ pub struct Decomposition {
     pub(crate) equality: Vec<Vec<Entry>>,
     /// Number of gluing rows among them (the rest are Dirichlet rows).
     pub(crate) n_gluing: usize,
+    /// Orthonormal gluing: rows of the undecomposed problem act on the mean of the copies.
+    pub(crate) orthonormal: bool,
     /// Owned subdomains of this rank.
     pub(crate) owned: std::ops::Range<usize>,
     pub(crate) ranks: Vec<std::ops::Range<usize>>,
@@ -128,7 +137,7 @@ impl Decomposition {
         let mut pieces: Vec<(usize, Vec<usize>)> = Vec::new();
         for (bi, b) in bodies.iter().enumerate() {
             let share = (params.subdomains * b.mesh.n_cells()).div_ceil(total_cells.max(1)).max(1);
-            for cells in partition_cells(&b.mesh, share, &b.name)? {
+            for cells in partition_cells(&b.mesh, share, &b.name, params.partitioner)? {
                 pieces.push((bi, cells));
             }
         }
@@ -215,6 +224,7 @@ impl Decomposition {
             dof_group,
             equality,
             n_gluing,
+            orthonormal,
             owned,
             ranks,
         })
@@ -249,19 +259,24 @@ impl Decomposition {
         self.owned.clone()
     }
 
-    /// A row of reduced coefficients mapped onto the owner copies:
-    /// `Σ_k c_k N_k` on copy `c₀` of each group.
+    /// A row of reduced coefficients mapped onto the copies: `Σ_k c_k N_k` on the owner copy
+    /// `c₀` of each group (star gluing), or `Σ_k c_k N_k / n` on each of its `n` copies
+    /// (orthonormal gluing: the row then takes the same value on glued displacements and is
+    /// orthogonal to the gluing rows, so that contact rows keep `B Bᵀ` well conditioned).
     pub(crate) fn map_row(&self, row: impl Iterator<Item = (usize, f64)>) -> Vec<Entry> {
         let d = self.dim;
         let mut out: Vec<Entry> = Vec::new();
         for (j, v) in row {
             let (gi, k) = self.dof_group[j];
             let g = &self.groups[gi];
-            let Some(&(s, a)) = g.copies.first() else { continue };
-            for c in 0..d {
-                let w = v * g.basis[k * d + c];
-                if w != 0.0 {
-                    out.push((s, d * a + c, w));
+            let copies = if self.orthonormal { &g.copies[..] } else { &g.copies[..g.copies.len().min(1)] };
+            let share = 1.0 / copies.len().max(1) as f64;
+            for &(s, a) in copies {
+                for c in 0..d {
+                    let w = v * g.basis[k * d + c] * share;
+                    if w != 0.0 {
+                        out.push((s, d * a + c, w));
+                    }
                 }
             }
         }

@@ -58,6 +58,35 @@ pub struct TfetiParams {
     pub eta_factor: f64,
     /// Decrease factor `β > 1` of `M` (default 10).
     pub beta: f64,
+    /// Preconditioner in face of the inner MPRGP/MPGP conjugate gradient steps (default
+    /// [`Preconditioner::Dirichlet`]).
+    pub preconditioner: Preconditioner,
+}
+
+/// The preconditioner `M⁻¹ ≈ (P F P + ρ Q)⁻¹` of the inner iterations, applied in face
+/// (`z = Z_F M⁻¹ Z_Fᵀ φ` on the free rows `F`):
+///
+/// ```text
+/// M⁻¹ = P B A Bᵀ P + Q / ρ,
+/// ```
+///
+/// with `A = diag S_s` (Dirichlet: the Schur complements of `K_s` on the dofs the dual rows
+/// touch) or `A = diag K_s` (lumped). `P B A Bᵀ P` is positive definite on `Im P` (`Bᵀλ` with
+/// `Gλ = 0` is orthogonal to `Ker K`), and `Q/ρ` inverts the penalty on `Im Q`, so `M⁻¹` is
+/// positive definite and so is its restriction to a face (Dostál 2009, Ch. 5: MPRGP with
+/// preconditioning in face; Farhat, Mandel, Roux 1994 for the projected Dirichlet
+/// preconditioner of FETI).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Preconditioner {
+    /// None (plain CG steps on the face).
+    None,
+    /// Lumped: `A = K`.
+    Lumped,
+    /// Dirichlet: `A = S` (one solve with the interior block `K_ii` of each subdomain per
+    /// application, like a product with `F`).
+    #[default]
+    Dirichlet,
 }
 
 impl Default for TfetiParams {
@@ -70,6 +99,7 @@ impl Default for TfetiParams {
             m_factor: 1.0,
             eta_factor: 0.1,
             beta: 10.0,
+            preconditioner: Preconditioner::default(),
         }
     }
 }
@@ -78,6 +108,11 @@ impl TfetiParams {
     /// Sets [`Self::tolerance`].
     pub fn with_tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
+        self
+    }
+    /// Sets [`Self::preconditioner`].
+    pub fn with_preconditioner(mut self, preconditioner: Preconditioner) -> Self {
+        self.preconditioner = preconditioner;
         self
     }
     /// Sets [`Self::max_outer`].
@@ -102,8 +137,15 @@ pub struct TfetiReport {
     pub outer_iterations: usize,
     /// MPRGP/MPGP iterations (all outer iterations together).
     pub inner_iterations: usize,
+    /// MPRGP/MPGP iterations of each outer iteration.
+    pub inner_per_outer: Vec<usize>,
+    /// Of the inner iterations: conjugate gradient, expansion and proportioning steps.
+    pub inner_steps: [usize; 3],
     /// Products with `F` (one subdomain solve each per subdomain).
     pub f_products: usize,
+    /// Applications of the preconditioner (one interior solve per subdomain each with
+    /// [`Preconditioner::Dirichlet`]).
+    pub preconditioner_products: usize,
     /// Final `‖g^P‖/‖b‖`.
     pub gradient: f64,
     /// Final `‖G̃ λ̃‖/‖b‖`.
@@ -151,6 +193,12 @@ struct Dual<'a> {
     /// Cholesky of `G_E G_Eᵀ`.
     ge: nalgebra::Cholesky<f64, nalgebra::Dyn>,
     products: std::sync::atomic::AtomicUsize,
+    /// The preconditioner and, for [`Preconditioner::Dirichlet`], the blocks of the owned
+    /// subdomains (`None` elsewhere).
+    preconditioner: Preconditioner,
+    dirichlet: Vec<Option<crate::subdomain::DirichletBlock>>,
+    /// Applications of the preconditioner.
+    prec_products: std::sync::atomic::AtomicUsize,
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -165,6 +213,7 @@ impl<'a> Dual<'a> {
         rows: &[Vec<Entry>],
         offsets: Vec<f64>,
         load: &[f64],
+        preconditioner: Preconditioner,
     ) -> Result<Self, FetiError> {
         let d = dec.dim;
         let n_sub = dec.subdomains.len();
@@ -233,6 +282,23 @@ impl<'a> Dual<'a> {
         };
         let ge = nalgebra::Cholesky::new(gram(0..n_eq)).ok_or(FetiError::SemiCoercive { pivot: 0 })?;
         let l = nalgebra::Cholesky::new(gram(0..m)).ok_or(FetiError::SemiCoercive { pivot: 0 })?.l();
+        let dirichlet: Vec<Option<crate::subdomain::DirichletBlock>> =
+            if preconditioner == Preconditioner::Dirichlet {
+                (0..n_sub)
+                    .into_par_iter()
+                    .map(|s| {
+                        if !dec.owned.contains(&s) {
+                            return Ok(None);
+                        }
+                        let mut boundary: Vec<usize> = sub_rows[s].entries.iter().map(|e| e.1).collect();
+                        boundary.sort_unstable();
+                        boundary.dedup();
+                        dec.subdomains[s].dirichlet_block(&boundary, s).map(Some)
+                    })
+                    .collect::<Result<_, FetiError>>()?
+            } else {
+                Vec::new()
+            };
         Ok(Self {
             dec,
             comm,
@@ -247,6 +313,9 @@ impl<'a> Dual<'a> {
             ge,
 
             products: std::sync::atomic::AtomicUsize::new(0),
+            preconditioner,
+            dirichlet,
+            prec_products: std::sync::atomic::AtomicUsize::new(0),
         })
     }
 
@@ -264,6 +333,47 @@ impl<'a> Dual<'a> {
                 let mut out = vec![0.0; sr.rows.len()];
                 for &(pos, dof, v) in &sr.entries {
                     out[pos] += v * x[dof];
+                }
+                Ok(out)
+            })
+            .collect::<Result<_, FetiError>>()?;
+        let all = self.comm.all_gather(&local.concat(), &self.counts)?;
+        let mut y = vec![0.0; self.m];
+        let mut k = 0;
+        for sr in &self.sub_rows {
+            for &r in &sr.rows {
+                y[r] += all[k];
+                k += 1;
+            }
+        }
+        Ok(y)
+    }
+
+    /// `B A Bᵀ λ` with `A = diag S_s` or `diag K_s` ([`Preconditioner`]), summed in subdomain
+    /// order like [`Self::bkb`].
+    fn bab(&self, lambda: &[f64]) -> Result<Vec<f64>, FetiError> {
+        self.prec_products.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let (dec, sub_rows, dirichlet) = (self.dec, &self.sub_rows, &self.dirichlet);
+        let kind = self.preconditioner;
+        let local: Vec<Vec<f64>> = dec
+            .owned
+            .clone()
+            .into_par_iter()
+            .map(|s| {
+                let sub = &dec.subdomains[s];
+                let sr = &sub_rows[s];
+                let mut x = vec![0.0; sub.n_dofs()];
+                for &(pos, dof, v) in &sr.entries {
+                    x[dof] += v * lambda[sr.rows[pos]];
+                }
+                let mut y = vec![0.0; x.len()];
+                match (kind, dirichlet.get(s).and_then(Option::as_ref)) {
+                    (Preconditioner::Dirichlet, Some(block)) => block.apply(sub, &x, &mut y)?,
+                    _ => sub.apply_stiffness(&x, &mut y),
+                }
+                let mut out = vec![0.0; sr.rows.len()];
+                for &(pos, dof, v) in &sr.entries {
+                    out[pos] += v * y[dof];
                 }
                 Ok(out)
             })
@@ -358,6 +468,28 @@ impl Hessian for ProjectedHessian<'_, '_> {
         }
         Ok(())
     }
+
+    /// `z = Z_F (P B A Bᵀ P + Q/ρ) Z_Fᵀ r` ([`Preconditioner`]).
+    fn precondition_in_face(
+        &mut self,
+        free: &[bool],
+        r: &[f64],
+        z: &mut [f64],
+    ) -> Result<bool, ContactError> {
+        let d = self.dual;
+        if d.preconditioner == Preconditioner::None || self.rho <= 0.0 {
+            return Ok(false);
+        }
+        let rf: Vec<f64> = r.iter().zip(free).map(|(&v, &f)| if f { v } else { 0.0 }).collect();
+        let pr = d.p(&rf);
+        let apr = d.bab(&pr).map_err(ContactError::from)?;
+        let papr = d.p(&apr);
+        let qr = d.q(&rf);
+        for (((zi, a), q), &f) in z.iter_mut().zip(&papr).zip(&qr).zip(free) {
+            *zi = if f { a + q / self.rho } else { 0.0 };
+        }
+        Ok(true)
+    }
 }
 
 /// `‖g^P‖` of `x ∈ Ω` with gradient `g` (see `synovia_uzawa::qp`).
@@ -398,22 +530,30 @@ fn projected_gradient(blocks: &[ConvexBlock], x: &[f64], g: &[f64]) -> f64 {
     s.sqrt()
 }
 
-/// Solves the contact problem with load `load` (reduced unknowns of the decomposed model),
-/// normal rows and optional Tresca rows by TFETI (module docs). Collective: every rank calls it
-/// with the same data.
-///
-/// # Errors
-/// [`FetiError::Mismatch`] for a problem on other unknowns, [`FetiError::SemiCoercive`],
-/// [`FetiError::NoConvergence`], and the errors of the subdomain solves and communication.
-pub fn solve(
-    dec: &Decomposition,
-    comm: &dyn Communicator,
+/// The dual data of one solve: `F`, `G`, the rows' scales and feasible sets, `λ₀` and the
+/// projected right-hand side `b = P (d̃ − F λ₀)` (module docs).
+struct SetUp<'a> {
+    dual: Dual<'a>,
+    scale: Vec<f64>,
+    blocks: Vec<ConvexBlock>,
+    lambda0: Vec<f64>,
+    b: Vec<f64>,
+    n_eq: usize,
+    mn: usize,
+    mt: usize,
+}
+
+/// Builds the dual problem of [`solve`] (module docs): rows `B = [B_E; Ĉ]` (normal rows scaled
+/// to unit norm, Tresca cells by a common scale), `Ω`, `λ₀ = G_Eᵀ (G_E G_Eᵀ)⁻¹ e` and
+/// `b = P (B K⁺ (f̂ − Bᵀ λ₀) − c)`.
+fn set_up<'a>(
+    dec: &'a Decomposition,
+    comm: &'a dyn Communicator,
     load: &[f64],
     normal: &NormalConstraints,
     friction: Option<&FrictionConstraints>,
     params: &TfetiParams,
-) -> Result<TfetiSolution, FetiError> {
-    let t0 = Instant::now();
+) -> Result<SetUp<'a>, FetiError> {
     let n = dec.n_reduced;
     if load.len() != n || normal.rows.ncols() != n || friction.is_some_and(|f| f.rows.ncols() != n) {
         return Err(FetiError::Mismatch { expected: n, got: load.len() });
@@ -462,8 +602,7 @@ pub fn solve(
             }
         }
     }
-    let dual = Dual::new(dec, comm, &rows, offsets, load)?;
-    let m = dual.m;
+    let dual = Dual::new(dec, comm, &rows, offsets, load, params.preconditioner)?;
     // e = Rᵀ f̂, λ₀ = G_Eᵀ (G_E G_Eᵀ)⁻¹ e
     let mut e = DVector::zeros(dual.n_coarse);
     {
@@ -480,6 +619,139 @@ pub fn solve(
     let mut r0 = dual.bkb(&lambda0, true)?;
     r0.iter_mut().zip(&dual.offsets).for_each(|(a, c)| *a -= c);
     let b = dual.p(&r0);
+    Ok(SetUp { dual, scale, blocks, lambda0, b, n_eq, mn, mt })
+}
+
+/// Lanczos estimates of the spectrum of the SMALBE Hessian on a face (a diagnostic of the inner
+/// iterations, docs/scale-out.md).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SpectrumEstimate {
+    /// Rows of the face.
+    pub rows: usize,
+    /// `‖P F P‖` (power method).
+    pub norm_pfp: f64,
+    /// Smallest and largest Ritz values of `H_FF`.
+    pub extreme: [f64; 2],
+    /// Their ratio, the estimate of `κ(H_FF)`.
+    pub condition: f64,
+    /// (Preconditioned) conjugate gradient steps to `‖r‖ ≤ 1e-8 ‖b_F‖`.
+    pub cg_steps: usize,
+}
+
+/// Estimates the spectrum of `H_FF = Z_Fᵀ (P F P + ρ Q) Z_F` (`ρ = rho_factor ‖PFP‖`, `Z_F` the
+/// rows of the face `F`) — preconditioned by `params.preconditioner` in face: of `M_F⁻¹ H_FF` —
+/// by the (preconditioned) conjugate gradient method on `H_FF x = b_F` from `x = 0`:
+/// the Lanczos tridiagonal matrix `T` built from the CG coefficients
+/// (`T_kk = 1/α_k + β_{k−1}/α_{k−1}`, `T_{k,k+1} = √β_k / α_k`) has Ritz values that converge to
+/// the extreme eigenvalues of `H_FF` from inside. The face holds the equality rows and the contact
+/// rows with `contact_free[r]` (`None`: none of them — the linear problem of the gluing and
+/// Dirichlet rows alone, as if no contact row were active).
+///
+/// # Errors
+/// As [`solve`].
+#[allow(clippy::too_many_arguments)]
+pub fn face_spectrum(
+    dec: &Decomposition,
+    comm: &dyn Communicator,
+    load: &[f64],
+    normal: &NormalConstraints,
+    friction: Option<&FrictionConstraints>,
+    params: &TfetiParams,
+    contact_free: Option<&[bool]>,
+    max_steps: usize,
+) -> Result<SpectrumEstimate, FetiError> {
+    let su = set_up(dec, comm, load, normal, friction, params)?;
+    let m = su.dual.m;
+    let free: Vec<bool> = (0..m)
+        .map(|r| r < su.n_eq || contact_free.and_then(|f| f.get(r - su.n_eq).copied()).unwrap_or(false))
+        .collect();
+    let mut pfp = ProjectedHessian { dual: &su.dual, rho: 0.0 };
+    let (est, _) = estimate_norm(&mut pfp, m, 30)?;
+    let mut hess = ProjectedHessian { dual: &su.dual, rho: params.rho_factor * est };
+    let mut r = su.b.clone();
+    r.iter_mut().zip(&free).for_each(|(a, &f)| {
+        if !f {
+            *a = 0.0;
+        }
+    });
+    let r0 = norm(&r).max(f64::MIN_POSITIVE);
+    let mut z = vec![0.0; m];
+    let precondition =
+        |hess: &mut ProjectedHessian<'_, '_>, r: &[f64], z: &mut [f64]| -> Result<(), FetiError> {
+            if !hess.precondition_in_face(&free, r, z)? {
+                z.copy_from_slice(r);
+            }
+            Ok(())
+        };
+    precondition(&mut hess, &r, &mut z)?;
+    let mut p = z.clone();
+    let mut hp = vec![0.0; m];
+    let mut rz = r.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>();
+    let (mut alphas, mut betas) = (Vec::new(), Vec::new());
+    let mut steps = 0;
+    while steps < max_steps && norm(&r) > 1e-8 * r0 {
+        hess.apply(&p, &mut hp).map_err(FetiError::from)?;
+        hp.iter_mut().zip(&free).for_each(|(a, &f)| {
+            if !f {
+                *a = 0.0;
+            }
+        });
+        let php: f64 = p.iter().zip(&hp).map(|(a, b)| a * b).sum();
+        if php <= 0.0 {
+            break;
+        }
+        let a = rz / php;
+        r.iter_mut().zip(&hp).for_each(|(ri, h)| *ri -= a * h);
+        precondition(&mut hess, &r, &mut z)?;
+        let rz_new = r.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>();
+        let b = rz_new / rz;
+        rz = rz_new;
+        p.iter_mut().zip(&z).for_each(|(pi, zi)| *pi = zi + b * *pi);
+        alphas.push(a);
+        betas.push(b);
+        steps += 1;
+    }
+    let k = alphas.len();
+    let mut t = DMatrix::<f64>::zeros(k, k);
+    for i in 0..k {
+        t[(i, i)] = 1.0 / alphas[i] + if i > 0 { betas[i - 1] / alphas[i - 1] } else { 0.0 };
+        if i + 1 < k {
+            let o = betas[i].sqrt() / alphas[i];
+            t[(i, i + 1)] = o;
+            t[(i + 1, i)] = o;
+        }
+    }
+    let ev = t.symmetric_eigenvalues();
+    let lo = ev.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = ev.iter().copied().fold(0.0, f64::max);
+    Ok(SpectrumEstimate {
+        rows: free.iter().filter(|&&f| f).count(),
+        norm_pfp: est,
+        extreme: [lo, hi],
+        condition: if lo > 0.0 { hi / lo } else { f64::INFINITY },
+        cg_steps: steps,
+    })
+}
+
+/// Solves the contact problem with load `load` (reduced unknowns of the decomposed model),
+/// normal rows and optional Tresca rows by TFETI (module docs). Collective: every rank calls it
+/// with the same data.
+///
+/// # Errors
+/// [`FetiError::Mismatch`] for a problem on other unknowns, [`FetiError::SemiCoercive`],
+/// [`FetiError::NoConvergence`], and the errors of the subdomain solves and communication.
+pub fn solve(
+    dec: &Decomposition,
+    comm: &dyn Communicator,
+    load: &[f64],
+    normal: &NormalConstraints,
+    friction: Option<&FrictionConstraints>,
+    params: &TfetiParams,
+) -> Result<TfetiSolution, FetiError> {
+    let t0 = Instant::now();
+    let SetUp { dual, scale, blocks, lambda0, b, n_eq, mn, mt } =
+        set_up(dec, comm, load, normal, friction, params)?;
+    let m = dual.m;
     let bnorm = norm(&b).max(f64::MIN_POSITIVE);
     let setup_s = t0.elapsed().as_secs_f64();
 
@@ -493,7 +765,9 @@ pub fn solve(
     let eta = params.eta_factor * bnorm;
     let eps = params.tolerance * bnorm;
     let chopped = blocks.iter().all(|b| matches!(b, ConvexBlock::Interval { .. }));
-    let mut opts = QpOptions::default().with_hessian_norm(Some(1.05 * est.max(rho))).with_precondition(false);
+    let mut opts = QpOptions::default()
+        .with_hessian_norm(Some(1.05 * est.max(rho)))
+        .with_precondition(params.preconditioner != Preconditioner::None);
 
     let mut x = vec![0.0; m];
     let mut mu = DVector::<f64>::zeros(dual.n_coarse);
@@ -534,6 +808,10 @@ pub fn solve(
             qp_until(&mut hess, &bk, &blocks, &mut x, &opts, chopped, &mut stop)?
         };
         report.inner_iterations += rep.iterations;
+        report.inner_per_outer.push(rep.iterations);
+        report.inner_steps[0] += rep.cg_steps;
+        report.inner_steps[1] += rep.expansion_steps;
+        report.inner_steps[2] += rep.proportioning_steps;
         gp_last = gp_s;
         gx_last = gx_s;
         if !rep.converged {
@@ -545,15 +823,17 @@ pub fn solve(
             break;
         }
         let gx = dual.gt_orth(&x);
-        mu += &gx * rho;
-        // L(λ, μ_new) = ½ λᵀ(g + b_k) − bᵀλ + μ_newᵀ G̃ λ
+        // L(λ_k, μ_k) = ½ λ_kᵀ(g + b_k) − bᵀλ_k + μ_kᵀ G̃ λ_k with the multiplier μ_k of this
+        // inner problem; M decreases if L(λ_k, μ_k) < L(λ_{k−1}, μ_{k−1}) + ρ/2 ‖G̃ λ_k‖²
+        // (Dostál 2009, Alg. 6.1, step 3)
         let half: f64 =
             x.iter().zip(last_g.iter().zip(&bk)).map(|(xi, (g, c))| xi * (g + c)).sum::<f64>() * 0.5;
         let l_new = half - x.iter().zip(&b).map(|(a, c)| a * c).sum::<f64>() + mu.dot(&gx);
-        if l_new < l_prev + 0.5 * rho * gx.norm_squared() {
+        if outer > 1 && l_new < l_prev + 0.5 * rho * gx.norm_squared() {
             big_m /= params.beta;
         }
         l_prev = l_new;
+        mu += &gx * rho;
     }
     report.gradient = gp_last / bnorm;
     report.feasibility = gx_last / bnorm;
@@ -577,6 +857,7 @@ pub fn solve(
         (0..mn).map(|r| scale[n_eq + r] * lambda[n_eq + r] / normal.weights[r]).collect();
     let lambda_t: Vec<f64> = (0..mt).map(|r| scale[n_eq + mn + r] * lambda[n_eq + mn + r]).collect();
     report.f_products = dual.products.load(std::sync::atomic::Ordering::Relaxed);
+    report.preconditioner_products = dual.prec_products.load(std::sync::atomic::Ordering::Relaxed);
     report.solve_s = t0.elapsed().as_secs_f64() - setup_s;
     Ok(TfetiSolution { u, lambda_n, lambda_t, report })
 }

@@ -46,8 +46,11 @@ use synovia_mesh::math::{Real, Vector};
 pub use comm::MpiCommunicator;
 pub use comm::{Communicator, SingleProcess};
 pub use decomposition::{Decomposition, DecompositionParams, Gluing};
-pub use dual::{solve, TfetiParams, TfetiReport, TfetiSolution};
+pub use dual::{
+    face_spectrum, solve, Preconditioner, SpectrumEstimate, TfetiParams, TfetiReport, TfetiSolution,
+};
 pub use error::FetiError;
+pub use partition::Partitioner;
 
 /// The contact solver `"tfeti"`: TFETI on a [`Decomposition`] of the model whose contact
 /// problems it solves, in one process (rayon threads over the subdomains).

@@ -46,6 +46,8 @@ pub struct Subdomain {
     free_index: Vec<usize>,
     /// The factorisation of `K_rr` (on the rank that owns the subdomain only).
     factor: Option<SparseCholesky>,
+    /// `K_s` by rows (all local dofs; entries sorted by column), kept for the preconditioners.
+    stiffness: Vec<Vec<(usize, f64)>>,
 }
 
 /// Rigid-body modes of points `x` (scaled, centred), orthonormalised with rank detection.
@@ -161,7 +163,8 @@ impl Subdomain {
                 nf += 1;
             }
         }
-        let mut s = Self { body, cells, nodes, kernel, fixing, free_index, factor: None };
+        let mut s =
+            Self { body, cells, nodes, kernel, fixing, free_index, factor: None, stiffness: Vec::new() };
         if factorise {
             s.factorise::<D>(index, mesh, c)?;
         }
@@ -224,6 +227,7 @@ impl Subdomain {
         let r = &self.kernel;
         let mut kr = DMatrix::<f64>::zeros(self.n_dofs(), r.ncols());
         let mut k_norm2 = 0.0;
+        let mut full: Vec<Vec<(usize, f64)>> = vec![Vec::new(); self.n_dofs()];
         for (&e, dofs) in self.cells.iter().zip(&cell_dofs) {
             let pts = mesh.cell_points(e);
             let geo = SimplexGeometry::new(&pts).ok_or_else(|| FetiError::Subdomain {
@@ -235,6 +239,7 @@ impl Subdomain {
                 for (b, &j) in dofs.iter().enumerate() {
                     let v = ke[a * ne + b];
                     k_norm2 += v * v;
+                    full[i].push((j, v));
                     for m in 0..r.ncols() {
                         kr[(i, m)] += v * r[(j, m)];
                     }
@@ -263,9 +268,124 @@ impl Subdomain {
             ),
         })?;
         self.factor = Some(factor);
+        for row in full.iter_mut() {
+            row.sort_by_key(|e| e.0);
+            let mut merged: Vec<(usize, f64)> = Vec::with_capacity(row.len());
+            for &(j, v) in row.iter() {
+                match merged.last_mut() {
+                    Some(l) if l.0 == j => l.1 += v,
+                    _ => merged.push((j, v)),
+                }
+            }
+            *row = merged;
+        }
+        self.stiffness = full;
         Ok(())
     }
 
+    /// `y = K_s x` (all local dofs; `K_s` is kept by the rank that factorised it).
+    pub fn apply_stiffness(&self, x: &[f64], y: &mut [f64]) {
+        for (yi, row) in y.iter_mut().zip(&self.stiffness) {
+            *yi = row.iter().map(|&(j, v)| v * x[j]).sum();
+        }
+    }
+
+    /// The Schur complement `S_s = K_bb − K_bi K_ii⁻¹ K_ib` of `K_s` on the local dofs
+    /// `boundary` (sorted; the dofs the dual rows touch), with `K_ii` factorised
+    /// ([`DirichletBlock::apply`]).
+    ///
+    /// # Errors
+    /// [`FetiError::Subdomain`] if `K_ii` is not positive definite (the boundary dofs do not fix
+    /// the rigid-body modes) or the subdomain is not factorised here.
+    pub fn dirichlet_block(&self, boundary: &[usize], index: usize) -> Result<DirichletBlock, FetiError> {
+        if self.stiffness.is_empty() {
+            return Err(FetiError::Subdomain {
+                subdomain: index,
+                message: "not factorised on this rank".into(),
+            });
+        }
+        let n = self.n_dofs();
+        let mut interior = vec![usize::MAX; n];
+        let mut ni = 0;
+        for (i, slot) in interior.iter_mut().enumerate() {
+            if boundary.binary_search(&i).is_err() {
+                *slot = ni;
+                ni += 1;
+            }
+        }
+        let factor = if ni == 0 {
+            None
+        } else {
+            let mut columns: Vec<Vec<usize>> = vec![Vec::new(); ni];
+            for (i, row) in self.stiffness.iter().enumerate() {
+                for &(j, _) in row {
+                    let (a, b) = (interior[i], interior[j]);
+                    if a != usize::MAX && b != usize::MAX && a >= b {
+                        columns[b].push(a);
+                    }
+                }
+            }
+            let mut k = SymmetricMatrix::from_columns(ni, columns)?;
+            for (i, row) in self.stiffness.iter().enumerate() {
+                for &(j, v) in row {
+                    let (a, b) = (interior[i], interior[j]);
+                    if a != usize::MAX && b != usize::MAX && a >= b {
+                        k.add(a, b, v)?;
+                    }
+                }
+            }
+            Some(SparseCholesky::new(k, &Ordering::Amd).map_err(|e| FetiError::Subdomain {
+                subdomain: index,
+                message: format!(
+                    "the interior block K_ii of the Dirichlet preconditioner is not positive definite: {e}"
+                ),
+            })?)
+        };
+        Ok(DirichletBlock { interior, n_interior: ni, factor })
+    }
+}
+
+/// The Dirichlet preconditioner's block of one subdomain: `K_ii` factorised (see
+/// [`Subdomain::dirichlet_block`]).
+pub struct DirichletBlock {
+    interior: Vec<usize>,
+    n_interior: usize,
+    factor: Option<SparseCholesky>,
+}
+
+impl std::fmt::Debug for DirichletBlock {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("DirichletBlock").field("n_interior", &self.n_interior).finish()
+    }
+}
+
+impl DirichletBlock {
+    /// `y = S_s x` for `x` zero on the interior dofs: `t = K_s x`, `w_i = K_ii⁻¹ t_i`,
+    /// `y_b = t_b − (K_s w)_b` (`w` zero on the boundary); `y` is zero on the interior.
+    ///
+    /// # Errors
+    /// Errors of the triangular solves.
+    pub fn apply(&self, sub: &Subdomain, x: &[f64], y: &mut [f64]) -> Result<(), FetiError> {
+        sub.apply_stiffness(x, y);
+        let Some(f) = &self.factor else { return Ok(()) };
+        let mut wi = vec![0.0; self.n_interior];
+        for (i, &a) in self.interior.iter().enumerate() {
+            if a != usize::MAX {
+                wi[a] = y[i];
+            }
+        }
+        f.solve_in_place(&mut wi)?;
+        let w: Vec<f64> = self.interior.iter().map(|&a| if a != usize::MAX { wi[a] } else { 0.0 }).collect();
+        let mut kw = vec![0.0; w.len()];
+        sub.apply_stiffness(&w, &mut kw);
+        for ((yi, &a), k) in y.iter_mut().zip(&self.interior).zip(&kw) {
+            *yi = if a == usize::MAX { *yi - k } else { 0.0 };
+        }
+        Ok(())
+    }
+}
+
+impl Subdomain {
     /// `x ← K_s⁺ x` (the fixing dofs of the result are 0).
     pub fn pinv_in_place(&self, x: &mut [f64], index: usize) -> Result<(), FetiError> {
         let f = self.factor.as_ref().ok_or_else(|| FetiError::Subdomain {

@@ -25,7 +25,8 @@
 //! Algorithms*, Ch. 5; MPGP: Dostál & Kozubek 2012). From a proportional iterate,
 //! a *conjugate gradient step* `x ← x − α_cg p`, `α_cg = gᵀp / pᵀHp`, is taken if it is feasible
 //! (`α_cg ≤ α_f`, the largest feasible step along `−p`), followed by
-//! `p ← z − (zᵀHp / pᵀHp) p` with `z = M_F⁻¹ φ` (`M_F = I`, or the Jacobi preconditioner
+//! `p ← z − (zᵀHp / pᵀHp) p` with `z = M_F⁻¹ φ` (`M_F = I`, the Jacobi preconditioner or the
+//! Hessian's own [`Hessian::precondition_in_face`]
 //! restricted to the free set: *preconditioning in face*, Dostál 2009, Ch. 5). Otherwise an
 //! *expansion step* goes to the boundary, `x^{½} = x − α_f p`, and then takes a fixed-length
 //! projected step `x ← P_Ω(x^{½} − ᾱ φ(x^{½}))`, restarting CG. A disproportional iterate gets a
@@ -68,6 +69,20 @@ pub trait Hessian {
     /// `diag H`, if cheaply available (`None` by default: no preconditioning).
     fn diagonal(&mut self) -> Option<Vec<f64>> {
         None
+    }
+    /// A general preconditioner in face: `z = Z_F M_F⁻¹ Z_Fᵀ r`, where `Z_F` selects the
+    /// entries with `free[i]` and `M⁻¹` is a symmetric positive definite approximation of `H⁻¹`
+    /// (e.g. a projected Dirichlet preconditioner of a FETI dual); `z` must vanish off the face.
+    /// Returns `Ok(false)` (the default) if the Hessian has none — then the Jacobi preconditioner
+    /// of [`Self::diagonal`] is used, or none.
+    fn precondition_in_face(
+        &mut self,
+        free: &[bool],
+        r: &[f64],
+        z: &mut [f64],
+    ) -> Result<bool, ContactError> {
+        let _ = (free, r, z);
+        Ok(false)
     }
 }
 
@@ -177,8 +192,8 @@ pub struct QpOptions {
     pub hessian_norm: Option<f64>,
     /// Power-method steps for the estimate of `‖H‖` (default `20`).
     pub power_iterations: usize,
-    /// Jacobi preconditioning in face of the CG steps, if the [`Hessian`] supplies its diagonal
-    /// (default `true`).
+    /// Preconditioning in face of the CG steps (default `true`): by the [`Hessian`]'s own
+    /// [`Hessian::precondition_in_face`] if it has one, else Jacobi if it supplies its diagonal.
     pub precondition: bool,
 }
 
@@ -330,7 +345,8 @@ pub fn estimate_norm<H: Hessian + ?Sized>(
 /// steps `x ← P(x − α_f p − ᾱ φ)` with the fixed length `ᾱ = step_factor/‖H‖ ∈ (0, 2/‖H‖]`,
 /// and proportioning steps along the chopped gradient `β` (`Γ = options.gamma`), until
 /// `‖g^P‖ ≤ ε ‖b‖`; see the [module docs](self). With `options.precondition` and a Hessian
-/// that supplies `diag H`, the CG steps are preconditioned in face by `diag(H)_F`.
+/// that supplies a preconditioner in face ([`Hessian::precondition_in_face`], `z = M_F⁻¹ φ`) or
+/// `diag H`, the CG steps are preconditioned in face by it or by `diag(H)_F`.
 ///
 /// `x` holds the initial guess (projected onto the box first) and receives the solution — also
 /// the last iterate when an error is returned.
@@ -835,7 +851,7 @@ fn run<H: Hessian + ?Sized>(
     rep.hessian_norm = hnorm;
     rep.step_length = abar;
 
-    // Jacobi preconditioner in face
+    // preconditioner in face: the Hessian's own (general), else Jacobi, else none
     let prec: Option<Vec<f64>> = if opt.precondition {
         hessian
             .diagonal()
@@ -844,10 +860,21 @@ fn run<H: Hessian + ?Sized>(
     } else {
         None
     };
-    let precondition = |phi: &[f64], z: &mut [f64]| match &prec {
-        Some(m) => z.iter_mut().zip(phi.iter().zip(m)).for_each(|(z, (p, m))| *z = p * m),
-        None => z.copy_from_slice(phi),
-    };
+    let mut general = opt.precondition;
+    let precondition =
+        |hessian: &mut H, general: &mut bool, w: &Split, z: &mut [f64]| -> Result<(), ContactError> {
+            if *general {
+                if hessian.precondition_in_face(&w.free, &w.phi, z)? {
+                    return check_finite(z, "the preconditioned free gradient");
+                }
+                *general = false;
+            }
+            match &prec {
+                Some(m) => z.iter_mut().zip(w.phi.iter().zip(m)).for_each(|(z, (p, m))| *z = p * m),
+                None => z.copy_from_slice(&w.phi),
+            }
+            Ok(())
+        };
 
     layout.project(x);
     let mut g = vec![0.0; n];
@@ -874,7 +901,7 @@ fn run<H: Hessian + ?Sized>(
     let bnorm = norm(b);
     let scale = if bnorm > 0.0 { bnorm } else { gpn.max(f64::MIN_POSITIVE) };
     let target = (opt.tolerance * scale).max(opt.absolute_tolerance);
-    precondition(&w.phi, &mut z);
+    precondition(hessian, &mut general, &w, &mut z)?;
     let mut p = z.clone();
     let mut free_prev = w.free.clone();
 
@@ -938,7 +965,7 @@ fn run<H: Hessian + ?Sized>(
                     g[k] -= acg * hp[k];
                 }
                 (bb, rf, gpn) = layout.split(x, &g, abar, &mut w);
-                precondition(&w.phi, &mut z);
+                precondition(hessian, &mut general, &w, &mut z)?;
                 let bcg = dot(&z, &hp) / php;
                 for k in 0..n {
                     p[k] = z[k] - bcg * p[k];
@@ -958,7 +985,7 @@ fn run<H: Hessian + ?Sized>(
                 layout.project(x);
                 gradient(hessian, x, &mut g, &mut rep)?;
                 (bb, rf, gpn) = layout.split(x, &g, abar, &mut w);
-                precondition(&w.phi, &mut z);
+                precondition(hessian, &mut general, &w, &mut z)?;
                 p.copy_from_slice(&z);
             }
         } else {
@@ -1054,7 +1081,7 @@ fn run<H: Hessian + ?Sized>(
                 }
             }
             (bb, rf, gpn) = layout.split(x, &g, abar, &mut w);
-            precondition(&w.phi, &mut z);
+            precondition(hessian, &mut general, &w, &mut z)?;
             p.copy_from_slice(&z);
         }
     }
