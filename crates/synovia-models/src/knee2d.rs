@@ -668,17 +668,17 @@ pub struct NonlinearKneeStep {
 impl Knee2d {
     /// The Newton parameters of [`nonlinear_cycle`]: the contact geometry rebuilt on the
     /// deformed configuration until it settles (`GeometryUpdate::Converged`, relative change
-    /// of the solution per rebuild ≤ 1e-4), Aitken-relaxed from ω = 0.6, passes with a moving
-    /// geometry ended at a relative residual of 1e-5 (the last one at 1e-10), modified Newton
+    /// of the solution per rebuild ≤ 1e-4), Aitken-relaxed from ω = 0.9, passes with a moving
+    /// geometry ended at a relative residual of 1e-3 (the last one at 1e-10), modified Newton
     /// (the tangent kept while full steps contract the residual by 0.5). docs/nonlinear.md
     /// gives the measurements behind these choices.
     pub fn nonlinear_newton_params() -> synovia::nonlinear::NewtonParams {
         synovia::nonlinear::NewtonParams::default()
             .with_geometry_update(synovia::nonlinear::GeometryUpdate::Converged)
             .with_geometry_tolerance(1e-4)
-            .with_geometry_relaxation(0.6)
+            .with_geometry_relaxation(0.9)
             .with_geometry_aitken(true)
-            .with_geometry_pass_tolerance(Some(1e-5))
+            .with_geometry_pass_tolerance(Some(1e-3))
             .with_max_geometry_passes(60)
             .with_tangent_reuse(Some(0.5))
     }
