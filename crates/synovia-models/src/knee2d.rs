@@ -1007,8 +1007,11 @@ pub fn nonlinear_cycle_with(
 
 /// A nodal field of a P1 triangle mesh of an annular sector about `centre`, evaluated at any
 /// point by linear interpolation on the cell that contains it,
-/// `v(x) = Σ_a φ_a(x) v_a` (barycentric `φ_a`), or the value of the nearest node for a point
-/// outside the mesh. Cells are found through bins of the polar angle about `centre`.
+/// `v(x) = Σ_a φ_a(x) v_a` (barycentric `φ_a`); a point just outside the mesh (e.g. on the
+/// circle beyond a chord of the boundary, every barycentric coordinate ≥ −1/4 on the nearest
+/// cell of its angle) by linear extrapolation on that cell, and a point farther out (beyond
+/// the sector's angles) by the value of the nearest node. Cells are found through bins of the
+/// polar angle about `centre`.
 #[derive(Debug, Clone)]
 pub struct SpatialField {
     nodes: Vec<Point<2>>,
@@ -1055,6 +1058,10 @@ impl SpatialField {
     pub fn value(&self, x: &Point<2>) -> Vector<2> {
         let a = (x[1] - self.centre[1]).atan2(x[0] - self.centre[0]);
         let bin = (a - self.start) / self.width;
+        // the cell of the angle's bin whose smallest barycentric coordinate is largest: the
+        // cell containing x, or (x in the sliver between a chord of the boundary and its arc)
+        // the nearest one, extrapolated linearly
+        let mut best: Option<(Real, [usize; 3], [Real; 3])> = None;
         if bin >= 0.0 && (bin as usize) < self.bins.len() {
             for &k in &self.bins[bin as usize] {
                 let [i, j, l] = self.cells[k];
@@ -1065,17 +1072,27 @@ impl SpatialField {
                 }
                 let s = ((x[0] - p[0]) * (r[1] - p[1]) - (r[0] - p[0]) * (x[1] - p[1])) / det;
                 let t = ((q[0] - p[0]) * (x[1] - p[1]) - (x[0] - p[0]) * (q[1] - p[1])) / det;
-                let tol = -1e-10;
-                if s >= tol && t >= tol && 1.0 - s - t >= tol {
-                    return self.values[i] * (1.0 - s - t) + self.values[j] * s + self.values[l] * t;
+                let phi = [1.0 - s - t, s, t];
+                let worst = phi.iter().copied().fold(Real::INFINITY, Real::min);
+                if best.as_ref().is_none_or(|b| worst > b.0) {
+                    best = Some((worst, [i, j, l], phi));
+                }
+                if worst >= 0.0 {
+                    break;
                 }
             }
         }
-        self.nodes
-            .iter()
-            .zip(&self.values)
-            .min_by(|u, v| (u.0 - x).norm().total_cmp(&(v.0 - x).norm()))
-            .map_or_else(Vector::<2>::zeros, |(_, v)| *v)
+        match best {
+            Some((worst, idx, phi)) if worst >= -0.25 => {
+                idx.iter().zip(phi).fold(Vector::<2>::zeros(), |acc, (&n, w)| acc + self.values[n] * w)
+            }
+            _ => self
+                .nodes
+                .iter()
+                .zip(&self.values)
+                .min_by(|u, v| (u.0 - x).norm().total_cmp(&(v.0 - x).norm()))
+                .map_or_else(Vector::<2>::zeros, |(_, v)| *v),
+        }
     }
 }
 
