@@ -446,10 +446,12 @@ impl<'a> Dual<'a> {
     }
 }
 
-/// `H = P F P + ρ Q` as a [`Hessian`].
+/// `H = P F P + ρ Q` as a [`Hessian`], with `‖H‖` (estimated; `0` if unknown) for the
+/// preconditioner's shift.
 struct ProjectedHessian<'d, 'a> {
     dual: &'d Dual<'a>,
     rho: f64,
+    norm: f64,
 }
 
 impl Hessian for ProjectedHessian<'_, '_> {
@@ -469,7 +471,10 @@ impl Hessian for ProjectedHessian<'_, '_> {
         Ok(())
     }
 
-    /// `z = Z_F (P B A Bᵀ P + Q/ρ) Z_Fᵀ r` ([`Preconditioner`]).
+    /// `z = Z_F (P B A Bᵀ P + Q/ρ + I/‖H‖) Z_Fᵀ r` ([`Preconditioner`]; the shift `I/‖H‖`
+    /// keeps the preconditioner definite on `Ker Bᵀ`, the directions of redundant rows — e.g. a
+    /// contact row on a node whose Dirichlet rows fix the same direction — where `H` has zero
+    /// curvature and the iteration must still move by expansion steps).
     fn precondition_in_face(
         &mut self,
         free: &[bool],
@@ -487,6 +492,11 @@ impl Hessian for ProjectedHessian<'_, '_> {
         let qr = d.q(&rf);
         for (((zi, a), q), &f) in z.iter_mut().zip(&papr).zip(&qr).zip(free) {
             *zi = if f { a + q / self.rho } else { 0.0 };
+        }
+        if self.norm > 0.0 {
+            for (zi, r) in z.iter_mut().zip(&rf) {
+                *zi += r / self.norm;
+            }
         }
         Ok(true)
     }
@@ -665,9 +675,10 @@ pub fn face_spectrum(
     let free: Vec<bool> = (0..m)
         .map(|r| r < su.n_eq || contact_free.and_then(|f| f.get(r - su.n_eq).copied()).unwrap_or(false))
         .collect();
-    let mut pfp = ProjectedHessian { dual: &su.dual, rho: 0.0 };
+    let mut pfp = ProjectedHessian { dual: &su.dual, rho: 0.0, norm: 0.0 };
     let (est, _) = estimate_norm(&mut pfp, m, 30)?;
-    let mut hess = ProjectedHessian { dual: &su.dual, rho: params.rho_factor * est };
+    let rho = params.rho_factor * est;
+    let mut hess = ProjectedHessian { dual: &su.dual, rho, norm: 1.05 * est.max(rho) };
     let mut r = su.b.clone();
     r.iter_mut().zip(&free).for_each(|(a, &f)| {
         if !f {
@@ -756,11 +767,11 @@ pub fn solve(
     let setup_s = t0.elapsed().as_secs_f64();
 
     // ‖P F P‖, ρ, M, η
-    let mut pfp = ProjectedHessian { dual: &dual, rho: 0.0 };
+    let mut pfp = ProjectedHessian { dual: &dual, rho: 0.0, norm: 0.0 };
     let (est, _) = estimate_norm(&mut pfp, m, 30)?;
     let est = est.max(f64::MIN_POSITIVE);
     let rho = params.rho_factor * est;
-    let mut hess = ProjectedHessian { dual: &dual, rho };
+    let mut hess = ProjectedHessian { dual: &dual, rho, norm: 1.05 * est.max(rho) };
     let mut big_m = params.m_factor * rho;
     let eta = params.eta_factor * bnorm;
     let eps = params.tolerance * bnorm;

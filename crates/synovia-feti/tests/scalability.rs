@@ -5,12 +5,13 @@
 //!
 //! * The condition number of the Dirichlet-preconditioned projected dual operator
 //!   `M⁻¹ (P F P + ρ Q)` on the gluing and Dirichlet rows (Lanczos estimate) must stay bounded:
-//!   at 64 subdomains at most 1.5 × that at 4 (measured 10.4 → 12.9 with `ρ = 10 ‖PFP‖`; the
+//!   at 64 subdomains at most 1.5 × that at 4 (measured 10.9 → 13.3 with `ρ = 10 ‖PFP‖`; the
 //!   theory: `C (1 + log H/h)²` independent of the number of subdomains). On METIS subdomains
-//!   of the same size it is not bounded (13.6 → 106.5 with `ρ = ‖PFP‖`).
+//!   of the same size it is not bounded (14.1 → 106.6 with `ρ = ‖PFP‖`).
 //! * The SMALBE/MPRGP iteration counts: the inner (MPRGP) iterations at 64 subdomains at most
-//!   3 × those at 4 (measured 42 → 112 frictionless, 56 → 102 Tresca; without the
-//!   preconditioner 169 → 379 and 126 → 319) and the outer iterations at most 20.
+//!   3 × those at 4 (measured 46 → 112 frictionless, 58 → 122 Tresca; without the
+//!   preconditioner 98 → 151 and 91 → 209) and the outer iterations at most 20. The aim,
+//!   at most 1.5 ×, is not reached (docs/scale-out.md says why).
 
 use std::sync::Arc;
 
