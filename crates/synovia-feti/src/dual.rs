@@ -24,7 +24,9 @@
 //! solved by SMALBE-M (Dostál 2009, *Optimal Quadratic Programming Algorithms*, Ch. 6):
 //! the inner bound/disc-constrained problems of the augmented Lagrangian
 //! `L(λ̃, μ) = ½ λ̃ᵀ(PFP + ρQ)λ̃ − λ̃ᵀ b + μᵀ G̃ λ̃` by MPRGP (2D) or MPGP (3D) of
-//! `synovia-uzawa` to the adaptive precision `‖g^P‖ ≤ min(M ‖G̃ λ̃‖, η)`, then
+//! `synovia-uzawa` (conjugate gradient steps preconditioned in face by
+//! `M⁻¹ = P B S Bᵀ P + Q/ρ + I/‖H‖`, [`Preconditioner`]) to the adaptive precision
+//! `‖g^P‖ ≤ min(M ‖G̃ λ̃‖, η)`, then
 //! `μ ← μ + ρ G̃ λ̃`, and `M ← M/β` when `L` did not increase by `ρ/2 ‖G̃ λ̃‖²`. The primal
 //! solution is `u = K⁺ (f̂ − Bᵀ λ) + R α` with `α = −(G_E G_Eᵀ)⁻¹ G_E (d̃ − F λ)_E` (the
 //! equality rows hold exactly).
@@ -67,13 +69,15 @@ pub struct TfetiParams {
 /// (`z = Z_F M⁻¹ Z_Fᵀ φ` on the free rows `F`):
 ///
 /// ```text
-/// M⁻¹ = P B A Bᵀ P + Q / ρ,
+/// M⁻¹ = P B A Bᵀ P + Q / ρ + I / ‖H‖,
 /// ```
 ///
 /// with `A = diag S_s` (Dirichlet: the Schur complements of `K_s` on the dofs the dual rows
-/// touch) or `A = diag K_s` (lumped). `P B A Bᵀ P` is positive definite on `Im P` (`Bᵀλ` with
-/// `Gλ = 0` is orthogonal to `Ker K`), and `Q/ρ` inverts the penalty on `Im Q`, so `M⁻¹` is
-/// positive definite and so is its restriction to a face (Dostál 2009, Ch. 5: MPRGP with
+/// touch) or `A = diag K_s` (lumped). `P B A Bᵀ P` is positive definite on `Im P` where `B` has
+/// independent rows (`Bᵀλ` with `Gλ = 0` is orthogonal to `Ker K`), `Q/ρ` inverts the penalty
+/// on `Im Q`, and the small shift `I/‖H‖` covers `Ker Bᵀ` of redundant rows (a contact row on a
+/// node whose Dirichlet rows fix the same direction), so `M⁻¹` is positive definite and so is
+/// its restriction to a face (Dostál 2009, Ch. 5: MPRGP with
 /// preconditioning in face; Farhat, Mandel, Roux 1994 for the projected Dirichlet
 /// preconditioner of FETI).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

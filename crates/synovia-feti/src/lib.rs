@@ -11,7 +11,10 @@
 //!   Dirichlet conditions are equality rows `B_E`.
 //! * [`solve`]: the dual problem with the contact rows as bound multipliers (`λ_n ≥ 0`) and
 //!   the Tresca rows as disc multipliers, the natural coarse space `G = Rᵀ Bᵀ` and its
-//!   projector, SMALBE-M with MPRGP (2D) / MPGP (3D) from `synovia-uzawa` ([`dual`]).
+//!   projector, SMALBE-M with MPRGP (2D) / MPGP (3D) from `synovia-uzawa` ([`dual`]), their
+//!   conjugate gradient steps preconditioned in face by the projected Dirichlet (or lumped)
+//!   preconditioner ([`Preconditioner`]); [`face_spectrum`] estimates the condition number the
+//!   inner iterations see.
 //! * Parallel execution: rayon's threads over the subdomains of a process, and — with the
 //!   cargo feature `mpi` — MPI ranks ([`comm`]), one code: each rank factorises its own
 //!   subdomains and only interface values travel. Sums are taken in subdomain order, so the
