@@ -341,6 +341,13 @@ impl<'a> Dual<'a> {
                 Ok(out)
             })
             .collect::<Result<_, FetiError>>()?;
+        self.sum_rows(&local)
+    }
+
+    /// `y = Σ_s` (the rows of subdomain `s`, `local[s]` on this rank's subdomains): the
+    /// values of every rank gathered, then added row by row in subdomain order (the same sum on
+    /// every rank and for every number of ranks).
+    fn sum_rows(&self, local: &[Vec<f64>]) -> Result<Vec<f64>, FetiError> {
         let all = self.comm.all_gather(&local.concat(), &self.counts)?;
         let mut y = vec![0.0; self.m];
         let mut k = 0;
@@ -382,16 +389,7 @@ impl<'a> Dual<'a> {
                 Ok(out)
             })
             .collect::<Result<_, FetiError>>()?;
-        let all = self.comm.all_gather(&local.concat(), &self.counts)?;
-        let mut y = vec![0.0; self.m];
-        let mut k = 0;
-        for sr in &self.sub_rows {
-            for &r in &sr.rows {
-                y[r] += all[k];
-                k += 1;
-            }
-        }
-        Ok(y)
+        self.sum_rows(&local)
     }
 
     /// `F λ`.
