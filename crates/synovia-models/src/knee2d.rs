@@ -116,6 +116,20 @@ pub const ISO14243_FLEXION_DEG: &[(Real, Real)] = &[
     (100.0, 0.0),
 ];
 
+/// The extent `max x − min x` of the loaded contact nodes (`Λ_n > 0`; the contact length of a
+/// sagittal model), and the row and value of the peak pressure `max Λ_n`.
+fn contact_length_and_peak(geo: &ContactGeometry<2>, lambda_n: &[Real]) -> (Real, usize, Real) {
+    let xs = (0..geo.len()).filter(|&r| lambda_n[r] > 0.0).map(|r| geo.nodes[r].position[0]);
+    let length = xs.clone().fold(Real::NEG_INFINITY, Real::max) - xs.fold(Real::INFINITY, Real::min);
+    let (peak_r, peak) =
+        lambda_n
+            .iter()
+            .copied()
+            .enumerate()
+            .fold((0, 0.0), |(ri, m), (r, l)| if l > m { (r, l) } else { (ri, m) });
+    (length, peak_r, peak)
+}
+
 /// The ISO 14243-1 axial force `F(t)` in N, `t` the fraction of the cycle (`0 ≤ t ≤ 1`).
 ///
 /// # Errors
@@ -573,17 +587,7 @@ impl KneeCycle {
         let r1 = contact.complete(model, d1, None, None, r1)?;
         let geo = contact.geometry();
         let force = resultant(geo, &r1);
-        let active: Vec<usize> = (0..geo.len()).filter(|&r| r1.solution.lambda_n[r] > 0.0).collect();
-        let xs = active.iter().map(|&r| geo.nodes[r].position[0]);
-        let contact_length =
-            xs.clone().fold(Real::NEG_INFINITY, Real::max) - xs.fold(Real::INFINITY, Real::min);
-        let (peak_r, peak) = r1
-            .solution
-            .lambda_n
-            .iter()
-            .copied()
-            .enumerate()
-            .fold((0, 0.0), |(ri, m), (r, l)| if l > m { (r, l) } else { (ri, m) });
+        let (contact_length, peak_r, peak) = contact_length_and_peak(geo, &r1.solution.lambda_n);
         let step = KneeStep {
             time,
             flexion_deg: theta.to_degrees(),
@@ -945,22 +949,14 @@ pub fn nonlinear_cycle_with(
         let contact = &r1.contact;
         let geo = nl.geometry();
         let force_v = traction_resultant(geo, &contact.solution.lambda_n);
-        let active: Vec<usize> = (0..geo.len()).filter(|&r| contact.solution.lambda_n[r] > 0.0).collect();
-        let xs = active.iter().map(|&r| geo.nodes[r].position[0]);
-        let contact_length =
-            xs.clone().fold(Real::NEG_INFINITY, Real::max) - xs.fold(Real::INFINITY, Real::min);
-        let (peak_r, peak) = contact
-            .solution
-            .lambda_n
-            .iter()
-            .copied()
-            .enumerate()
-            .fold((0, 0.0), |(ri, m), (r, l)| if l > m { (r, l) } else { (ri, m) });
+        let (contact_length, peak_r, peak) = contact_length_and_peak(geo, &contact.solution.lambda_n);
         // the gaps of the solution on its own deformed configuration: d(x + u) = d_total − [u] · n
         let disp = &contact.displacement;
         let deformed = ContactGeometry::new_deformed(&model, &pairs, disp)?;
-        let active_nodes: std::collections::HashSet<usize> =
-            active.iter().map(|&r| geo.nodes[r].node.1).collect();
+        let active_nodes: std::collections::HashSet<usize> = (0..geo.len())
+            .filter(|&r| contact.solution.lambda_n[r] > 0.0)
+            .map(|r| geo.nodes[r].node.1)
+            .collect();
         let (mut gap_error, mut penetration) = (0.0_f64, 0.0_f64);
         for node in &deformed.nodes {
             let jump = node.jump(disp).ok_or("contact node outside the displacement field")?;
