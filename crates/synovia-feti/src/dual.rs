@@ -180,6 +180,23 @@ struct SubRows {
     entries: Vec<(usize, usize, f64)>,
 }
 
+impl SubRows {
+    /// `B_s x`: the subdomain's rows applied to its local vector `x`.
+    fn apply(&self, x: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.rows.len()];
+        for &(pos, dof, v) in &self.entries {
+            out[pos] += v * x[dof];
+        }
+        out
+    }
+    /// `x += scale · B_sᵀ λ` (`λ` over all dual rows).
+    fn add_transpose(&self, scale: f64, lambda: &[f64], x: &mut [f64]) {
+        for &(pos, dof, v) in &self.entries {
+            x[dof] += scale * v * lambda[self.rows[pos]];
+        }
+    }
+}
+
 /// The assembled dual operator of one contact problem.
 struct Dual<'a> {
     dec: &'a Decomposition,
@@ -332,13 +349,8 @@ impl<'a> Dual<'a> {
             .clone()
             .into_par_iter()
             .map(|s| {
-                let sr = &sub_rows[s];
                 let x = subdomain_solve(dec, sub_rows, loads, s, lambda, with_load)?;
-                let mut out = vec![0.0; sr.rows.len()];
-                for &(pos, dof, v) in &sr.entries {
-                    out[pos] += v * x[dof];
-                }
-                Ok(out)
+                Ok(sub_rows[s].apply(&x))
             })
             .collect::<Result<_, FetiError>>()?;
         self.sum_rows(&local)
@@ -374,19 +386,13 @@ impl<'a> Dual<'a> {
                 let sub = &dec.subdomains[s];
                 let sr = &sub_rows[s];
                 let mut x = vec![0.0; sub.n_dofs()];
-                for &(pos, dof, v) in &sr.entries {
-                    x[dof] += v * lambda[sr.rows[pos]];
-                }
+                sr.add_transpose(1.0, lambda, &mut x);
                 let mut y = vec![0.0; x.len()];
                 match (kind, dirichlet.get(s).and_then(Option::as_ref)) {
                     (Preconditioner::Dirichlet, Some(block)) => block.apply(sub, &x, &mut y)?,
                     _ => sub.apply_stiffness(&x, &mut y),
                 }
-                let mut out = vec![0.0; sr.rows.len()];
-                for &(pos, dof, v) in &sr.entries {
-                    out[pos] += v * y[dof];
-                }
-                Ok(out)
+                Ok(sr.apply(&y))
             })
             .collect::<Result<_, FetiError>>()?;
         self.sum_rows(&local)
@@ -889,9 +895,7 @@ fn subdomain_solve(
     let sub = &dec.subdomains[s];
     let sr = &sub_rows[s];
     let mut x = if with_load { loads[s].clone() } else { vec![0.0; sub.n_dofs()] };
-    for &(pos, dof, v) in &sr.entries {
-        x[dof] -= v * lambda[sr.rows[pos]];
-    }
+    sr.add_transpose(-1.0, lambda, &mut x);
     sub.pinv_in_place(&mut x, s)?;
     Ok(x)
 }
