@@ -83,27 +83,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         let s0 = frictionless.solve(&dec, &SingleProcess, &params)?;
         let spectrum = if std::env::args().any(|a| a == "spectrum") {
-            let eq = synovia_feti::face_spectrum(
-                &dec,
-                &SingleProcess,
-                &frictionless.load,
-                &frictionless.normal,
-                None,
-                &params,
-                None,
-                2000,
-            )?;
+            // on the equality rows alone, and on the face of the frictionless solution
+            let spectrum_on = |face: Option<&[bool]>| {
+                synovia_feti::face_spectrum(
+                    &dec,
+                    &SingleProcess,
+                    &frictionless.load,
+                    &frictionless.normal,
+                    None,
+                    &params,
+                    face,
+                    2000,
+                )
+            };
+            let eq = spectrum_on(None)?;
             let active: Vec<bool> = s0.lambda_n.iter().map(|&l| l > 0.0).collect();
-            let sol = synovia_feti::face_spectrum(
-                &dec,
-                &SingleProcess,
-                &frictionless.load,
-                &frictionless.normal,
-                None,
-                &params,
-                Some(&active),
-                2000,
-            )?;
+            let sol = spectrum_on(Some(&active))?;
             serde_json::json!({"equality": {"rows": eq.rows, "pfp": eq.norm_pfp, "extreme": eq.extreme, "condition": eq.condition, "cg": eq.cg_steps},
                 "solution_face": {"rows": sol.rows, "extreme": sol.extreme, "condition": sol.condition, "cg": sol.cg_steps}})
         } else {
