@@ -185,13 +185,9 @@ def ball_files(tmp_path_factory):
     return d
 
 
-def test_stl_rigid_body_with_friction_equals_scenario(ball_files):
-    sc = synovia.Model.from_scenario(ball_files / "ball.toml")
-    surface = synovia.read_stl(ball_files / "ball_m.stl", scale=1000.0)
-    assert len(surface) == 2 * 32 * 15 and surface.is_closed_solid
-    lo, hi = surface.bounding_box
-    np.testing.assert_allclose(lo, [-0.5, -0.5, 1.0], atol=1e-12)
-    np.testing.assert_allclose(hi, [0.5, 0.5, 2.0], atol=1e-12)
+def run_ball_from_python(sc, ball_files, **smoothing):
+    """BALL_TOML's model built with the Python API on the bodies of the scenario model `sc`
+    (the STL ball's `Shape.stl` with `smoothing`), run over its three levels."""
     m = copy_bodies(sc, {"block": MAT(1000.0, 0.3)})
     m.clamp("block", "bottom")
     m.add_rigid_body(
@@ -200,10 +196,20 @@ def test_stl_rigid_body_with_friction_equals_scenario(ball_files):
         prescribe={"tx": np.array([[0.0, 0.0], [1.0, 0.02]]), "rz": [[0.0, 0.0], [1.0, np.deg2rad(2.0)]]},
         force={"tz": -50.0},
     )
-    shape = synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0)
+    shape = synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0, **smoothing)
     m.contact_rigid_body("ball-block", "block", "top", "ball", shape, friction=0.2, search_distance=0.3)
     m.solver("pdas")
-    got, ref = m.run_quasistatic([0.0, 0.5, 1.0]), sc.run()
+    return m.run_quasistatic([0.0, 0.5, 1.0])
+
+
+def test_stl_rigid_body_with_friction_equals_scenario(ball_files):
+    sc = synovia.Model.from_scenario(ball_files / "ball.toml")
+    surface = synovia.read_stl(ball_files / "ball_m.stl", scale=1000.0)
+    assert len(surface) == 2 * 32 * 15 and surface.is_closed_solid
+    lo, hi = surface.bounding_box
+    np.testing.assert_allclose(lo, [-0.5, -0.5, 1.0], atol=1e-12)
+    np.testing.assert_allclose(hi, [0.5, 0.5, 2.0], atol=1e-12)
+    got, ref = run_ball_from_python(sc, ball_files), sc.run()
     worst = same_runs(got, ref, 1e-12, "STL ball from Python")
     print(f"STL ball with friction from Python vs scenario: largest relative difference {worst:.2e}")
     for rec in got.records:
@@ -223,24 +229,9 @@ def test_smoothed_stl_rigid_body_equals_scenario(ball_files):
     assert toml != BALL_TOML
     (ball_files / "ball_smooth.toml").write_text(toml)
     sc = synovia.Model.from_scenario(ball_files / "ball_smooth.toml")
-
-    def model(**smoothing):
-        m = copy_bodies(sc, {"block": MAT(1000.0, 0.3)})
-        m.clamp("block", "bottom")
-        m.add_rigid_body(
-            "ball",
-            center=[0.0, 0.0, 1.5],
-            prescribe={"tx": np.array([[0.0, 0.0], [1.0, 0.02]]), "rz": [[0.0, 0.0], [1.0, np.deg2rad(2.0)]]},
-            force={"tz": -50.0},
-        )
-        shape = synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0, **smoothing)
-        m.contact_rigid_body("ball-block", "block", "top", "ball", shape, friction=0.2, search_distance=0.3)
-        m.solver("pdas")
-        return m.run_quasistatic([0.0, 0.5, 1.0])
-
-    got, ref = model(subdivide=2, crease_angle_deg=40.0), sc.run()
+    got, ref = run_ball_from_python(sc, ball_files, subdivide=2, crease_angle_deg=40.0), sc.run()
     same_runs(got, ref, 1e-12, "smoothed STL ball from Python")
-    faceted = model()
+    faceted = run_ball_from_python(sc, ball_files)
     # the smoothed ball (Loop shrinks it slightly) sits lower at the same force
     tz = [r["rigid"][0]["dofs"][2] for r in got.records]
     tz_faceted = [r["rigid"][0]["dofs"][2] for r in faceted.records]
