@@ -49,8 +49,8 @@ struct Pose {
     contact_force: f64,
     friction_force: f64,
     area: f64,
-    /// Contact area above the film threshold `FILM_THRESHOLD_MPA`: pair, medial, lateral.
-    film_area: [f64; 3],
+    /// Contact area above the film threshold [`FILM_THRESHOLD_MPA`].
+    film_area: f64,
     peak: f64,
     medial: Side,
     lateral: Side,
@@ -62,6 +62,8 @@ struct Pose {
 struct Side {
     force: f64,
     area: f64,
+    /// Contact area above [`FILM_THRESHOLD_MPA`].
+    film_area: f64,
     peak: f64,
     cop: Option<[f64; 3]>,
 }
@@ -89,8 +91,8 @@ fn main() -> Result<(), Error> {
     });
     // the model (synovia_models::tkr3d); the options of this example set its fields
     let mut model = Tkr3d { fine, free_ml, free_adduction, ..Tkr3d::default() };
-    // `--femur-subdivision N`: levels of Loop subdivision of the femoral STL (default 2; 0: the
-    // decimated facets as they are)
+    // `--femur-subdivision N`: levels of Loop subdivision of the femoral STL (default 0: the
+    // decimated facets as they are; docs/tkr3d.md)
     if let Some(v) = std::env::args().skip_while(|a| a != "--femur-subdivision").nth(1) {
         model.femur_subdivision = v.parse()?;
     }
@@ -156,15 +158,23 @@ fn main() -> Result<(), Error> {
         let record = session.record().ok_or("no record")?;
         let pair = &record.pairs[0];
         let rigid = &record.rigid[0];
+        let result = session.result().ok_or("no result")?;
+        // the area a pressure-sensitive film would show: the pair's, then its sides' in the
+        // record's order
+        let film = synovia::time::results::contact_area_above(session.geometry(), result, FILM_THRESHOLD_MPA);
+        let film = film.first().ok_or("no pair")?;
         let side = |name: &str| {
-            pair.sides.iter().find(|s| s.name == name).map_or(Side::default(), |s| Side {
-                force: s.normal_force,
-                area: s.contact_area,
-                peak: s.peak_pressure,
-                cop: s.centre_of_pressure,
+            pair.sides.iter().enumerate().find(|(_, s)| s.name == name).map_or(Side::default(), |(k, s)| {
+                Side {
+                    force: s.normal_force,
+                    area: s.contact_area,
+                    film_area: film.get(k + 1).copied().unwrap_or(0.0),
+                    peak: s.peak_pressure,
+                    cop: s.centre_of_pressure,
+                }
             })
         };
-        let mut pose = Pose {
+        let pose = Pose {
             percent: 100.0 * t,
             load: -rigid.applied[1].unwrap_or(0.0),
             si_mm: rigid.dofs[1],
@@ -174,7 +184,7 @@ fn main() -> Result<(), Error> {
             contact_force: pair.normal_force,
             friction_force: pair.tangential_force,
             area: pair.contact_area,
-            film_area: [0.0; 3],
+            film_area: film[0],
             peak: pair.peak_pressure,
             medial: side("medial"),
             lateral: side("lateral"),
@@ -204,11 +214,6 @@ fn main() -> Result<(), Error> {
             let detail = format!("{detail}; solver {}, fallback {:?}", record.solver, record.fallback);
             return Err(format!("pose {i}: KKT residual {:.2e} > 1e-8 ({detail})", pose.kkt).into());
         }
-        let result = session.result().ok_or("no result")?;
-        // the area a pressure-sensitive film would show (pair, lateral = positive side, medial)
-        let film = synovia::time::results::contact_area_above(session.geometry(), result, FILM_THRESHOLD_MPA);
-        let film = film.first().ok_or("no pair")?;
-        pose.film_area = [film[0], film.get(2).copied().unwrap_or(0.0), film.get(1).copied().unwrap_or(0.0)];
         // the contact state (`--stress`: also the stress and strain fields, docs/output.md)
         let vtu = if stress {
             synovia::output::contact_vtu(session.model(), session.geometry(), result, Encoding::Zlib)?
@@ -234,7 +239,7 @@ fn main() -> Result<(), Error> {
         peak.peak,
         peak.percent,
         max(&|p| p.area),
-        max(&|p| p.film_area[0]),
+        max(&|p| p.film_area),
         max(&|p| p.medial.force),
         max(&|p| p.lateral.force),
         max(&|p| p.friction_force),
@@ -274,9 +279,9 @@ fn csv_text(poses: &[Pose]) -> String {
             cop(p.lateral.cop, 2),
             p.solves,
             p.seconds,
-            p.film_area[0],
-            p.film_area[1],
-            p.film_area[2]
+            p.film_area,
+            p.medial.film_area,
+            p.lateral.film_area
         );
     }
     s
