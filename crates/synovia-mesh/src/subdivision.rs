@@ -42,22 +42,12 @@ impl TriangleSurface {
     /// [`SurfaceError::InconsistentOrientation`] ([`TriangleSurface::check_manifold`]);
     /// the errors of [`TriangleSurface::new`] if a level makes a triangle degenerate.
     pub fn loop_subdivided(&self, levels: usize, crease_angle: Real) -> Result<Self, SurfaceError> {
-        if levels > 4 {
-            return Err(SurfaceError::InvalidParameter(format!(
-                "{levels} levels of subdivision asked; at most 4 (256 times the triangles)"
-            )));
-        }
         if !(0.0..=std::f64::consts::PI).contains(&crease_angle) {
             return Err(SurfaceError::InvalidParameter(format!(
                 "crease angle {crease_angle} rad must lie in [0, π]"
             )));
         }
-        self.check_manifold()?;
-        let mut surface = self.clone();
-        for _ in 0..levels {
-            surface = surface.loop_level(Some(crease_angle.cos()))?;
-        }
-        Ok(surface)
+        self.subdivided(levels, Some(crease_angle.cos()))
     }
 
     /// `levels` levels of midpoint subdivision: the same triangles and vertex numbering as
@@ -70,25 +60,32 @@ impl TriangleSurface {
     /// # Errors
     /// As [`TriangleSurface::loop_subdivided`].
     pub fn midpoint_subdivided(&self, levels: usize) -> Result<Self, SurfaceError> {
-        self.check_manifold()?;
+        self.subdivided(levels, None)
+    }
+
+    /// `levels` (at most 4) levels of [`TriangleSurface::loop_level`] on a checked manifold.
+    fn subdivided(&self, levels: usize, crease_cos: Option<Real>) -> Result<Self, SurfaceError> {
         if levels > 4 {
             return Err(SurfaceError::InvalidParameter(format!(
                 "{levels} levels of subdivision asked; at most 4 (256 times the triangles)"
             )));
         }
+        self.check_manifold()?;
         let mut surface = self.clone();
         for _ in 0..levels {
-            surface = surface.loop_level(None)?;
+            surface = surface.loop_level(crease_cos)?;
         }
         Ok(surface)
     }
 
     /// One level of [`TriangleSurface::loop_subdivided`] on a checked manifold; an edge is a
     /// crease when the cosine between its triangles' normals is below `crease_cos`; `None`:
-    /// midpoint subdivision (no point moves).
+    /// midpoint subdivision (every edge split at its midpoint, no point moves).
     fn loop_level(&self, crease_cos: Option<Real>) -> Result<Self, SurfaceError> {
-        let crease_cos = crease_cos.unwrap_or(Real::INFINITY);
-        let linear = crease_cos.is_infinite();
+        let (crease_cos, linear) = match crease_cos {
+            Some(c) => (c, false),
+            None => (Real::INFINITY, true),
+        };
         let v = self.vertices();
         let tris = self.triangles();
         let normals: Vec<Vector<3>> = (0..tris.len()).map(|t| self.normal(t)).collect();
