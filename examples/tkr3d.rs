@@ -112,6 +112,15 @@ fn main() -> Result<(), Error> {
         model.friction = v.parse()?;
     }
     let friction = model.friction;
+    // `--insert-material E,nu`: Young's modulus (MPa) and Poisson's ratio of the insert
+    // (default UHMWPE 463 MPa, 0.46)
+    if let Some(v) = std::env::args().skip_while(|a| a != "--insert-material").nth(1) {
+        let parts: Vec<&str> = v.split(',').collect();
+        let [e, nu] = parts[..] else {
+            return Err("--insert-material takes E,nu, e.g. 463,0.46".into());
+        };
+        model.insert_material = (e.trim().parse()?, nu.trim().parse()?);
+    }
     if let Some(tol) = std::env::args().skip_while(|a| a != "--geometry-tolerance").nth(1) {
         model.control.geometry_tolerance = tol.parse()?;
     }

@@ -145,6 +145,8 @@ pub struct Tkr3d {
     /// few degrees at each edge; two levels (0.31 mm) make it smooth on the scale of the
     /// insert's meshes (docs/tkr3d.md, "Mesh convergence"; `synovia_mesh::subdivision`).
     pub femur_subdivision: usize,
+    /// Young's modulus (MPa) and Poisson's ratio of the insert (default [`UHMWPE`]).
+    pub insert_material: (Real, Real),
 }
 
 impl Default for Tkr3d {
@@ -161,6 +163,7 @@ impl Default for Tkr3d {
             superior: Superior::IsoForce,
             control: ForceControlParams::default(),
             femur_subdivision: FEMUR_SUBDIVISION,
+            insert_material: UHMWPE,
         }
     }
 }
@@ -210,7 +213,7 @@ impl Tkr3d {
             );
         }
         let mut joint = JointModel::<3>::new();
-        let uhmwpe = isotropic(UHMWPE.0, UHMWPE.1)?;
+        let uhmwpe = isotropic(self.insert_material.0, self.insert_material.1)?;
         joint.add_gmsh_bodies(self.data_dir.join("mesh").join(self.mesh_file()), |_| {
             Some(uhmwpe.clone().into())
         })?;
