@@ -29,6 +29,14 @@
 //!   `time_per_pose_ms`, `friction_time_per_pose_ms`, `ratio` = time per pose / `elastic_s`,
 //!   `max_force_error` (the contact force against the ISO load), `from_scratch_ratio` (set-up
 //!   with the first pose, per elastic solve).
+//! - `large_contact_surface` (issue 17, item 3): a 2 mm cartilage layer on a femoral head (one
+//!   P1 cap of [`layered_cap_3d`], radii 23–25 mm, half-angle 80°, `n_surface` 71: 20 449
+//!   candidate nodes on its outer sphere, 245 388 DOFs) on the rigid bone, pushed 0.032 mm into
+//!   a rigid spherical socket (radial clearance 0.5 mm, touching at the pole), normal then
+//!   Tresca step (shift 0.01 mm) as above; `time_s = tresca_s`, plus `setup_s`,
+//!   `candidate_nodes`, `active_nodes` (positive pressure in the Tresca solution) and
+//!   `elastic_peak_rss_mb` (the plain elastic factorisation + solve of the model in a child of
+//!   its own) with `rss_over_elastic`. `scale` multiplies `n_surface` by `√scale`.
 //!
 //! Sizes at scale 1 (the defaults): 2D Hertz level 14 (169 120 DOFs), 3D hemisphere level 17
 //! (≈ 270k DOFs, extrapolated: 79 686 at level 15, ≈ × 1.85 per level), 100 knee poses of the
@@ -42,6 +50,7 @@
 //! ```
 //!
 //! The contact cases also print `normal_active` (rows in contact after the normal solve),
+//! `active_nodes` (contact nodes with a positive pressure in the final solution),
 //! `trailing_dofs` (dofs in the dense trailing block of the factor) and the symbolic and
 //! numeric times and size of the contact set-up's factorisation. The environment variables
 //! `SYNOVIA_TRAILING_DOFS` and `SYNOVIA_SCREENED_DOFS` override
@@ -55,6 +64,7 @@ use std::time::Instant;
 use serde_json::{json, Value};
 use synovia::contact::StaticContact;
 use synovia::contact_ops::operators::ContactPair;
+use synovia::mesh::generators::layered_cap_3d;
 use synovia::prelude::*;
 use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 use synovia_models::knee2d::{cycle_times, iso14243_axial_force, Knee2d};
@@ -63,8 +73,17 @@ use synovia_models::tkr3d::{Superior, Tkr3d};
 mod bench_common;
 use bench_common::{parse_args, peak_rss_bytes, spawn_case, Invocation, Res};
 
-const CASES: [&str; 5] =
-    ["hertz2d_tresca", "resolve_new_loads", "hemisphere3d_friction", "knee2d_gait", "pose_resolve_3d"];
+const CASES: [&str; 6] = [
+    "hertz2d_tresca",
+    "resolve_new_loads",
+    "hemisphere3d_friction",
+    "knee2d_gait",
+    "pose_resolve_3d",
+    "large_contact_surface",
+];
+/// The plain elastic solve of `large_contact_surface`'s model in a child of its own (for its
+/// peak RSS); run by that case, not listed in [`CASES`].
+const LARGE_ELASTIC: &str = "large_contact_surface_elastic";
 const MU: Real = 0.3;
 
 /// Refinement levels at `scale`: `base` minus `round(log2(1 / scale))`.
@@ -140,6 +159,8 @@ fn normal_tresca<const D: usize>(
         "contact_numeric_s": sc.elastic().info().numeric_s,
         "contact_factor_nnz": sc.elastic().info().factor_nnz,
         "tresca_iterations": tresca.solution.report.iterations,
+        // contact nodes with a positive pressure in the frictional solution
+        "active_nodes": tresca.solution.lambda_n.iter().filter(|&&l| l > 0.0).count(),
         "kkt": tresca.kkt.max().max(normal.kkt.max()),
         // everything from the model: contact set-up (factorisation with the interface ordered
         // last, trailing block, geometry) + frictionless + Tresca solve, per elastic solve
@@ -190,6 +211,102 @@ fn hemisphere_case(scale: f64) -> Res<Value> {
     let mut v = normal_tresca(&model, &pairs, 2e-4 * p.radius, None)?;
     v["levels"] = json!(p.levels);
     Ok(v)
+}
+
+/// The cartilage cap of `large_contact_surface` in its socket (see [`large_contact_case`]).
+struct LargeCap {
+    /// Inner (bone) and outer (cartilage surface) radius, mm.
+    radii: [Real; 2],
+    /// Half-angle of the cap (radians).
+    half_angle: Real,
+    /// Surface resolution of [`layered_cap_3d`]: `(2 n + 1)²` nodes per sphere.
+    n_surface: usize,
+    /// Radial cells through the cartilage.
+    n_radial: usize,
+    /// Radial clearance of the socket, mm.
+    clearance: Real,
+    /// Approach of the bone into the socket, mm.
+    push: Real,
+}
+
+impl LargeCap {
+    fn new(scale: f64) -> Self {
+        Self {
+            radii: [23.0, 25.0],
+            half_angle: 80.0_f64.to_radians(),
+            n_surface: ((71.0 * scale.sqrt()).round() as usize).max(4),
+            n_radial: 4,
+            clearance: 0.5,
+            push: 0.032,
+        }
+    }
+
+    /// The model: one cartilage body, its inner sphere moved by `(t, 0, −push)` with the
+    /// (rigid) bone, its outer sphere the candidate surface against the rigid socket.
+    fn model(&self) -> Res<(Model<3>, Vec<ContactPair<3>>)> {
+        let mut layers = layered_cap_3d(
+            Point::<3>::zeros(),
+            &self.radii,
+            self.half_angle,
+            self.n_surface,
+            &[self.n_radial],
+        )?;
+        let mut mesh = layers.pop().ok_or("no cartilage layer")?;
+        mesh.set_part_kind("inner", BoundaryKind::Prescribed)?;
+        mesh.set_part_kind("outer", BoundaryKind::Contact)?;
+        let mut model = Model::<3>::new();
+        let b = model.add_body("cartilage", mesh, std::sync::Arc::new(isotropic(10.0, 0.45)?))?;
+        let push = self.push;
+        model.prescribe(b, "inner", move |_, t| Vector::<3>::new(t, 0.0, -push))?;
+        // the socket touches the cap's pole (centre raised by the clearance)
+        let c = self.clearance;
+        let socket = SphereObstacle::new(Point::<3>::new(0.0, 0.0, c), self.radii[1] + c, true)?;
+        Ok((model, vec![ContactPair::rigid("cartilage-socket", b, "outer", std::sync::Arc::new(socket))]))
+    }
+}
+
+/// `large_contact_surface`: a 2 mm cartilage layer on a femoral head (P1 cap of
+/// [`layered_cap_3d`], radii 23–25 mm, half-angle 80°, its inner sphere carried by the rigid
+/// bone) pushed into a rigid spherical socket (radial clearance 0.5 mm, touching at the pole)
+/// by 0.032 mm, then shifted sideways by 0.01 mm: the whole outer sphere is the candidate
+/// surface, a polar patch is in contact. Normal then Tresca solve (μ = 0.3) as the other
+/// contact cases. The plain elastic solve of the same model also runs in a child of its own
+/// ([`LARGE_ELASTIC`]) for its peak RSS.
+fn large_contact_case(scale: f64) -> Res<Value> {
+    // first, before this process holds anything large
+    let plain = spawn_case(LARGE_ELASTIC, scale)?;
+    let cap = LargeCap::new(scale);
+    let (model, mut pairs) = cap.model()?;
+    for pair in &mut pairs {
+        pair.friction = MU;
+    }
+    let mut v = normal_tresca(&model, &pairs, 0.01, None)?;
+    v["setup_s"] = v["contact_setup_s"].clone();
+    v["candidate_nodes"] = v["contact_nodes"].clone();
+    v["n_surface"] = json!(cap.n_surface);
+    v["elastic_peak_rss_mb"] = plain["peak_rss_mb"].clone();
+    v["elastic_child_s"] = plain["elastic_s"].clone();
+    v["elastic_numeric_s"] = plain["numeric_s"].clone();
+    v["elastic_factor_nnz"] = plain["factor_nnz"].clone();
+    Ok(v)
+}
+
+/// The plain elastic factorisation + solve of `large_contact_surface`'s model, alone.
+fn large_elastic_case(scale: f64) -> Res<Value> {
+    let (model, _) = LargeCap::new(scale).model()?;
+    let t0 = Instant::now();
+    let mut s = ElasticSolver::new(&model, ElasticParams::default())?;
+    s.solve(&model, 0.0)?;
+    let elastic_s = t0.elapsed().as_secs_f64();
+    let info = s.info();
+    Ok(json!({
+        "dofs": info.n_dofs,
+        "time_s": elastic_s,
+        "elastic_s": elastic_s,
+        "symbolic_s": info.symbolic_s,
+        "numeric_s": info.numeric_s,
+        "factor_nnz": info.factor_nnz,
+    }))
 }
 
 fn knee_case(scale: f64) -> Res<Value> {
@@ -292,6 +409,8 @@ fn child(case: &str, scale: f64) -> Res<()> {
         "hemisphere3d_friction" => hemisphere_case(scale)?,
         "knee2d_gait" => knee_case(scale)?,
         "pose_resolve_3d" => pose_resolve_case(scale)?,
+        "large_contact_surface" => large_contact_case(scale)?,
+        LARGE_ELASTIC => large_elastic_case(scale)?,
         other => return Err(format!("unknown case `{other}` ({})", CASES.join(", ")).into()),
     };
     let (t, e) = (v["time_s"].as_f64().unwrap_or(f64::NAN), v["elastic_s"].as_f64().unwrap_or(f64::NAN));
@@ -299,7 +418,12 @@ fn child(case: &str, scale: f64) -> Res<()> {
     v["case"] = json!(case);
     v["scale"] = json!(scale);
     v["ratio"] = json!(t / e);
-    v["peak_rss_mb"] = json!(peak_rss_bytes()? as f64 / 1.0e6);
+    let peak_mb = peak_rss_bytes()? as f64 / 1.0e6;
+    v["peak_rss_mb"] = json!(peak_mb);
+    if let Some(elastic_mb) = v["elastic_peak_rss_mb"].as_f64() {
+        // against the plain elastic solve of the same model in its own child
+        v["rss_over_elastic"] = json!(peak_mb / elastic_mb);
+    }
     println!("{v}");
     Ok(())
 }
