@@ -216,6 +216,66 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         warm_start: Option<&ContactSolution>,
     ) -> Result<StaticContactResult<D>, ContactError> {
+        let source = self.given(load, lifts)?;
+        match self.solve_with(source, solver, slip_bound, previous, warm_start, false)? {
+            Solved::Full(result) => Ok(*result),
+            Solved::Multipliers(..) => {
+                Err(ContactError::InvalidParameter("internal: multipliers without displacement".into()))
+            }
+        }
+    }
+
+    /// [`StaticContact::solve_load`] without the final displacement, as
+    /// [`StaticContact::solve_multipliers`] for a caller's load: the multipliers `Λ_n`, `Λ_t` of
+    /// `A U + B_hnᵀ κ Λ_n + B_Htᵀ Λ_t = F̄` with the complementarity and friction conditions of
+    /// [`StaticContact::solve_load`], the solver report (the solution's `u` is empty) and the
+    /// coarse-level iterations. Saves the displacement's back-substitution
+    /// `U = A⁻¹ F̄ − A⁻¹ (Cᵀ ν)` and the KKT check: for the trials of a search over loads (e.g.
+    /// the load control of a Newton iteration, `synovia-nonlinear`), the accepted one completed
+    /// by [`StaticContact::complete_load`].
+    ///
+    /// # Errors
+    /// As [`StaticContact::solve_load`].
+    #[allow(clippy::too_many_arguments)]
+    pub fn solve_load_multipliers(
+        &self,
+        load: &[f64],
+        lifts: &[Vector<D>],
+        solver: &dyn ContactSolver,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        warm_start: Option<&ContactSolution>,
+    ) -> Result<(ContactSolution, usize), ContactError> {
+        let source = self.given(load, lifts)?;
+        Ok(match self.solve_with(source, solver, slip_bound, previous, warm_start, true)? {
+            Solved::Full(result) => (result.solution, result.coarse_iterations),
+            Solved::Multipliers(solution, coarse) => (*solution, coarse),
+        })
+    }
+
+    /// Completes a solution of [`StaticContact::solve_load_multipliers`] (same `load`, `lifts`,
+    /// `slip_bound`, `previous`): the displacement `U = A⁻¹ F̄ − A⁻¹ (Cᵀ ν)`, `ν = (κ Λ_n, Λ_t)`
+    /// (with `A⁻¹ F̄` kept from the solve of the same load when it was the last one, so half a
+    /// solve on a condensed interface), the KKT check and the nodal fields — the result
+    /// [`StaticContact::solve_load`] would have returned, to rounding.
+    ///
+    /// # Errors
+    /// As [`StaticContact::complete`], and [`StaticContact::solve_load`]'s checks of `load`
+    /// and `lifts`.
+    pub fn complete_load(
+        &self,
+        load: &[f64],
+        lifts: &[Vector<D>],
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        solution: ContactSolution,
+    ) -> Result<StaticContactResult<D>, ContactError> {
+        let source = self.given(load, lifts)?;
+        self.complete_with(source, slip_bound, previous, solution)
+    }
+
+    /// The source of a caller's `load` and `lifts` ([`StaticContact::solve_load`]), checked.
+    fn given<'a>(&self, load: &'a [f64], lifts: &'a [Vector<D>]) -> Result<Source<'a, D>, ContactError> {
         let dofs = self.elastic.dofs();
         if load.len() != dofs.n_dofs() || lifts.len() != dofs.groups().len() {
             return Err(ContactError::InvalidParameter(format!(
@@ -229,13 +289,7 @@ impl<const D: usize> StaticContact<D> {
         if load.iter().any(|v| !v.is_finite()) {
             return Err(ContactError::InvalidParameter("the load is not finite".into()));
         }
-        let source = Source::Given(load, lifts);
-        match self.solve_with(source, solver, slip_bound, previous, warm_start, false)? {
-            Solved::Full(result) => Ok(*result),
-            Solved::Multipliers(..) => {
-                Err(ContactError::InvalidParameter("internal: multipliers without displacement".into()))
-            }
-        }
+        Ok(Source::Given(load, lifts))
     }
 
     /// Rebuilds the contact geometry of `pairs` at the pose `x + u⁰`, `u⁰ = displacement[body][node]`
@@ -430,8 +484,19 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         solution: ContactSolution,
     ) -> Result<StaticContactResult<D>, ContactError> {
-        let Assembled { load, lifts, normal, friction_op } =
-            self.assemble(Source::Model(model, t), slip_bound, previous)?;
+        self.complete_with(Source::Model(model, t), slip_bound, previous, solution)
+    }
+
+    /// [`StaticContact::complete`] of either source: `U = A⁻¹ F − A⁻¹ (Cᵀ ν)` unless the
+    /// solution has its `u`, the KKT check and the nodal fields.
+    fn complete_with(
+        &self,
+        source: Source<'_, D>,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
+        solution: ContactSolution,
+    ) -> Result<StaticContactResult<D>, ContactError> {
+        let Assembled { load, lifts, normal, friction_op } = self.assemble(source, slip_bound, previous)?;
         let friction = active_friction(friction_op.as_ref());
         let n_tangential = friction.map_or(0, |f| f.rows.nrows());
         if solution.lambda_n.len() != normal.rows.nrows() || solution.lambda_t.len() != n_tangential {
@@ -444,7 +509,9 @@ impl<const D: usize> StaticContact<D> {
             )));
         }
         let operator = self.operator()?;
-        let mut context = SolveContext::new();
+        // the kept caches: `A⁻¹ F` of the last solve (the accepted trial of a search over
+        // loads on a caller's matrix) or from the recycled load solves
+        let mut context = self.context.with_start(None, false);
         context.set_load_solution(self.recycled_load_solution(&operator, &load)?);
         let problem = ContactProblem { operator: &operator, load: &load, normal: &normal, friction };
         let mut solution = solution;

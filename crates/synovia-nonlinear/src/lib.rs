@@ -833,12 +833,13 @@ impl<const D: usize> NonlinearContact<D> {
             let (load, result) = if let Some(ctl) = control.as_deref_mut() {
                 // load control: the level's time `t` of this iteration is the one at which the
                 // linearised problem's resultant equals the target (secant on `t`; each trial a
-                // contact solve on the kept factorisation)
+                // contact solve on the kept factorisation, for the multipliers only: the
+                // displacement is completed for the accepted trial alone)
                 let resultant = ctl.resultant;
                 let trial = |tt: Real,
                              warm: Option<&ContactSolution>|
                  -> Result<
-                    (Real, Vec<Real>, Vec<Vector<D>>, Vec<Real>, Real, StaticContactResult<D>),
+                    (Real, Vec<Real>, Vec<Vector<D>>, Vec<Real>, Real, ContactSolution),
                     NonlinearError,
                 > {
                     let lt: Vec<Vector<D>> =
@@ -854,7 +855,7 @@ impl<const D: usize> NonlinearContact<D> {
                         subtract_tangent_lift(model, &self.dofs, kin, at, &dl, &mut ld)?;
                         lift_force = norm(&(0..n).map(|i| ld[i] - before[i]).collect::<Vec<_>>());
                     }
-                    let res = self.contact.solve_load(
+                    let (res, _) = self.contact.solve_load_multipliers(
                         &ld,
                         &lt,
                         solver,
@@ -862,7 +863,7 @@ impl<const D: usize> NonlinearContact<D> {
                         previous_disp.as_deref(),
                         warm.filter(|w| w.lambda_n.len() == rows),
                     )?;
-                    let f = resultant(self.contact.geometry(), &res.solution.lambda_n);
+                    let f = resultant(self.contact.geometry(), &res.lambda_n);
                     Ok((f, ld, lt, fe, lift_force, res))
                 };
                 let inner = 0.1 * ctl.tolerance;
@@ -885,7 +886,7 @@ impl<const D: usize> NonlinearContact<D> {
                     }
                     (ta, fa) = (tb, b.0);
                     tb = tc;
-                    b = trial(tb, Some(&b.5.solution))?;
+                    b = trial(tb, Some(&b.5))?;
                 }
                 if (b.0 - ctl.target).abs() > inner {
                     return Err(NonlinearError::NoConvergence {
@@ -895,7 +896,14 @@ impl<const D: usize> NonlinearContact<D> {
                         reason: format!("load control: resultant {} for the target {}", b.0, ctl.target),
                     });
                 }
-                let (_, ld, lt, fe, lift_force, res) = b;
+                let (_, ld, lt, fe, lift_force, solution) = b;
+                let res = self.contact.complete_load(
+                    &ld,
+                    &lt,
+                    slip_bound.as_deref().filter(|g| g.len() == rows),
+                    previous_disp.as_deref(),
+                    solution,
+                )?;
                 predictor = lift_force > 0.0;
                 r_start = r_start.max(lift_force);
                 t = tb;

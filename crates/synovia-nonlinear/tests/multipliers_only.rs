@@ -1,0 +1,113 @@
+//! The multiplier-only solve of a caller's load ([`StaticContact::solve_load_multipliers`]) and
+//! its completion ([`StaticContact::complete_load`]), what the load control of a Newton
+//! iteration uses for its trial solves: the multipliers are those of the full solve
+//! ([`StaticContact::solve_load`]) to 1e-12, and the completed displacement is the full solve's.
+#![allow(clippy::unwrap_used)]
+
+use std::sync::Arc;
+
+use synovia_contact::operators::ContactPair;
+use synovia_contact::{ContactParams, StaticContact, StaticContactResult};
+use synovia_fem::assembly::{assemble_matrix, body_stiffnesses};
+use synovia_fem::element::stiffness_into;
+use synovia_fem::{ElasticParams, ElasticSolver, Model};
+use synovia_material::plane_strain;
+use synovia_mesh::generators::{rectangle, Grading};
+use synovia_mesh::math::{Point, Real, Vector};
+use synovia_mesh::BoundaryKind;
+use synovia_pdas::Pdas;
+
+/// A block pressed by its top onto a shallow bump (partial contact), with friction.
+fn pressed_block() -> (Model<2>, Vec<ContactPair<2>>) {
+    let mut mesh = rectangle(0.0, 1.0, 0.0, 0.25, 12, 4, Grading::Uniform, Grading::Uniform).unwrap();
+    mesh.set_part_kind("top", BoundaryKind::Prescribed).unwrap();
+    mesh.set_part_kind("bottom", BoundaryKind::Contact).unwrap();
+    let mut model = Model::<2>::new();
+    let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0, 0.3).unwrap())).unwrap();
+    model.prescribe(b, "top", |_, t| Vector::<2>::new(2e-4 * t, -1e-3 * t)).unwrap();
+    let bump = synovia_contact::operators::FnObstacle::new(|x: &Point<2>| {
+        let g = 0.2 * (x[0] - 0.5);
+        let n = (1.0 + g * g).sqrt();
+        ((x[1] + 0.1 * (x[0] - 0.5).powi(2)) / n, Vector::<2>::new(g / n, 1.0 / n))
+    });
+    let pairs = vec![ContactPair::rigid("floor", b, "bottom", Arc::new(bump)).with_friction(0.3)];
+    (model, pairs)
+}
+
+fn max_abs(x: &[Real]) -> Real {
+    x.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+fn max_diff(a: &[Real], b: &[Real]) -> Real {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).fold(0.0, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// The completed result equals the full solve's: multipliers to 1e-12, displacements (reduced
+/// and nodal) to 1e-12 relative, the same KKT residuals.
+fn assert_same(full: &StaticContactResult<2>, completed: &StaticContactResult<2>, what: &str) {
+    let (a, b) = (&full.solution, &completed.solution);
+    let ln = max_abs(&a.lambda_n).max(Real::MIN_POSITIVE);
+    assert!(max_diff(&a.lambda_n, &b.lambda_n) <= 1e-12 * ln, "{what}: Λ_n");
+    let lt = max_abs(&a.lambda_t).max(Real::MIN_POSITIVE);
+    assert!(max_diff(&a.lambda_t, &b.lambda_t) <= 1e-12 * lt, "{what}: Λ_t");
+    let scale = max_abs(&a.u);
+    assert!(scale > 0.0);
+    let du = max_diff(&a.u, &b.u);
+    assert!(du <= 1e-12 * scale, "{what}: |ΔU| = {du:e}, scale {scale:e}");
+    for (x, y) in full.displacement[0].iter().zip(&completed.displacement[0]) {
+        assert!((x - y).norm() <= 1e-12 * scale, "{what}: nodal displacement");
+    }
+    assert!(completed.kkt.satisfied(1e-10), "{what}: {:?}", completed.kkt);
+    assert_eq!(full.cell_node, completed.cell_node);
+}
+
+#[test]
+fn multiplier_only_solve_and_completion_equal_the_full_solve() {
+    let (model, pairs) = pressed_block();
+    let solver = Pdas::new(ContactParams::default().with_tolerance(1e-13));
+    let c0 = body_stiffnesses(&model).unwrap();
+    let contact = StaticContact::with_system_matrix(&model, &pairs, ElasticParams::default(), |dofs, a| {
+        assemble_matrix(&model, dofs, a, |b, _, geo, out| stiffness_into(geo, &c0[b], out))
+    })
+    .unwrap();
+    let elastic = ElasticSolver::new(&model, ElasticParams::default()).unwrap();
+    // two loads of a search over the approach (the prescribed push at t = 0.8 and t = 1)
+    let (load_a, lifts_a) = elastic.rhs(&model, 0.8).unwrap();
+    let (load_b, lifts_b) = elastic.rhs(&model, 1.0).unwrap();
+    let first = contact.solve_load(&load_b, &lifts_b, &solver, None, None, None).unwrap();
+    let active = first.solution.lambda_n.iter().filter(|&&l| l > 0.0).count();
+    assert!(active > 0 && active < first.solution.lambda_n.len());
+    let g = contact.geometry().slip_bounds_from_pressure(&first.solution.lambda_n);
+    for slip in [None, Some(&g[..])] {
+        let what = if slip.is_some() { "Tresca" } else { "frictionless" };
+        let full_a = contact.solve_load(&load_a, &lifts_a, &solver, slip, None, None).unwrap();
+        let full_b =
+            contact.solve_load(&load_b, &lifts_b, &solver, slip, None, Some(&full_a.solution)).unwrap();
+        // the trials: multipliers only (no displacement), the second warm-started from the first
+        let (ma, _) = contact.solve_load_multipliers(&load_a, &lifts_a, &solver, slip, None, None).unwrap();
+        assert!(ma.u.is_empty(), "{what}: a multiplier-only solve has no displacement");
+        let (mb, _) =
+            contact.solve_load_multipliers(&load_b, &lifts_b, &solver, slip, None, Some(&ma)).unwrap();
+        assert!(mb.u.is_empty());
+        let ln = max_abs(&full_b.solution.lambda_n);
+        assert!(max_diff(&full_a.solution.lambda_n, &ma.lambda_n) <= 1e-12 * ln, "{what}: trial a Λ_n");
+        assert!(max_diff(&full_b.solution.lambda_n, &mb.lambda_n) <= 1e-12 * ln, "{what}: trial b Λ_n");
+        if slip.is_some() {
+            assert!(!mb.lambda_t.is_empty());
+            let lt = max_abs(&full_b.solution.lambda_t);
+            assert!(max_diff(&full_b.solution.lambda_t, &mb.lambda_t) <= 1e-12 * lt, "{what}: Λ_t");
+        }
+        // the accepted trial (the last one solved: its A⁻¹ F is kept), then the other one (its
+        // A⁻¹ F is solved again)
+        let done_b = contact.complete_load(&load_b, &lifts_b, slip, None, mb).unwrap();
+        assert_same(&full_b, &done_b, what);
+        let done_a = contact.complete_load(&load_a, &lifts_a, slip, None, ma.clone()).unwrap();
+        assert_same(&full_a, &done_a, what);
+    }
+    // a solution that does not fit, a load of the wrong size: errors
+    let (ma, _) = contact.solve_load_multipliers(&load_a, &lifts_a, &solver, None, None, None).unwrap();
+    assert!(contact.complete_load(&load_a, &lifts_a, Some(&g), None, ma.clone()).is_err());
+    assert!(contact.complete_load(&load_a[1..], &lifts_a, None, None, ma).is_err());
+    assert!(contact.solve_load_multipliers(&load_a, &lifts_a[1..], &solver, None, None, None).is_err());
+}
