@@ -433,6 +433,48 @@ SynStatus syn_model_add_contact_plane(struct SynModel *model,
                                       size_t *pair);
 
 /**
+ * Sets the material law of body `body` (its id in `element_body`, or its position in the
+ * scenario file) by name, with its constants:
+ *
+ * | `law` | constants (`n_constants`) |
+ * |---|---|
+ * | `"isotropic"` | `E`, `ν` (2) — linear, plane strain in 2D |
+ * | `"neo_hookean"` | `E`, `ν` (2) — compressible neo-Hookean, `W = μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)²` |
+ * | `"mooney_rivlin"` | `c₁`, `c₂`, `λ` (3) — compressible Mooney–Rivlin |
+ *
+ * A model with a hyperelastic law is solved by the Newton iteration with load stepping and
+ * cut-back (docs/model.md §2.3; small strain unless `syn_model_set_kinematics` asks for
+ * finite strain). The factorisation and the last solution are discarded.
+ *
+ * Errors: `SYN_STATUS_NULL_POINTER` (NULL `law`, or NULL `constants` with `n_constants > 0`),
+ * `SYN_STATUS_INDEX_OUT_OF_RANGE` (body), `SYN_STATUS_INVALID_ARGUMENT` (unknown law, wrong
+ * number of constants, non-finite constants), `SYN_STATUS_MODEL_REJECTED` (inadmissible
+ * constants, e.g. `E <= 0` or `ν` outside `(−1, ½)`).
+ *
+ * # Safety
+ * `law` must be NULL or NUL-terminated; `constants` NULL or valid for reading `n_constants`
+ * doubles.
+ */
+SynStatus syn_model_set_material(struct SynModel *model,
+                                 size_t body,
+                                 const char *law,
+                                 const double *constants,
+                                 size_t n_constants);
+
+/**
+ * Sets the strain kinematics of body `body`: `"small"` (default) or `"finite"` (total
+ * Lagrangian, the contact geometry rebuilt on the deformed configuration; solved by the
+ * Newton iteration). The factorisation and the last solution are discarded.
+ *
+ * Errors: `SYN_STATUS_NULL_POINTER`, `SYN_STATUS_INDEX_OUT_OF_RANGE` (body),
+ * `SYN_STATUS_INVALID_ARGUMENT` (another name).
+ *
+ * # Safety
+ * `kinematics` must be NULL or NUL-terminated.
+ */
+SynStatus syn_model_set_kinematics(struct SynModel *model, size_t body, const char *kinematics);
+
+/**
  * Chooses the contact solver by name: `"pdas-fallback"` (default), `"pdas"`, `"au-pdas"`,
  * `"uzawa-mprgp"`, `"dual-mprgp"`.
  *

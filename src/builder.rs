@@ -982,6 +982,12 @@ impl<const D: usize> JointModel<D> {
         self
     }
 
+    /// The parameters of the Newton iteration of nonlinear models (set by
+    /// [`JointModel::newton_params`]).
+    pub fn newton_parameters(&self) -> NewtonParams {
+        self.newton
+    }
+
     /// `true` if a body has a nonlinear material or finite-strain kinematics: the model is then
     /// solved by the Newton iteration of [`synovia_nonlinear`].
     pub fn is_nonlinear(&self) -> bool {

@@ -6,14 +6,18 @@
 
 use std::sync::Arc;
 
+use synovia::contact_ops::operators::ContactGeometry;
 use synovia::contact_ops::{ContactSolver, StaticContact, StaticContactResult};
-use synovia::fem::{ElasticParams, ElasticSolver, OrderingChoice};
+use synovia::fem::{ElasticParams, ElasticSolver, Kinematics, OrderingChoice};
 use synovia::material::Material;
 use synovia::mesh::math::{Real, Vector};
+use synovia::nonlinear::{NonlinearContact, NonlinearError, NonlinearResult};
 use synovia::time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
 use synovia::time::results::{PairRecord, StepRecord};
 use synovia::time::TimeError;
-use synovia_scenario::arrays::{ArrayError, ArrayModel, ConditionChange, ConditionKind, ModelArrays};
+use synovia_scenario::arrays::{
+    material_law, ArrayError, ArrayModel, ConditionChange, ConditionKind, ModelArrays,
+};
 use synovia_scenario::scenario::Scenario;
 
 use crate::{Fail, SynStatus};
@@ -58,6 +62,9 @@ impl Default for Params {
 enum Solver<const D: usize> {
     Elastic(Box<ElasticSolver<D>>),
     Contact(Box<QuasiStaticStepper<D>>),
+    /// A nonlinear material or finite strain: the Newton iteration with load stepping and
+    /// cut-back (docs/model.md §2.3), with or without contact pairs.
+    Nonlinear(Box<NonlinearContact<D>>),
 }
 
 /// The last solution.
@@ -70,6 +77,9 @@ pub(crate) struct Solved<const D: usize> {
     /// The contact solution (`None` without contact pairs).
     pub result: Option<StaticContactResult<D>>,
     pub pairs: Vec<PairRecord>,
+    /// The contact geometry of the solution when it depends on the solution (nonlinear
+    /// models: the configuration of the last Newton pass); `None`: the solver's fixed one.
+    pub geometry: Option<ContactGeometry<D>>,
 }
 
 /// One model behind a handle.
@@ -220,6 +230,33 @@ impl<const D: usize> State<D> {
         Ok(i)
     }
 
+    /// Body `body` gets the law `law` with `constants` ([`material_law`]); the factorisation
+    /// and the last solution are discarded.
+    pub fn set_material(&mut self, body: usize, law: &str, constants: &[Real]) -> Result<(), Fail> {
+        let material = material_law::<D>(law, constants)?;
+        self.model.set_material(body, material)?;
+        self.invalidate();
+        Ok(())
+    }
+
+    /// Body `body`'s strain kinematics: `"small"` or `"finite"`; the factorisation and the
+    /// last solution are discarded.
+    pub fn set_kinematics(&mut self, body: usize, kinematics: &str) -> Result<(), Fail> {
+        let k = match kinematics {
+            "small" => Kinematics::SmallStrain,
+            "finite" => Kinematics::FiniteStrain,
+            other => {
+                return Err(Fail::new(
+                    SynStatus::InvalidArgument,
+                    format!("kinematics is `small` or `finite`, got `{other}`"),
+                ))
+            }
+        };
+        self.model.set_kinematics(body, k)?;
+        self.invalidate();
+        Ok(())
+    }
+
     pub fn set_solver(&mut self, name: &str) -> Result<(), Fail> {
         Ok(self.model.set_solver(name)?)
     }
@@ -230,7 +267,19 @@ impl<const D: usize> State<D> {
         }
         let model = self.model.joint().model();
         model.validate().map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?;
-        let solver = if self.model.joint().pairs().is_empty() {
+        let joint = self.model.joint();
+        let solver = if joint.is_nonlinear() {
+            Solver::Nonlinear(Box::new(
+                NonlinearContact::new(
+                    model,
+                    joint.pairs(),
+                    joint.kinematics(),
+                    self.params.elastic,
+                    joint.newton_parameters(),
+                )
+                .map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?,
+            ))
+        } else if joint.pairs().is_empty() {
             Solver::Elastic(Box::new(
                 ElasticSolver::new(model, self.params.elastic)
                     .map_err(|e| Fail::new(SynStatus::ModelRejected, e.to_string()))?,
@@ -267,12 +316,26 @@ impl<const D: usize> State<D> {
                     displacement: sol.displacement,
                     result: None,
                     pairs: Vec::new(),
+                    geometry: None,
                 }
             }
             Some(Solver::Contact(stepper)) => {
                 // a new sequence, cold-started; a failure keeps the previous one
                 let (record, result) = stepper.restart(model, t, cs.as_ref(), false).map_err(solve_failed)?;
                 solved_from(record, result)
+            }
+            Some(Solver::Nonlinear(nl)) => {
+                // from the unloaded reference, the load ramped to its value at `t`; a failure
+                // restores the state of the previous solution
+                let kept = nl.checkpoint();
+                nl.reset(t);
+                match nl.step_to(model, t, cs.as_ref()) {
+                    Ok(level) => solved_nonlinear(nl, &level, 0),
+                    Err(e) => {
+                        nl.restore(kept).map_err(nonlinear_failed)?;
+                        return Err(nonlinear_failed(e));
+                    }
+                }
             }
             None => return Err(Fail::new(SynStatus::Panic, "no solver after build")),
         };
@@ -319,6 +382,7 @@ impl<const D: usize> State<D> {
                     displacement: sol.displacement,
                     result: None,
                     pairs: Vec::new(),
+                    geometry: None,
                 })
             }
             Some(Solver::Contact(stepper)) => {
@@ -327,6 +391,18 @@ impl<const D: usize> State<D> {
                 }
                 let (record, result) = stepper.step(model, t, cs.as_ref()).map_err(solve_failed)?;
                 Ok(solved_from(record, result))
+            }
+            Some(Solver::Nonlinear(nl)) => {
+                // from the last solution; cut-backs that end part-way leave a converged
+                // sub-level, so a failure restores the last solution's state
+                let kept = nl.checkpoint();
+                match nl.step_to(model, t, cs.as_ref()) {
+                    Ok(level) => Ok(solved_nonlinear(nl, &level, prev.step + 1)),
+                    Err(e) => {
+                        nl.restore(kept).map_err(nonlinear_failed)?;
+                        Err(nonlinear_failed(e))
+                    }
+                }
             }
             None => Err(Fail::new(SynStatus::Panic, "no solver after build")),
         }
@@ -351,13 +427,23 @@ impl<const D: usize> State<D> {
     fn contact(&self) -> Option<&StaticContact<D>> {
         match &self.solver {
             Some(Solver::Contact(c)) => Some(c.contact()),
+            Some(Solver::Nonlinear(nl)) => Some(nl.contact()),
             _ => None,
+        }
+    }
+
+    /// The contact geometry of the last solution (a nonlinear model's is kept with it: the
+    /// solver's may have moved on to a failed iterate).
+    fn geometry(&self) -> Option<&ContactGeometry<D>> {
+        match self.last.as_ref().and_then(|s| s.geometry.as_ref()) {
+            Some(g) => Some(g),
+            None => self.contact().map(|c| c.geometry()),
         }
     }
 
     pub fn n_contact_nodes(&self) -> Result<usize, Fail> {
         self.solved()?;
-        Ok(self.contact().map_or(0, |c| c.geometry().len()))
+        Ok(self.geometry().map_or(0, |g| g.len()))
     }
 
     /// Per contact node: pair index, global node id, reference coordinates, pressure.
@@ -372,8 +458,7 @@ impl<const D: usize> State<D> {
         let total = self.n_contact_nodes()?;
         check_len(n, total, "contact node count")?;
         let s = self.solved()?;
-        let Some(c) = self.contact() else { return Ok(()) };
-        let geometry = c.geometry();
+        let Some(geometry) = self.geometry() else { return Ok(()) };
         for (r, cn) in geometry.nodes.iter().enumerate() {
             if let Some(p) = pair.as_deref_mut() {
                 p[r] = i32::try_from(cn.pair).unwrap_or(-1);
@@ -414,6 +499,7 @@ impl<const D: usize> State<D> {
         let n_dofs = match &self.solver {
             Some(Solver::Elastic(e)) => e.info().n_dofs,
             Some(Solver::Contact(c)) => c.contact().elastic().info().n_dofs,
+            Some(Solver::Nonlinear(nl)) => nl.dofs().n_dofs(),
             None => 0,
         };
         Ok(Info {
@@ -422,8 +508,36 @@ impl<const D: usize> State<D> {
             iterations: s.iterations,
             kkt: s.result.as_ref().map_or(0.0, |x| x.kkt.max()),
             n_dofs,
-            contact_nodes: self.contact().map_or(0, |c| c.geometry().len()),
+            contact_nodes: self.geometry().map_or(0, |g| g.len()),
         })
+    }
+}
+
+/// A failure of the Newton iteration: no convergence within the cut-backs (or a state that
+/// cannot be restored) is a failed solve; invalid input is an invalid argument.
+fn nonlinear_failed(e: NonlinearError) -> Fail {
+    let status = match &e {
+        NonlinearError::InvalidParameter(_) => SynStatus::InvalidArgument,
+        _ => SynStatus::SolveFailed,
+    };
+    Fail::new(status, e.to_string())
+}
+
+/// The last solution from a level of the Newton iteration.
+fn solved_nonlinear<const D: usize>(
+    nl: &NonlinearContact<D>,
+    level: &NonlinearResult<D>,
+    step: usize,
+) -> Solved<D> {
+    let geometry = nl.geometry().clone();
+    Solved {
+        time: level.time,
+        step,
+        iterations: level.report.total_iterations,
+        displacement: level.contact.displacement.clone(),
+        result: Some(level.contact.clone()),
+        pairs: synovia::time::results::pair_records(&geometry, &level.contact),
+        geometry: Some(geometry),
     }
 }
 
@@ -441,5 +555,6 @@ fn solved_from<const D: usize>(record: StepRecord, result: &StaticContactResult<
         displacement: result.displacement.clone(),
         result: Some(result.clone()),
         pairs: record.pairs,
+        geometry: None,
     }
 }

@@ -40,6 +40,7 @@ pub mod solver;
 pub mod static_contact;
 pub mod surface_obstacle;
 pub mod testing;
+pub mod warm;
 
 pub use context::SolveContext;
 pub use discretisation::{ContactDiscretisation, ContactRow, PairContext};

@@ -358,6 +358,10 @@ struct State<const D: usize> {
     result: Option<StaticContactResult<D>>,
 }
 
+/// A converged state of a [`NonlinearContact`] ([`NonlinearContact::checkpoint`]).
+#[derive(Debug, Clone)]
+pub struct NonlinearCheckpoint<const D: usize>(State<D>);
+
 /// Nonlinear elasticity with contact: the Newton iteration of the module docs on one symbolic
 /// factorisation, with load stepping. Holds the converged state (time, displacement,
 /// multipliers) that the next level starts from.
@@ -462,6 +466,34 @@ impl<const D: usize> NonlinearContact<D> {
         self.state =
             State { time: t0, scale: 0.0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None };
         self.tangent_kept = false;
+    }
+
+    /// A copy of the converged state (time, load factor, displacement, contact forces and
+    /// multipliers), to go back to with [`Self::restore`] — e.g. after a level that failed
+    /// part-way, whose cut-backs left the state at a converged sub-level the caller did not
+    /// ask for.
+    pub fn checkpoint(&self) -> NonlinearCheckpoint<D> {
+        NonlinearCheckpoint(self.state.clone())
+    }
+
+    /// Back to a state of [`Self::checkpoint`]. The tangent is refactorised at the next
+    /// iteration (and, in finite strain, the contact geometry rebuilt on the restored
+    /// configuration, as at the start of every level).
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] for a checkpoint of another model (a different
+    /// number of unknowns).
+    pub fn restore(&mut self, checkpoint: NonlinearCheckpoint<D>) -> Result<(), NonlinearError> {
+        let n = self.dofs.n_dofs();
+        if checkpoint.0.reduced.len() != n {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "checkpoint of {} unknowns for a model of {n}",
+                checkpoint.0.reduced.len()
+            )));
+        }
+        self.state = checkpoint.0;
+        self.tangent_kept = false;
+        Ok(())
     }
 
     /// Maps the converged state to a moved reference configuration, so that the next level
@@ -725,7 +757,12 @@ impl<const D: usize> NonlinearContact<D> {
             _ => None,
         };
         let previous_disp = if friction { previous.map(|p| p.displacement.clone()) } else { None };
-        let mut warm: Option<ContactSolution> = previous.map(|p| p.solution.clone());
+        // (`Λ_t` on the friction cells of this level's slip bounds: the committed level may
+        // have had other cells, or none from the reference configuration)
+        let mut warm: Option<ContactSolution> = previous.map(|p| match slip_bound.as_deref() {
+            Some(g) => synovia_contact::warm::warm_start(self.contact.geometry(), p, g),
+            None => ContactSolution { lambda_t: Vec::new(), ..p.solution.clone() },
+        });
         let residual_of = |f_ext: &[Real], f_int: &[Real], c: &[Real]| -> Vec<Real> {
             (0..n).map(|i| f_ext[i] - f_int[i] - c[i]).collect()
         };

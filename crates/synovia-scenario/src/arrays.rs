@@ -168,6 +168,68 @@ pub fn part_name(tag: i32) -> String {
     format!("tag_{tag}")
 }
 
+/// The material law `law` with its constants, by name (the names of the scenario files'
+/// `material.type`, docs/scenario.md):
+///
+/// | `law` | constants | stress |
+/// |---|---|---|
+/// | `isotropic` | `E`, `ν` | `τ = C e(u)`, isotropic `C` (plane strain in 2D) |
+/// | `neo_hookean` | `E`, `ν` | compressible neo-Hookean, `W = μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)²` with the Lamé constants of `E`, `ν` |
+/// | `mooney_rivlin` | `c₁`, `c₂`, `λ` | compressible Mooney–Rivlin, `W = c₁ (Ī₁ − 3) + c₂ (Ī₂ − 3) + λ/2 (ln J)²` |
+///
+/// The hyperelastic laws are nonlinear (no constant stiffness): a model with one of them is
+/// solved by the Newton iteration of `synovia::nonlinear` (docs/model.md §2.3), in small or
+/// finite strain ([`ArrayModel::set_kinematics`]).
+///
+/// # Errors
+/// [`ArrayError::InvalidArgument`] for an unknown law or a wrong number of constants,
+/// [`ArrayError::Rejected`] for inadmissible constants (e.g. `E ≤ 0`, `ν ∉ (−1, ½)`).
+pub fn material_law<const D: usize>(
+    law: &str,
+    constants: &[Real],
+) -> Result<Arc<dyn Material<D>>, ArrayError> {
+    let expected = match law {
+        "isotropic" | "neo_hookean" => 2,
+        "mooney_rivlin" => 3,
+        other => {
+            return Err(ArrayError::InvalidArgument(format!(
+                "unknown material law `{other}` (isotropic, neo_hookean, mooney_rivlin)"
+            )))
+        }
+    };
+    if constants.len() != expected {
+        return Err(ArrayError::InvalidArgument(format!(
+            "material law `{law}` takes {expected} constants ({}), got {}",
+            if law == "mooney_rivlin" { "c1, c2, lambda" } else { "E, nu" },
+            constants.len()
+        )));
+    }
+    finite(constants, "material constants")?;
+    let rejected = |e: MaterialError| ArrayError::Rejected(format!("material law `{law}`: {e}"));
+    let law: Arc<dyn Material<D>> = match law {
+        "isotropic" => {
+            let (e, nu) = (constants[0], constants[1]);
+            let any: Box<dyn std::any::Any> = if D == 2 {
+                Box::new(Arc::new(synovia::material::plane_strain(e, nu).map_err(rejected)?)
+                    as Arc<dyn Material<2>>)
+            } else {
+                Box::new(
+                    Arc::new(synovia::material::isotropic(e, nu).map_err(rejected)?) as Arc<dyn Material<3>>
+                )
+            };
+            *any.downcast::<Arc<dyn Material<D>>>()
+                .map_err(|_| ArrayError::InvalidArgument(format!("no isotropic law in dimension {D}")))?
+        }
+        "neo_hookean" => {
+            Arc::new(synovia::material::neo_hookean(constants[0], constants[1]).map_err(rejected)?)
+        }
+        _ => Arc::new(
+            synovia::material::mooney_rivlin(constants[0], constants[1], constants[2]).map_err(rejected)?,
+        ),
+    };
+    Ok(law)
+}
+
 impl<const D: usize> ArrayModel<D> {
     /// A model from arrays. Bodies are named `body_0`, `body_1`, …, parts `tag_<tag>`
     /// ([`part_name`]); the material of body `b` is `material(young[b], poisson[b])` (e.g.
@@ -315,6 +377,42 @@ impl<const D: usize> ArrayModel<D> {
             }
         }
         Self { joint, node_map, n_global, parts, conditions: HashMap::new() }
+    }
+
+    /// Body `body` (its id in the arrays) gets the elastic law `material` (e.g. from
+    /// [`material_law`]); a Kelvin–Voigt body keeps its viscous part.
+    ///
+    /// # Errors
+    /// [`ArrayError::IndexOutOfRange`] for a body id out of range.
+    pub fn set_material(&mut self, body: usize, material: Arc<dyn Material<D>>) -> Result<(), ArrayError> {
+        let n = self.joint.model().bodies().len();
+        if body >= n {
+            return Err(ArrayError::IndexOutOfRange(format!("body {body} is out of range 0..{n}")));
+        }
+        self.joint
+            .model_mut()
+            .body_mut(BodyId(body))
+            .map_err(|e| ArrayError::Rejected(e.to_string()))?
+            .material = material;
+        Ok(())
+    }
+
+    /// The kinematics of body `body`'s strain (docs/model.md §2.3): small strain (default) or
+    /// finite strain (total Lagrangian, the contact geometry on the deformed configuration).
+    ///
+    /// # Errors
+    /// [`ArrayError::IndexOutOfRange`] for a body id out of range.
+    pub fn set_kinematics(
+        &mut self,
+        body: usize,
+        kinematics: synovia::fem::Kinematics,
+    ) -> Result<(), ArrayError> {
+        let n = self.joint.model().bodies().len();
+        if body >= n {
+            return Err(ArrayError::IndexOutOfRange(format!("body {body} is out of range 0..{n}")));
+        }
+        self.joint.set_kinematics(BodyId(body), kinematics)?;
+        Ok(())
     }
 
     /// The model.

@@ -97,8 +97,8 @@ use std::time::Instant;
 
 use synovia_contact::operators::{ContactGeometry, ContactPair};
 use synovia_contact::{
-    slip_speeds, ContactError, ContactSolution, ContactSolver, FrictionLaw, PairFrictionLaws, SolverReport,
-    StaticContact, StaticContactResult,
+    slip_speeds, ContactError, ContactSolution, ContactSolver, FrictionLaw, PairFrictionLaws, StaticContact,
+    StaticContactResult,
 };
 
 use synovia_fem::{BodyId, ElasticParams, Model};
@@ -869,39 +869,7 @@ fn relative_change(a: &[Real], b: &[Real]) -> Real {
     }
 }
 
-/// A warm start for the Tresca problem with slip bounds `g` from the solution `from` of
-/// another level: `U` and `Λ_n` copied; `Λ_t` of each new friction cell (the nodes with
-/// `g_r > 0`, in node order, as built by [`ContactGeometry::friction_constraints`]) copied from
-/// the cell of the same contact node in `from`, or 0 if that node had no cell there.
-pub fn warm_start<const D: usize>(
-    geometry: &ContactGeometry<D>,
-    from: &StaticContactResult<D>,
-    g: &[Real],
-) -> ContactSolution {
-    let comps = D.saturating_sub(1);
-    let mut cell_of = vec![None; geometry.len()];
-    for (c, &r) in from.cell_node.iter().enumerate() {
-        if let Some(slot) = cell_of.get_mut(r) {
-            *slot = Some(c);
-        }
-    }
-    let mut lambda_t = Vec::new();
-    for (r, &gr) in g.iter().enumerate() {
-        if gr > 0.0 {
-            let cell = cell_of.get(r).copied().flatten();
-            for k in 0..comps {
-                let v = cell.and_then(|c| from.solution.lambda_t.get(c * comps + k)).copied().unwrap_or(0.0);
-                lambda_t.push(v);
-            }
-        }
-    }
-    ContactSolution {
-        u: from.solution.u.clone(),
-        lambda_n: from.solution.lambda_n.clone(),
-        lambda_t,
-        report: SolverReport::default(),
-    }
-}
+pub use synovia_contact::warm::warm_start;
 
 /// A contact result computed on the geometry `from`, carried to the nodes of the rebuilt
 /// geometry `to` ([`ContactGeometry::node_map`]): `Λ_n` node by node (0 for nodes new in `to`),
