@@ -10,36 +10,7 @@ use std::ptr::{null, null_mut};
 
 use synovia_capi::*;
 
-fn last_error() -> String {
-    let mut buf = vec![0 as c_char; 1024];
-    unsafe { syn_last_error_message(buf.as_mut_ptr(), buf.len()) };
-    unsafe { CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()
-}
-
-#[track_caller]
-fn ok(status: SynStatus) {
-    assert_eq!(status, SynStatus::Ok, "{}", last_error());
-}
-
-fn arrays(a: &common::Arrays, body: &[i32], young: &[f64], poisson: &[f64]) -> SynMeshArrays {
-    SynMeshArrays {
-        dimension: 2,
-        coords: a.coords.as_ptr(),
-        coords_len: a.coords.len(),
-        elements: a.elements.as_ptr(),
-        elements_len: a.elements.len(),
-        element_body: body.as_ptr(),
-        element_body_len: body.len(),
-        facets: a.facets.as_ptr(),
-        facets_len: a.facets.len(),
-        facet_tags: a.tags.as_ptr(),
-        facet_tags_len: a.tags.len(),
-        young: young.as_ptr(),
-        young_len: young.len(),
-        poisson: poisson.as_ptr(),
-        poisson_len: poisson.len(),
-    }
-}
+use common::{arrays, last_error, ok};
 
 /// The punch of `common` through the C API, with its conditions and pair.
 fn punch_model() -> *mut SynModel {

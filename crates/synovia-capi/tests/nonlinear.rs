@@ -7,7 +7,7 @@
 
 mod common;
 
-use std::ffi::{c_char, CStr, CString};
+use std::ffi::CString;
 use std::ptr::{null, null_mut};
 use std::sync::Arc;
 
@@ -15,16 +15,7 @@ use synovia::fem::BodyId;
 use synovia::material::{neo_hookean, Material};
 use synovia_capi::*;
 
-fn last_error() -> String {
-    let mut buf = vec![0 as c_char; 1024];
-    unsafe { syn_last_error_message(buf.as_mut_ptr(), buf.len()) };
-    unsafe { CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()
-}
-
-#[track_caller]
-fn ok(status: SynStatus) {
-    assert_eq!(status, SynStatus::Ok, "{}", last_error());
-}
+use common::{arrays, last_error, ok};
 
 /// The punch of `common` (linear, E = 1000, ν = 0.3, plane strain) with its top moved by
 /// `top` and pressed frictionless onto the plane `y = 0`.
@@ -32,23 +23,7 @@ fn punch(top: [f64; 2], friction: f64) -> *mut SynModel {
     let a = common::punch();
     let body = vec![0; a.elements.len() / 3];
     let (young, poisson) = ([common::YOUNG], [common::POISSON]);
-    let desc = SynMeshArrays {
-        dimension: 2,
-        coords: a.coords.as_ptr(),
-        coords_len: a.coords.len(),
-        elements: a.elements.as_ptr(),
-        elements_len: a.elements.len(),
-        element_body: body.as_ptr(),
-        element_body_len: body.len(),
-        facets: a.facets.as_ptr(),
-        facets_len: a.facets.len(),
-        facet_tags: a.tags.as_ptr(),
-        facet_tags_len: a.tags.len(),
-        young: young.as_ptr(),
-        young_len: 1,
-        poisson: poisson.as_ptr(),
-        poisson_len: 1,
-    };
+    let desc = arrays(&a, &body, &young, &poisson);
     let mut m = null_mut();
     ok(unsafe { syn_model_from_arrays(&desc, &mut m) });
     ok(unsafe { syn_model_set_displacement(m, common::TAG_TOP, top.as_ptr(), 2) });
@@ -112,23 +87,7 @@ fn compressed(s: f64, law: Option<(&str, &[f64])>) -> Vec<f64> {
     let a = common::punch();
     let body = vec![0; a.elements.len() / 3];
     let (young, poisson) = ([common::YOUNG], [common::POISSON]);
-    let desc = SynMeshArrays {
-        dimension: 2,
-        coords: a.coords.as_ptr(),
-        coords_len: a.coords.len(),
-        elements: a.elements.as_ptr(),
-        elements_len: a.elements.len(),
-        element_body: body.as_ptr(),
-        element_body_len: body.len(),
-        facets: a.facets.as_ptr(),
-        facets_len: a.facets.len(),
-        facet_tags: a.tags.as_ptr(),
-        facet_tags_len: a.tags.len(),
-        young: young.as_ptr(),
-        young_len: 1,
-        poisson: poisson.as_ptr(),
-        poisson_len: 1,
-    };
+    let desc = arrays(&a, &body, &young, &poisson);
     let mut m = null_mut();
     ok(unsafe { syn_model_from_arrays(&desc, &mut m) });
     ok(syn_model_clamp(m, common::TAG_BOTTOM));

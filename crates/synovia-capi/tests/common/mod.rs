@@ -11,6 +11,7 @@ use synovia::fem::ComponentMask;
 use synovia::material::plane_strain;
 use synovia::mesh::math::{Point, Vector};
 use synovia::mesh::{BoundaryKind, Mesh};
+use synovia_capi::{syn_last_error_message, SynMeshArrays, SynStatus};
 
 /// Elements across.
 pub const NX: usize = 24;
@@ -120,4 +121,41 @@ pub fn reference_forces() -> Result<Vec<f64>, Box<dyn std::error::Error>> {
     let times: Vec<f64> = STEPS.iter().map(|s| s.0).collect();
     let res = jm.run_quasistatic(&times)?;
     Ok(res.records.iter().map(|r| r.pairs[0].normal_force).collect())
+}
+
+/// The message of the last failed C API call on this thread.
+pub fn last_error() -> String {
+    let mut buf = vec![0 as std::ffi::c_char; 1024];
+    // SAFETY: `buf` is writable for its length.
+    unsafe { syn_last_error_message(buf.as_mut_ptr(), buf.len()) };
+    // SAFETY: syn_last_error_message NUL-terminates within `buf`.
+    unsafe { std::ffi::CStr::from_ptr(buf.as_ptr()) }.to_string_lossy().into_owned()
+}
+
+/// Asserts that a C API call succeeded (with its error message otherwise).
+#[track_caller]
+pub fn ok(status: SynStatus) {
+    assert_eq!(status, SynStatus::Ok, "{}", last_error());
+}
+
+/// The 2D arrays of `a` for `syn_model_from_arrays`, with the body of each element and one
+/// `E`, `ν` per body (the slices must outlive the returned view).
+pub fn arrays(a: &Arrays, body: &[i32], young: &[f64], poisson: &[f64]) -> SynMeshArrays {
+    SynMeshArrays {
+        dimension: 2,
+        coords: a.coords.as_ptr(),
+        coords_len: a.coords.len(),
+        elements: a.elements.as_ptr(),
+        elements_len: a.elements.len(),
+        element_body: body.as_ptr(),
+        element_body_len: body.len(),
+        facets: a.facets.as_ptr(),
+        facets_len: a.facets.len(),
+        facet_tags: a.tags.as_ptr(),
+        facet_tags_len: a.tags.len(),
+        young: young.as_ptr(),
+        young_len: young.len(),
+        poisson: poisson.as_ptr(),
+        poisson_len: poisson.len(),
+    }
 }
