@@ -204,6 +204,18 @@ impl<'a> ContactProblem<'a> {
     }
 }
 
+/// `A⁻¹ F` of an [`Interface`]: whole, or the forward half `y = L⁻¹ P F` of a factor whose
+/// trailing block holds every row ([`FactorisedOperator::forward_solve`]).
+#[derive(Debug)]
+enum LoadSolution {
+    Full(std::sync::Arc<Vec<f64>>),
+    Forward(std::sync::Arc<Vec<f64>>),
+}
+
+/// Tag of the kept forward half of a load solve in the [`SolveContext`] (its key is the
+/// load's fingerprint with this tag, so that it is never taken for `A⁻¹ F`).
+const FORWARD_KEY: u64 = 0x9e37_79b9_7f4a_7c15;
+
 /// Lazily evaluated interface Schur complement `S = C A⁻¹ Cᵀ` and the interface load
 /// `w = C A⁻¹ F` (docs/model.md §6.4). Columns of `S` come from the operator
 /// ([`FactorisedOperator::interface_columns`]); those of an earlier interface of the same
@@ -213,8 +225,8 @@ impl<'a> ContactProblem<'a> {
 pub struct Interface<'a> {
     problem: ContactProblem<'a>,
     context: &'a SolveContext,
-    /// `A⁻¹ F`.
-    load_solution: std::sync::Arc<Vec<f64>>,
+    /// `A⁻¹ F`, or its forward half.
+    load_solution: LoadSolution,
     w: Vec<f64>,
     columns: Vec<Option<Vec<f64>>>,
     solves: usize,
@@ -230,29 +242,49 @@ impl Drop for Interface<'_> {
 
 impl<'a> Interface<'a> {
     /// Validates the problem and computes `w = C A⁻¹ F` (one solve, unless the context holds
-    /// `A⁻¹ F` for the same `F` and operator, or was given it).
+    /// `A⁻¹ F` for the same `F` and operator, or was given it). When every row lies in a
+    /// dense trailing block of the factor ([`FactorisedOperator::forward_solve`]) the solve is
+    /// its forward half `y = L⁻¹ P F` with `w = C L₂₂⁻ᵀ y₂`; the backward half runs only if
+    /// the displacement is asked for ([`Interface::displacement`]).
     #[tracing::instrument(level = "debug", skip_all)]
     pub fn new(problem: ContactProblem<'a>, context: &'a SolveContext) -> Result<Self, ContactError> {
         problem.validate()?;
         let t0 = Instant::now();
         let n = problem.load.len();
         let (x, solves) = match context.given_load_solution(n) {
-            Some(x) => (x, 0),
+            Some(x) => (LoadSolution::Full(x), 0),
             None => {
                 let key = problem.load_fingerprint();
-                match context.load_solve(key) {
-                    Some(x) => (x, 0),
-                    None => {
-                        let mut x = problem.load.to_vec();
-                        problem.operator.solve_in_place(&mut x)?;
-                        let x = std::sync::Arc::new(x);
-                        context.put_load_solve(key, x.clone());
-                        (x, 1)
-                    }
+                let forward_key = key ^ FORWARD_KEY;
+                let covered = problem.operator.forward_covers(problem.rows());
+                match (context.load_solve(key), context.load_solve(forward_key).filter(|_| covered)) {
+                    (Some(x), _) => (LoadSolution::Full(x), 0),
+                    (None, Some(y)) => (LoadSolution::Forward(y), 0),
+                    (None, None) => match covered
+                        .then(|| problem.operator.forward_solve(problem.load))
+                        .transpose()?
+                        .flatten()
+                    {
+                        Some(y) => {
+                            let y = std::sync::Arc::new(y);
+                            context.put_load_solve(forward_key, y.clone());
+                            (LoadSolution::Forward(y), 1)
+                        }
+                        None => {
+                            let mut x = problem.load.to_vec();
+                            problem.operator.solve_in_place(&mut x)?;
+                            let x = std::sync::Arc::new(x);
+                            context.put_load_solve(key, x.clone());
+                            (LoadSolution::Full(x), 1)
+                        }
+                    },
                 }
             }
         };
-        let w = problem.apply(&x);
+        let w = match &x {
+            LoadSolution::Full(x) => problem.apply(x),
+            LoadSolution::Forward(y) => problem.apply(&problem.operator.interface_of_forward(y)?),
+        };
         let m = problem.n_rows();
         let fingerprint = problem.rows_fingerprint();
         let columns = context.take_columns(fingerprint, m);
@@ -351,13 +383,20 @@ impl<'a> Interface<'a> {
             return Ok(Vec::new());
         }
         let t0 = Instant::now();
-        let mut rhs = vec![0.0; self.load_solution.len()];
+        let mut rhs = vec![0.0; self.problem.load.len()];
         self.problem.apply_transpose_add(nu, &mut rhs);
-        self.problem.operator.solve_supported_in_place(&mut rhs)?;
-        rhs.iter_mut().zip(self.load_solution.iter()).for_each(|(y, x)| *y = x - *y);
+        let u = match &self.load_solution {
+            LoadSolution::Full(x) => {
+                self.problem.operator.solve_supported_in_place(&mut rhs)?;
+                rhs.iter_mut().zip(x.iter()).for_each(|(y, x)| *y = x - *y);
+                rhs
+            }
+            // the backward half of the load's solve with the interface forces: one solve
+            LoadSolution::Forward(y) => self.problem.operator.complete_forward(y, &rhs)?,
+        };
         self.solves += 1;
         self.solve_s += t0.elapsed().as_secs_f64();
-        Ok(rhs)
+        Ok(u)
     }
 }
 

@@ -448,6 +448,147 @@ impl CholeskySolver {
         Ok(())
     }
 
+    /// The forward half of a solve with an [`Ordering::Trailing`] factorisation: with
+    /// `P A Pᵀ = L Lᵀ`, returns `y = L⁻¹ P b` (in factor order), from which
+    /// [`CholeskySolver::trailing_of_forward`] gives `(A⁻¹ b)_c = L₂₂⁻ᵀ y₂` on the trailing
+    /// dofs `c` (a dense solve of size `k = |c|`) and [`CholeskySolver::complete_forward`] the
+    /// whole `A⁻¹ (b − s)` for any `s` supported on `c` (the backward half). About half the
+    /// cost of [`CholeskySolver::solve_in_place`]: for loads whose solution is needed only on
+    /// the contact interface (docs/model.md §6.4, the trials of a search over loads). `None`
+    /// without a trailing block.
+    ///
+    /// # Errors
+    /// A wrong length, or no successful factorisation.
+    pub fn forward_trailing(&self, b: &[f64]) -> Result<Option<Vec<f64>>, LinalgError> {
+        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+        use faer::sparse::linalg::triangular_solve::solve_lower_triangular_in_place;
+        use faer::sparse::SparseColMatRef;
+        let n = self.symbolic.nrows();
+        let (Some(_), Some(perm), true) = (self.trailing.as_ref(), self.symbolic.perm(), self.factorized)
+        else {
+            return Ok(None);
+        };
+        if b.len() != n {
+            return Err(LinalgError::Length { what: "right-hand side", expected: n, got: b.len() });
+        }
+        let (fwd, _) = perm.arrays();
+        let mut y: Vec<f64> = fwd.iter().map(|&i| b[i]).collect();
+        let ym = MatMut::from_column_major_slice_mut(&mut y, n, 1);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(sym) => {
+                let l = SparseColMatRef::<'_, usize, f64>::new(sym.factor(), &self.factor);
+                solve_lower_triangular_in_place(l, Conj::No, ym, Par::Seq);
+            }
+            SymbolicCholeskyRaw::Supernodal(sym) => {
+                let req = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
+                let mut mem = MemBuffer::try_new(req)
+                    .map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
+                SupernodalLltRef::new(sym, &self.factor).l_solve_with_conj(
+                    Conj::No,
+                    ym,
+                    Par::Seq,
+                    MemStack::new(&mut mem),
+                );
+            }
+        }
+        Ok(Some(y))
+    }
+
+    /// `x = A⁻¹ b` on the trailing dofs `c` from the forward half `y = L⁻¹ P b` of
+    /// [`CholeskySolver::forward_trailing`]: `x̃₂ = L₂₂⁻ᵀ y₂` (the trailing rows of
+    /// `Lᵀ x̃ = y`, `x̃ = P x`), returned as a vector of length `n` that is zero outside `c`.
+    ///
+    /// # Errors
+    /// [`LinalgError::InvalidParameter`] without a trailing block; a wrong length.
+    pub fn trailing_of_forward(&self, y: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        let n = self.symbolic.nrows();
+        let (Some(block), true) = (self.trailing.as_ref(), self.factorized) else {
+            return Err(LinalgError::InvalidParameter("no trailing block of the factorisation".into()));
+        };
+        if y.len() != n {
+            return Err(LinalgError::Length { what: "forward solution", expected: n, got: y.len() });
+        }
+        let k = block.dofs.len();
+        let mut z = y[n - k..].to_vec();
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            block.factor.as_ref().transpose(),
+            MatMut::from_column_major_slice_mut(&mut z, k, 1),
+            Par::Seq,
+        );
+        let mut x = vec![0.0; n];
+        for (&d, v) in block.dofs.iter().zip(z) {
+            x[d] = v;
+        }
+        Ok(x)
+    }
+
+    /// `x = A⁻¹ (b − s)` from the forward half `y = L⁻¹ P b` of
+    /// [`CholeskySolver::forward_trailing`] and an `s` that vanishes outside the trailing dofs
+    /// `c` (e.g. contact forces `Cᵀ ν`): `P x = L⁻ᵀ (y − (0, L₂₂⁻¹ s_c))`, a dense forward
+    /// solve of size `k` and the backward half over the whole factor. An `s` with entries
+    /// outside `c` is solved whole and subtracted.
+    ///
+    /// # Errors
+    /// [`LinalgError::InvalidParameter`] without a trailing block; wrong lengths; a failed solve.
+    pub fn complete_forward(&self, y: &[f64], s: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+        use faer::sparse::linalg::triangular_solve::solve_lower_triangular_transpose_in_place;
+        use faer::sparse::SparseColMatRef;
+        let n = self.symbolic.nrows();
+        let (Some(block), Some(perm), true) = (self.trailing.as_ref(), self.symbolic.perm(), self.factorized)
+        else {
+            return Err(LinalgError::InvalidParameter("no trailing block of the factorisation".into()));
+        };
+        if y.len() != n || s.len() != n {
+            return Err(LinalgError::Length {
+                what: "forward solution",
+                expected: n,
+                got: y.len().min(s.len()),
+            });
+        }
+        let (fwd, inv) = perm.arrays();
+        let k = block.dofs.len();
+        let t0 = n - k;
+        let mut z = y.to_vec();
+        let outside = fwd[..t0].iter().any(|&i| s[i] != 0.0);
+        if !outside {
+            let mut sc: Vec<f64> = (0..k).map(|p| s[fwd[t0 + p]]).collect();
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+                block.factor.as_ref(),
+                MatMut::from_column_major_slice_mut(&mut sc, k, 1),
+                Par::Seq,
+            );
+            for (zp, v) in z[t0..].iter_mut().zip(&sc) {
+                *zp -= v;
+            }
+        }
+        let zm = MatMut::from_column_major_slice_mut(&mut z, n, 1);
+        match self.symbolic.raw() {
+            SymbolicCholeskyRaw::Simplicial(sym) => {
+                let l = SparseColMatRef::<'_, usize, f64>::new(sym.factor(), &self.factor);
+                solve_lower_triangular_transpose_in_place(l, Conj::No, zm, Par::Seq);
+            }
+            SymbolicCholeskyRaw::Supernodal(sym) => {
+                let req = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
+                let mut mem = MemBuffer::try_new(req)
+                    .map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
+                SupernodalLltRef::new(sym, &self.factor).l_transpose_solve_with_conj(
+                    Conj::No,
+                    zm,
+                    Par::Seq,
+                    MemStack::new(&mut mem),
+                );
+            }
+        }
+        let mut x: Vec<f64> = (0..n).map(|i| z[inv[i]]).collect();
+        if outside {
+            let mut sx = s.to_vec();
+            self.solve_in_place(&mut sx)?;
+            x.iter_mut().zip(&sx).for_each(|(a, b)| *a -= b);
+        }
+        Ok(x)
+    }
+
     /// Solves `A x = b` in place for one right-hand side.
     pub fn solve_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
         let n = b.len();

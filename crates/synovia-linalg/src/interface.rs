@@ -661,6 +661,85 @@ mod tests {
     /// Rows on the trailing block that differ only by a factor (the friction rows
     /// `g_c,r κ_r T_rᵀ` of successive time levels) share one kept solve, and the columns of `S`
     /// built from it agree with fresh solves; a row of another direction is solved anew.
+    /// The 5-point Laplacian (+ 0.1 I) of an `m × m` grid.
+    fn grid(m: usize) -> SymmetricMatrix {
+        let n = m * m;
+        let columns = (0..n)
+            .map(|j| {
+                let mut c = vec![j];
+                if (j + 1) % m != 0 {
+                    c.push(j + 1);
+                }
+                if j + m < n {
+                    c.push(j + m);
+                }
+                c
+            })
+            .collect();
+        let mut a = SymmetricMatrix::from_columns(n, columns).expect("pattern");
+        for j in 0..n {
+            a.add(j, j, 4.1).expect("diagonal");
+            if (j + 1) % m != 0 {
+                a.add(j + 1, j, -1.0).expect("off-diagonal");
+            }
+            if j + m < n {
+                a.add(j + m, j, -1.0).expect("off-diagonal");
+            }
+        }
+        a
+    }
+
+    /// The two halves of a solve with a trailing block: `L₂₂⁻ᵀ y₂` of the forward half is
+    /// `A⁻¹ b` on the trailing dofs, and the completion is `A⁻¹ (b − s)` for an `s` on them
+    /// (and for one with entries outside them, solved whole), to 1e-13 — on a tridiagonal and
+    /// a 2D grid matrix; rows outside the block are not covered.
+    #[test]
+    fn forward_half_and_completion_equal_the_whole_solve() {
+        for (a, last) in [(tridiagonal(60), (45..60).collect::<Vec<_>>()), (grid(24), (0..24).collect())] {
+            let n = a.n();
+            let op = SparseCholesky::new(
+                a,
+                &Ordering::Trailing { base: Box::new(Ordering::Amd), last: last.clone() },
+            )
+            .expect("factor");
+            let b: Vec<f64> = (0..n).map(|i| ((i * 7 % 13) as f64 - 6.0) * 0.3 + 1.0).collect();
+            let mut x = b.clone();
+            op.solve_in_place(&mut x).expect("solve");
+            let scale = x.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let mut rows = SparseRows::new(n);
+            rows.push_row([(last[1], 1.0), (last[2], -0.5)]);
+            rows.push_row([(last[4], 0.25)]);
+            assert!(op.forward_covers(RowStack::new(&rows, None)));
+            let y = op.forward_solve(&b).expect("forward").expect("a trailing block");
+            let xc = op.interface_of_forward(&y).expect("trailing values");
+            for i in 0..n {
+                let want = if last.contains(&i) { x[i] } else { 0.0 };
+                assert!((xc[i] - want).abs() <= 1e-13 * scale, "x_{i}: {} vs {want}", xc[i]);
+            }
+            let mut s_in = vec![0.0; n];
+            s_in[last[1]] = 0.7;
+            s_in[last[4]] = -1.3;
+            let mut s_out = s_in.clone();
+            s_out[n / 2] = 0.4;
+            assert!(!last.contains(&(n / 2)));
+            for s in [s_in, s_out] {
+                let mut want: Vec<f64> = b.iter().zip(&s).map(|(b, s)| b - s).collect();
+                op.solve_in_place(&mut want).expect("solve");
+                let got = op.complete_forward(&y, &s).expect("completion");
+                for i in 0..n {
+                    assert!((got[i] - want[i]).abs() <= 1e-13 * scale, "u_{i}: {} vs {}", got[i], want[i]);
+                }
+            }
+            let mut outside = SparseRows::new(n);
+            outside.push_row([(n / 2, 1.0)]);
+            assert!(!op.forward_covers(RowStack::new(&outside, None)));
+        }
+        // without a trailing block: no forward half
+        let plain = SparseCholesky::new(tridiagonal(20), &Ordering::Amd).expect("factor");
+        assert!(plain.forward_solve(&[1.0; 20]).expect("no error").is_none());
+        assert!(plain.interface_of_forward(&[1.0; 20]).is_err());
+    }
+
     #[test]
     fn rescaled_rows_share_a_kept_solve() {
         let n = 40;

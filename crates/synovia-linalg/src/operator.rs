@@ -72,6 +72,42 @@ pub trait FactorisedOperator: Send + Sync + fmt::Debug {
     fn solve_supported_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
         self.solve_in_place(b)
     }
+    /// `true` if every dof of the interface `rows` lies in a dense trailing block of the
+    /// factor, so that [`FactorisedOperator::forward_solve`] serves them (default `false`).
+    fn forward_covers(&self, rows: RowStack<'_>) -> bool {
+        let _ = rows;
+        false
+    }
+    /// The forward half of a solve `A x = b` for interfaces whose rows the operator covers
+    /// ([`FactorisedOperator::forward_covers`]; docs/model.md §6.4): `Some(y)`, from which
+    /// [`FactorisedOperator::interface_of_forward`] gives `x` on the interface dofs and
+    /// [`FactorisedOperator::complete_forward`] the whole `A⁻¹ (b − Cᵀ ν)`, each about half a
+    /// solve. Default `None` (no dense trailing block: solve whole).
+    ///
+    /// # Errors
+    /// A wrong length, or a failed solve.
+    fn forward_solve(&self, b: &[f64]) -> Result<Option<Vec<f64>>, LinalgError> {
+        let _ = b;
+        Ok(None)
+    }
+    /// `x = A⁻¹ b` on the interface dofs (zero elsewhere) from `y` of
+    /// [`FactorisedOperator::forward_solve`].
+    ///
+    /// # Errors
+    /// Operators without [`FactorisedOperator::forward_solve`]; a wrong length.
+    fn interface_of_forward(&self, y: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        let _ = y;
+        Err(LinalgError::InvalidParameter("this operator has no forward solve".into()))
+    }
+    /// `x = A⁻¹ (b − s)` from `y` of [`FactorisedOperator::forward_solve`] of `b` and an `s`
+    /// that vanishes outside the interface dofs (e.g. `Cᵀ ν`).
+    ///
+    /// # Errors
+    /// Operators without [`FactorisedOperator::forward_solve`]; wrong lengths; a failed solve.
+    fn complete_forward(&self, y: &[f64], s: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        let _ = (y, s);
+        Err(LinalgError::InvalidParameter("this operator has no forward solve".into()))
+    }
     /// Computes the columns `j ∈ wanted` of the interface Schur complement
     /// `S = C A⁻¹ Cᵀ` of the rows `C` into `columns[j]` (entries already `Some` are kept; an
     /// implementation may fill other columns too). `kept` holds solves of single rows shared
@@ -248,6 +284,21 @@ impl FactorisedOperator for CholeskyOperator<'_> {
     fn solve_supported_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
         self.factor.solve_trailing_supported_in_place(b)
     }
+    fn forward_covers(&self, rows: RowStack<'_>) -> bool {
+        self.factor.trailing().is_some_and(|block| {
+            (0..rows.n_rows())
+                .all(|r| rows.row(r).all(|(i, _)| block.position.get(i).is_some_and(|&p| p != usize::MAX)))
+        })
+    }
+    fn forward_solve(&self, b: &[f64]) -> Result<Option<Vec<f64>>, LinalgError> {
+        self.factor.forward_trailing(b)
+    }
+    fn interface_of_forward(&self, y: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        self.factor.trailing_of_forward(y)
+    }
+    fn complete_forward(&self, y: &[f64], s: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        self.factor.complete_forward(y, s)
+    }
     fn interface_columns(
         &self,
         rows: RowStack<'_>,
@@ -315,6 +366,18 @@ impl FactorisedOperator for SparseCholesky {
     }
     fn solve_supported_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
         self.view().solve_supported_in_place(b)
+    }
+    fn forward_covers(&self, rows: RowStack<'_>) -> bool {
+        self.view().forward_covers(rows)
+    }
+    fn forward_solve(&self, b: &[f64]) -> Result<Option<Vec<f64>>, LinalgError> {
+        self.view().forward_solve(b)
+    }
+    fn interface_of_forward(&self, y: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        self.view().interface_of_forward(y)
+    }
+    fn complete_forward(&self, y: &[f64], s: &[f64]) -> Result<Vec<f64>, LinalgError> {
+        self.view().complete_forward(y, s)
     }
     fn interface_columns(
         &self,
