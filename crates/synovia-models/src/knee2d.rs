@@ -1206,13 +1206,30 @@ impl synovia_contact::ContactDiscretisation<2> for SmoothNodeToSegment {
             synovia_mesh::mesh::nodal_normals_at(pos_l, facets.iter().map(Vec::as_slice))
                 .into_iter()
                 .collect();
+        // the segments with their nodal normals and bounding boxes widened by the search
+        // distance: a master point x(ξ) lies on its segment, so a slave node outside the
+        // widened box of a segment has no master point within the search distance there
+        let sd = self.search_distance;
+        let segments: Vec<(usize, usize, Vector<2>, Vector<2>, Point<2>, Point<2>)> = facets
+            .iter()
+            .filter_map(|f| {
+                let [a, b] = f[..] else { return None };
+                let (na, nb) = (normals.get(&a)?, normals.get(&b)?);
+                let (xa, xb) = (pos_l[a], pos_l[b]);
+                let lo = Point::<2>::new(xa[0].min(xb[0]) - sd, xa[1].min(xb[1]) - sd);
+                let hi = Point::<2>::new(xa[0].max(xb[0]) + sd, xa[1].max(xb[1]) + sd);
+                Some((a, b, *na, *nb, lo, hi))
+            })
+            .collect();
         let mut rows = Vec::new();
         for &(i, ns) in cx.normals() {
             let x = &pos_k[i];
             let mut best: Option<(Real, usize, usize, Real, Vector<2>, Point<2>)> = None;
-            for f in &facets {
-                let [a, b] = f[..] else { continue };
-                let (Some(na), Some(nb)) = (normals.get(&a), normals.get(&b)) else { continue };
+            for (a, b, na, nb, lo, hi) in &segments {
+                let (a, b) = (*a, *b);
+                if x[0] < lo[0] || x[0] > hi[0] || x[1] < lo[1] || x[1] > hi[1] {
+                    continue;
+                }
                 let Some((xi, xm, n)) = Self::project(x, (&pos_l[a], &pos_l[b]), (na, nb)) else {
                     continue;
                 };
