@@ -1020,6 +1020,8 @@ pub struct SpatialField {
     start: Real,
     width: Real,
     bins: Vec<Vec<usize>>,
+    /// The node indices sorted by `x₀` (ties by index), for the nearest-node search.
+    by_x: Vec<usize>,
 }
 
 impl SpatialField {
@@ -1050,7 +1052,41 @@ impl SpatialField {
                 bin.push(k);
             }
         }
-        Self { nodes, cells, values: values.to_vec(), centre, start: lo, width, bins }
+        let mut by_x: Vec<usize> = (0..nodes.len()).collect();
+        by_x.sort_by(|&a, &b| nodes[a][0].total_cmp(&nodes[b][0]).then(a.cmp(&b)));
+        Self { nodes, cells, values: values.to_vec(), centre, start: lo, width, bins, by_x }
+    }
+
+    /// The node nearest to `x` (the smallest index among equally near ones), `None` for an
+    /// empty mesh: a scan of the nodes sorted by `x₀` outward from `x₀`, ended on each side when
+    /// `(x₀ − y₀)²` alone exceeds the best squared distance.
+    fn nearest_node(&self, x: &Point<2>) -> Option<usize> {
+        let start = self.by_x.partition_point(|&i| self.nodes[i][0] < x[0]);
+        let mut best: Option<(Real, usize)> = None;
+        let mut consider = |i: usize| -> bool {
+            let d = self.nodes[i] - x;
+            if best.is_some_and(|(b, _)| d[0] * d[0] > b) {
+                return false;
+            }
+            let d2 = d.norm_squared();
+            if best.is_none_or(|(b, j)| d2 < b || (d2 == b && i < j)) {
+                best = Some((d2, i));
+            }
+            true
+        };
+        let (mut up, mut down) = (start, start);
+        let (mut go_up, mut go_down) = (true, true);
+        while go_up || go_down {
+            if go_up {
+                go_up = up < self.by_x.len() && consider(self.by_x[up]);
+                up += 1;
+            }
+            if go_down {
+                go_down = down > 0 && consider(self.by_x[down - 1]);
+                down = down.saturating_sub(1);
+            }
+        }
+        best.map(|(_, i)| i)
     }
 
     /// `v(x)` (see the type docs).
@@ -1085,12 +1121,7 @@ impl SpatialField {
             Some((worst, idx, phi)) if worst >= -0.25 => {
                 idx.iter().zip(phi).fold(Vector::<2>::zeros(), |acc, (&n, w)| acc + self.values[n] * w)
             }
-            _ => self
-                .nodes
-                .iter()
-                .zip(&self.values)
-                .min_by(|u, v| (u.0 - x).norm().total_cmp(&(v.0 - x).norm()))
-                .map_or_else(Vector::<2>::zeros, |(_, v)| *v),
+            _ => self.nearest_node(x).map_or_else(Vector::<2>::zeros, |i| self.values[i]),
         }
     }
 }
@@ -1272,6 +1303,34 @@ mod tests {
     /// 80°, 90°, 100°, radial nodal normals): a point on the shared vertex's normal gets the
     /// same point and normal from both segments, and inside a segment the interpolated normal
     /// passes through the point.
+    /// The nearest-node search of [`SpatialField`] (sorted by `x₀`) finds the node that a
+    /// scan of all nodes finds, for points inside, around and far outside an annular mesh.
+    #[test]
+    fn nearest_node_equals_the_scan_of_all_nodes() {
+        let knee = Knee2d::coarse();
+        let (model, _) = knee.model(0.0).expect("model");
+        let mesh = &model.bodies()[0].mesh;
+        let values: Vec<Vector<2>> = mesh.nodes().iter().map(|x| Vector::<2>::new(x[0], -x[1])).collect();
+        let field = SpatialField::new(mesh, &values, knee.condyle_centre());
+        let scan = |x: &Point<2>| {
+            mesh.nodes()
+                .iter()
+                .enumerate()
+                .min_by(|u, v| (u.1 - x).norm().total_cmp(&(v.1 - x).norm()))
+                .map(|(i, _)| i)
+        };
+        for k in 0..400 {
+            let a = 0.37 * k as Real;
+            let r = 5.0 + 0.11 * (k % 97) as Real;
+            let x =
+                knee.condyle_centre() + Vector::<2>::new(r * a.cos(), r * a.sin()) * (1.0 + (k % 5) as Real);
+            assert_eq!(field.nearest_node(&x), scan(&x), "point {x:?}");
+        }
+        for &x in mesh.nodes().iter().step_by(7) {
+            assert_eq!(field.nearest_node(&x), scan(&x));
+        }
+    }
+
     #[test]
     fn smooth_projection_is_continuous_at_a_vertex() {
         let at = |deg: Real| Vector::<2>::new(deg.to_radians().cos(), deg.to_radians().sin());
