@@ -398,9 +398,6 @@ impl CholeskySolver {
     /// # Errors
     /// As [`CholeskySolver::solve_in_place`].
     pub fn solve_trailing_supported_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
-        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
-        use faer::sparse::linalg::triangular_solve::solve_lower_triangular_transpose_in_place;
-        use faer::sparse::SparseColMatRef;
         let n = self.symbolic.nrows();
         let (Some(block), Some(perm), true) = (self.trailing.as_ref(), self.symbolic.perm(), self.factorized)
         else {
@@ -424,26 +421,41 @@ impl CholeskySolver {
             MatMut::from_column_major_slice_mut(&mut z[t0..], k, 1),
             Par::Seq,
         );
-        let zm = MatMut::from_column_major_slice_mut(&mut z, n, 1);
+        self.sparse_half_solve(MatMut::from_column_major_slice_mut(&mut z, n, 1), true)?;
+        for (i, bi) in b.iter_mut().enumerate() {
+            *bi = z[inv[i]];
+        }
+        Ok(())
+    }
+
+    /// One triangular half of a solve with the sparse factor, in factor order and in place:
+    /// `x ← L⁻¹ x` (`transpose = false`) or `x ← L⁻ᵀ x` (`transpose = true`).
+    fn sparse_half_solve(&self, x: MatMut<'_, f64>, transpose: bool) -> Result<(), LinalgError> {
+        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+        use faer::sparse::linalg::triangular_solve::{
+            solve_lower_triangular_in_place, solve_lower_triangular_transpose_in_place,
+        };
+        use faer::sparse::SparseColMatRef;
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(sym) => {
                 let l = SparseColMatRef::<'_, usize, f64>::new(sym.factor(), &self.factor);
-                solve_lower_triangular_transpose_in_place(l, Conj::No, zm, Par::Seq);
+                if transpose {
+                    solve_lower_triangular_transpose_in_place(l, Conj::No, x, Par::Seq);
+                } else {
+                    solve_lower_triangular_in_place(l, Conj::No, x, Par::Seq);
+                }
             }
             SymbolicCholeskyRaw::Supernodal(sym) => {
                 let req = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
                 let mut mem = MemBuffer::try_new(req)
                     .map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
-                SupernodalLltRef::new(sym, &self.factor).l_transpose_solve_with_conj(
-                    Conj::No,
-                    zm,
-                    Par::Seq,
-                    MemStack::new(&mut mem),
-                );
+                let llt = SupernodalLltRef::new(sym, &self.factor);
+                if transpose {
+                    llt.l_transpose_solve_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut mem));
+                } else {
+                    llt.l_solve_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut mem));
+                }
             }
-        }
-        for (i, bi) in b.iter_mut().enumerate() {
-            *bi = z[inv[i]];
         }
         Ok(())
     }
@@ -460,9 +472,6 @@ impl CholeskySolver {
     /// # Errors
     /// A wrong length, or no successful factorisation.
     pub fn forward_trailing(&self, b: &[f64]) -> Result<Option<Vec<f64>>, LinalgError> {
-        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
-        use faer::sparse::linalg::triangular_solve::solve_lower_triangular_in_place;
-        use faer::sparse::SparseColMatRef;
         let n = self.symbolic.nrows();
         let (Some(_), Some(perm), true) = (self.trailing.as_ref(), self.symbolic.perm(), self.factorized)
         else {
@@ -473,24 +482,7 @@ impl CholeskySolver {
         }
         let (fwd, _) = perm.arrays();
         let mut y: Vec<f64> = fwd.iter().map(|&i| b[i]).collect();
-        let ym = MatMut::from_column_major_slice_mut(&mut y, n, 1);
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(sym) => {
-                let l = SparseColMatRef::<'_, usize, f64>::new(sym.factor(), &self.factor);
-                solve_lower_triangular_in_place(l, Conj::No, ym, Par::Seq);
-            }
-            SymbolicCholeskyRaw::Supernodal(sym) => {
-                let req = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
-                let mut mem = MemBuffer::try_new(req)
-                    .map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
-                SupernodalLltRef::new(sym, &self.factor).l_solve_with_conj(
-                    Conj::No,
-                    ym,
-                    Par::Seq,
-                    MemStack::new(&mut mem),
-                );
-            }
-        }
+        self.sparse_half_solve(MatMut::from_column_major_slice_mut(&mut y, n, 1), false)?;
         Ok(Some(y))
     }
 
@@ -531,9 +523,6 @@ impl CholeskySolver {
     /// # Errors
     /// [`LinalgError::InvalidParameter`] without a trailing block; wrong lengths; a failed solve.
     pub fn complete_forward(&self, y: &[f64], s: &[f64]) -> Result<Vec<f64>, LinalgError> {
-        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
-        use faer::sparse::linalg::triangular_solve::solve_lower_triangular_transpose_in_place;
-        use faer::sparse::SparseColMatRef;
         let n = self.symbolic.nrows();
         let (Some(block), Some(perm), true) = (self.trailing.as_ref(), self.symbolic.perm(), self.factorized)
         else {
@@ -562,24 +551,7 @@ impl CholeskySolver {
                 *zp -= v;
             }
         }
-        let zm = MatMut::from_column_major_slice_mut(&mut z, n, 1);
-        match self.symbolic.raw() {
-            SymbolicCholeskyRaw::Simplicial(sym) => {
-                let l = SparseColMatRef::<'_, usize, f64>::new(sym.factor(), &self.factor);
-                solve_lower_triangular_transpose_in_place(l, Conj::No, zm, Par::Seq);
-            }
-            SymbolicCholeskyRaw::Supernodal(sym) => {
-                let req = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
-                let mut mem = MemBuffer::try_new(req)
-                    .map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
-                SupernodalLltRef::new(sym, &self.factor).l_transpose_solve_with_conj(
-                    Conj::No,
-                    zm,
-                    Par::Seq,
-                    MemStack::new(&mut mem),
-                );
-            }
-        }
+        self.sparse_half_solve(MatMut::from_column_major_slice_mut(&mut z, n, 1), true)?;
         let mut x: Vec<f64> = (0..n).map(|i| z[inv[i]]).collect();
         if outside {
             let mut sx = s.to_vec();
