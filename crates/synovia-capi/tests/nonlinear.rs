@@ -17,15 +17,22 @@ use synovia_capi::*;
 
 use common::{arrays, last_error, ok};
 
-/// The punch of `common` (linear, E = 1000, ν = 0.3, plane strain) with its top moved by
-/// `top` and pressed frictionless onto the plane `y = 0`.
-fn punch(top: [f64; 2], friction: f64) -> *mut SynModel {
+/// The punch mesh of `common` as a C API model without conditions (linear, E = 1000, ν = 0.3,
+/// plane strain).
+fn linear_punch() -> *mut SynModel {
     let a = common::punch();
     let body = vec![0; a.elements.len() / 3];
     let (young, poisson) = ([common::YOUNG], [common::POISSON]);
     let desc = arrays(&a, &body, &young, &poisson);
     let mut m = null_mut();
     ok(unsafe { syn_model_from_arrays(&desc, &mut m) });
+    m
+}
+
+/// The punch of `common` (linear, E = 1000, ν = 0.3, plane strain) with its top moved by
+/// `top` and pressed frictionless onto the plane `y = 0`.
+fn punch(top: [f64; 2], friction: f64) -> *mut SynModel {
+    let m = linear_punch();
     ok(unsafe { syn_model_set_displacement(m, common::TAG_TOP, top.as_ptr(), 2) });
     let (p, n) = ([0.0, 0.0], [0.0, 1.0]);
     ok(unsafe {
@@ -84,12 +91,7 @@ fn static_force(s: f64, law: Option<(&str, &[f64])>) -> f64 {
 /// The displacements of the punch without contact, its bottom clamped and its top moved by
 /// `s × (0.01, −0.05)`, with the law `law` in small strain (`None`: the arrays' linear law).
 fn compressed(s: f64, law: Option<(&str, &[f64])>) -> Vec<f64> {
-    let a = common::punch();
-    let body = vec![0; a.elements.len() / 3];
-    let (young, poisson) = ([common::YOUNG], [common::POISSON]);
-    let desc = arrays(&a, &body, &young, &poisson);
-    let mut m = null_mut();
-    ok(unsafe { syn_model_from_arrays(&desc, &mut m) });
+    let m = linear_punch();
     ok(syn_model_clamp(m, common::TAG_BOTTOM));
     let top = [0.01 * s, -0.05 * s];
     ok(unsafe { syn_model_set_displacement(m, common::TAG_TOP, top.as_ptr(), 2) });
