@@ -214,6 +214,36 @@ fn block_material<const D: usize>(
     Ok(synovia_material::anisotropic::<D>(c).map_err(synovia_fem::FemError::from)?)
 }
 
+/// A plane-strain block `[0, 1] × [0, ¼]` (`nx × ny` cells, E = 1, ν = 0.3) whose top follows
+/// the prescribed displacement `top(t)` and whose bottom is the contact part of the pair
+/// `floor` (Coulomb coefficient 0.3) against the rigid shallow bump
+/// `φ(x) = (y + 0.1 (x − ½)²) / √(1 + g²)`, `g = 0.2 (x − ½)`: pressed down, only part of the
+/// bottom touches. For tests of the contact machinery on a caller's matrix and load.
+///
+/// # Errors
+/// Mesh, model or pair errors (none for `nx, ny ≥ 1`).
+pub fn block_on_bump(
+    nx: usize,
+    ny: usize,
+    top: impl Fn(f64) -> Vector<2> + Send + Sync + 'static,
+) -> Result<(Model<2>, Vec<crate::operators::ContactPair<2>>), ContactError> {
+    let mut mesh = rectangle(0.0, 1.0, 0.0, 0.25, nx, ny, Grading::Uniform, Grading::Uniform)?;
+    mesh.set_part_kind("top", BoundaryKind::Prescribed)?;
+    mesh.set_part_kind("bottom", BoundaryKind::Contact)?;
+    let mut model = Model::<2>::new();
+    let material = plane_strain(1.0, 0.3).map_err(synovia_fem::FemError::from)?;
+    let b = model.add_body("block", mesh, Arc::new(material))?;
+    model.prescribe(b, "top", move |_, t| top(t))?;
+    let bump = crate::operators::FnObstacle::new(|x: &Point<2>| {
+        let g = 0.2 * (x[0] - 0.5);
+        let n = (1.0 + g * g).sqrt();
+        ((x[1] + 0.1 * (x[0] - 0.5).powi(2)) / n, Vector::<2>::new(g / n, 1.0 / n))
+    });
+    let pairs =
+        vec![crate::operators::ContactPair::rigid("floor", b, "bottom", Arc::new(bump)).with_friction(0.3)];
+    Ok((model, pairs))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -4,34 +4,17 @@
 //! ([`StaticContact::solve_load`]) to 1e-12, and the completed displacement is the full solve's.
 #![allow(clippy::unwrap_used)]
 
-use std::sync::Arc;
-
 use synovia_contact::operators::ContactPair;
 use synovia_contact::{ContactParams, StaticContact, StaticContactResult};
 use synovia_fem::assembly::{assemble_matrix, body_stiffnesses};
 use synovia_fem::element::stiffness_into;
 use synovia_fem::{ElasticParams, ElasticSolver, Model};
-use synovia_material::plane_strain;
-use synovia_mesh::generators::{rectangle, Grading};
-use synovia_mesh::math::{Point, Real, Vector};
-use synovia_mesh::BoundaryKind;
+use synovia_mesh::math::{Real, Vector};
 use synovia_pdas::Pdas;
 
 /// A block pressed by its top onto a shallow bump (partial contact), with friction.
 fn pressed_block() -> (Model<2>, Vec<ContactPair<2>>) {
-    let mut mesh = rectangle(0.0, 1.0, 0.0, 0.25, 12, 4, Grading::Uniform, Grading::Uniform).unwrap();
-    mesh.set_part_kind("top", BoundaryKind::Prescribed).unwrap();
-    mesh.set_part_kind("bottom", BoundaryKind::Contact).unwrap();
-    let mut model = Model::<2>::new();
-    let b = model.add_body("block", mesh, Arc::new(plane_strain(1.0, 0.3).unwrap())).unwrap();
-    model.prescribe(b, "top", |_, t| Vector::<2>::new(2e-4 * t, -1e-3 * t)).unwrap();
-    let bump = synovia_contact::operators::FnObstacle::new(|x: &Point<2>| {
-        let g = 0.2 * (x[0] - 0.5);
-        let n = (1.0 + g * g).sqrt();
-        ((x[1] + 0.1 * (x[0] - 0.5).powi(2)) / n, Vector::<2>::new(g / n, 1.0 / n))
-    });
-    let pairs = vec![ContactPair::rigid("floor", b, "bottom", Arc::new(bump)).with_friction(0.3)];
-    (model, pairs)
+    synovia_contact::testing::block_on_bump(12, 4, |t| Vector::<2>::new(2e-4 * t, -1e-3 * t)).unwrap()
 }
 
 fn max_abs(x: &[Real]) -> Real {
