@@ -658,9 +658,6 @@ mod tests {
             .collect()
     }
 
-    /// Rows on the trailing block that differ only by a factor (the friction rows
-    /// `g_c,r κ_r T_rᵀ` of successive time levels) share one kept solve, and the columns of `S`
-    /// built from it agree with fresh solves; a row of another direction is solved anew.
     /// The 5-point Laplacian (+ 0.1 I) of an `m × m` grid.
     fn grid(m: usize) -> SymmetricMatrix {
         let n = m * m;
@@ -740,6 +737,9 @@ mod tests {
         assert!(plain.interface_of_forward(&[1.0; 20]).is_err());
     }
 
+    /// Rows on the trailing block that differ only by a factor (the friction rows
+    /// `g_c,r κ_r T_rᵀ` of successive time levels) share one kept solve, and the columns of `S`
+    /// built from it agree with fresh solves; a row of another direction is solved anew.
     #[test]
     fn rescaled_rows_share_a_kept_solve() {
         let n = 40;
