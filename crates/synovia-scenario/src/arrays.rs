@@ -385,15 +385,9 @@ impl<const D: usize> ArrayModel<D> {
     /// # Errors
     /// [`ArrayError::IndexOutOfRange`] for a body id out of range.
     pub fn set_material(&mut self, body: usize, material: Arc<dyn Material<D>>) -> Result<(), ArrayError> {
-        let n = self.joint.model().bodies().len();
-        if body >= n {
-            return Err(ArrayError::IndexOutOfRange(format!("body {body} is out of range 0..{n}")));
-        }
-        self.joint
-            .model_mut()
-            .body_mut(BodyId(body))
-            .map_err(|e| ArrayError::Rejected(e.to_string()))?
-            .material = material;
+        let id = self.body(body)?;
+        self.joint.model_mut().body_mut(id).map_err(|e| ArrayError::Rejected(e.to_string()))?.material =
+            material;
         Ok(())
     }
 
@@ -407,12 +401,18 @@ impl<const D: usize> ArrayModel<D> {
         body: usize,
         kinematics: synovia::fem::Kinematics,
     ) -> Result<(), ArrayError> {
+        let id = self.body(body)?;
+        self.joint.set_kinematics(id, kinematics)?;
+        Ok(())
+    }
+
+    /// The body with id `body` (its position in the arrays' bodies).
+    fn body(&self, body: usize) -> Result<BodyId, ArrayError> {
         let n = self.joint.model().bodies().len();
         if body >= n {
             return Err(ArrayError::IndexOutOfRange(format!("body {body} is out of range 0..{n}")));
         }
-        self.joint.set_kinematics(BodyId(body), kinematics)?;
-        Ok(())
+        Ok(BodyId(body))
     }
 
     /// The model.
