@@ -377,6 +377,21 @@ pub struct NonlinearContact<const D: usize> {
     /// iteration may keep: false until the first factorisation at a loaded state and after
     /// a rebuilt geometry or a failed level.
     tangent_kept: bool,
+    /// The constant matrix `B` of [`Self::with_constant_matrix`] (on the tangent's pattern),
+    /// added to every tangent; `B ũ` is added to the internal force.
+    constant: Option<synovia_linalg::SymmetricMatrix>,
+}
+
+/// The extra terms of one level of [`NonlinearContact::step_with_terms`] (docs/model.md
+/// (12.1)): the level solves `B ũ + Pᵀ F_int(u) + c = Pᵀ F_ext(t) + g` with the constant
+/// matrix `B` of [`NonlinearContact::with_constant_matrix`].
+#[derive(Debug, Clone, Copy)]
+pub struct LevelTerms<'a> {
+    /// The extra load `g` (reduced, one value per unknown).
+    pub load: &'a [Real],
+    /// Tresca slip bounds `g_c` per contact node of the level (`None`: frictionless), slip
+    /// measured from the committed state.
+    pub slip_bound: Option<&'a [Real]>,
 }
 
 fn norm(x: &[Real]) -> Real {
@@ -398,6 +413,41 @@ impl<const D: usize> NonlinearContact<D> {
         elastic: ElasticParams,
         params: NewtonParams,
     ) -> Result<Self, NonlinearError> {
+        Self::build(model, pairs, kinematics, elastic, params, None)
+    }
+
+    /// As [`Self::new`], with a constant symmetric matrix `B` (reduced, on the tangent's
+    /// pattern) that `assemble(dofs, b)` fills into a zeroed matrix of that pattern: every
+    /// tangent is `K_T(u) + B` and every internal force `Pᵀ F_int(u) + B ũ` (docs/model.md
+    /// (12.1)). The dynamic scheme uses it for the inertia and damping terms
+    /// `B = (M̃_ρ + Δt (M̃_α + Ã⁽¹⁾)) / Δt²` (docs/model.md (12.2)); a positive definite `B`
+    /// makes the first tangent `K_T(0) + B` positive definite even for bodies that nothing
+    /// holds.
+    ///
+    /// # Errors
+    /// As [`Self::new`], and the errors of `assemble`.
+    pub fn with_constant_matrix(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        kinematics: &[Kinematics],
+        elastic: ElasticParams,
+        params: NewtonParams,
+        assemble: impl FnOnce(&DofMap<D>, &mut synovia_linalg::SymmetricMatrix) -> Result<(), FemError>,
+    ) -> Result<Self, NonlinearError> {
+        Self::build(model, pairs, kinematics, elastic, params, Some(Box::new(assemble)))
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn build(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        kinematics: &[Kinematics],
+        elastic: ElasticParams,
+        params: NewtonParams,
+        assemble: Option<
+            Box<dyn FnOnce(&DofMap<D>, &mut synovia_linalg::SymmetricMatrix) -> Result<(), FemError> + '_>,
+        >,
+    ) -> Result<Self, NonlinearError> {
         params.check()?;
         let nb = model.bodies().len();
         if kinematics.len() != nb {
@@ -408,8 +458,17 @@ impl<const D: usize> NonlinearContact<D> {
         }
         let zero: Vec<Vec<Vector<D>>> =
             model.bodies().iter().map(|b| vec![Vector::<D>::zeros(); b.mesh.n_nodes()]).collect();
+        let mut constant = None;
         let contact = StaticContact::with_system_matrix(model, pairs, elastic, |dofs, m| {
-            assemble_tangent(model, dofs, kinematics, &zero, m)
+            assemble_tangent(model, dofs, kinematics, &zero, m)?;
+            if let Some(assemble) = assemble {
+                let mut b = m.clone();
+                b.zero();
+                assemble(dofs, &mut b)?;
+                m.add_scaled(1.0, &b)?;
+                constant = Some(b);
+            }
+            Ok(())
         })?;
         let dofs = contact.elastic().dofs().clone();
         let n = dofs.n_dofs();
@@ -427,7 +486,60 @@ impl<const D: usize> NonlinearContact<D> {
                 result: None,
             },
             tangent_kept: false,
+            constant,
         })
+    }
+
+    /// The constant matrix `B` of [`Self::with_constant_matrix`] (`None` for [`Self::new`]).
+    pub fn constant_matrix(&self) -> Option<&synovia_linalg::SymmetricMatrix> {
+        self.constant.as_ref()
+    }
+
+    /// Replaces the constant matrix `B` (same pattern as the one of
+    /// [`Self::with_constant_matrix`]; e.g. the dynamic scheme's `B` of another time step).
+    /// The tangent is refactorised at the next iteration.
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] without a constant matrix or for another pattern.
+    pub fn set_constant_matrix(&mut self, b: synovia_linalg::SymmetricMatrix) -> Result<(), NonlinearError> {
+        match &self.constant {
+            Some(old) if old.n() == b.n() && old.nnz() == b.nnz() => {
+                self.constant = Some(b);
+                self.tangent_kept = false;
+                Ok(())
+            }
+            Some(_) => Err(NonlinearError::InvalidParameter(
+                "the constant matrix must have the pattern of the tangent".into(),
+            )),
+            None => Err(NonlinearError::InvalidParameter(
+                "set_constant_matrix needs a NonlinearContact built with with_constant_matrix".into(),
+            )),
+        }
+    }
+
+    /// Sets the committed state to the loaded configuration `ũ` at time `t` (load factor 1,
+    /// no contact forces, no multipliers): the start of a time integration from an initial
+    /// displacement `u(t) = u_p(t) + P ũ`.
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] for a wrong length or non-finite values.
+    pub fn set_state(&mut self, t: Real, reduced: &[Real]) -> Result<(), NonlinearError> {
+        let n = self.dofs.n_dofs();
+        if reduced.len() != n || !t.is_finite() || reduced.iter().any(|v| !v.is_finite()) {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "state: {n} finite unknowns and a finite time needed, got {} at t = {t}",
+                reduced.len()
+            )));
+        }
+        self.state = State {
+            time: t,
+            scale: 1.0,
+            reduced: reduced.to_vec(),
+            contact_force: vec![0.0; n],
+            result: None,
+        };
+        self.tangent_kept = false;
+        Ok(())
     }
 
     /// The contact machinery (geometry, factorisation of the last tangent).
@@ -445,6 +557,11 @@ impl<const D: usize> NonlinearContact<D> {
         &self.dofs
     }
 
+    /// The kinematics of the bodies.
+    pub fn kinematics(&self) -> &[Kinematics] {
+        &self.kinematics
+    }
+
     /// The parameters.
     pub fn params(&self) -> &NewtonParams {
         &self.params
@@ -458,6 +575,12 @@ impl<const D: usize> NonlinearContact<D> {
     /// Reduced unknowns `ũ` of the converged state.
     pub fn reduced(&self) -> &[Real] {
         &self.state.reduced
+    }
+
+    /// Reduced contact forces `c = B_hnᵀ κ Λ_n + B_Htᵀ Λ_t` (the linearised solve's
+    /// `F̄ − A ũ*`) of the converged state.
+    pub fn contact_force(&self) -> &[Real] {
+        &self.state.contact_force
     }
 
     /// Back to the unloaded reference configuration at time `t0`.
@@ -533,6 +656,22 @@ impl<const D: usize> NonlinearContact<D> {
         self.tangent_kept = false;
     }
 
+    /// `Pᵀ F_int(u) + B ũ` (with the constant matrix `B`, if any) and the strain energy.
+    fn effective_force(
+        &self,
+        model: &Model<D>,
+        displacement: &[Vec<Vector<D>>],
+        reduced: &[Real],
+    ) -> Result<(Vec<Real>, Real), FemError> {
+        let (mut f, energy) = internal_force(model, &self.dofs, &self.kinematics, displacement)?;
+        if let Some(b) = &self.constant {
+            let mut bu = vec![0.0; f.len()];
+            b.mul_vec(reduced, &mut bu);
+            f.iter_mut().zip(&bu).for_each(|(a, v)| *a += v);
+        }
+        Ok((f, energy))
+    }
+
     fn finite_strain(&self) -> bool {
         self.kinematics.contains(&Kinematics::FiniteStrain)
     }
@@ -575,7 +714,7 @@ impl<const D: usize> NonlinearContact<D> {
         let mut halvings = 0usize;
         loop {
             let (time, scale) = point(target);
-            match self.newton(model, time, scale, solver, &mut report, None) {
+            match self.newton(model, time, scale, solver, &mut report, None, None) {
                 Ok((result, energy, iterations, reduced, force, _)) => {
                     report.sublevels += 1;
                     self.state =
@@ -669,8 +808,68 @@ impl<const D: usize> NonlinearContact<D> {
         }
         let start = Instant::now();
         let mut report = NewtonReport::default();
-        match self.newton(model, t_guess, 1.0, solver, &mut report, Some(control)) {
+        match self.newton(model, t_guess, 1.0, solver, &mut report, Some(control), None) {
             Ok((result, energy, iterations, reduced, force, t)) => {
+                report.sublevels = 1;
+                report.iterations = iterations;
+                report.time_s = start.elapsed().as_secs_f64();
+                self.state = State {
+                    time: t,
+                    scale: 1.0,
+                    reduced,
+                    contact_force: force,
+                    result: Some(result.clone()),
+                };
+                Ok(NonlinearResult { time: t, contact: result, strain_energy: energy, report })
+            }
+            Err(e) => {
+                self.tangent_kept = false;
+                Err(e)
+            }
+        }
+    }
+
+    /// Solves one level `t` with extra terms from the committed state (docs/model.md (12.1)):
+    ///
+    /// ```text
+    /// B ũ + Pᵀ F_int(u) + B_hnᵀ κ Λ_n + B_Htᵀ Λ_t = Pᵀ F_ext(t) + g,   u = u_p(t) + P ũ,
+    /// ```
+    ///
+    /// with the constant matrix `B` of [`Self::with_constant_matrix`] (none for
+    /// [`Self::new`]), the load `g` and the Tresca slip bounds of `terms` (slip measured from
+    /// the committed state's displacement), by the Newton iteration of [`Self::step_to`] on
+    /// the tangent `K_T(u) + B` (predictor, line search, deformed-configuration geometry in
+    /// finite strain). The dynamic scheme solves each time step this way (docs/model.md
+    /// (12.2)). No cut-back (the caller owns the meaning of `B` and `g`, e.g. a time step):
+    /// on failure the committed state is unchanged; on success the level is committed.
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] for a non-finite `t`, a `g` of the wrong length or
+    /// from the unloaded reference (set a state first, [`Self::set_state`]);
+    /// [`NonlinearError::NoConvergence`] and the errors of an iteration.
+    pub fn step_with_terms(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        terms: &LevelTerms<'_>,
+        solver: &dyn ContactSolver,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
+        let n = self.dofs.n_dofs();
+        if !t.is_finite() || terms.load.len() != n || terms.load.iter().any(|v| !v.is_finite()) {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "level with extra terms: a finite time and {n} finite load values needed, got t = {t} and {} values",
+                terms.load.len()
+            )));
+        }
+        if self.state.scale < 1.0 {
+            return Err(NonlinearError::InvalidParameter(
+                "a level with extra terms starts from a loaded state (set_state)".into(),
+            ));
+        }
+        let start = Instant::now();
+        let mut report = NewtonReport::default();
+        match self.newton(model, t, 1.0, solver, &mut report, None, Some(terms)) {
+            Ok((result, energy, iterations, reduced, force, _)) => {
                 report.sublevels = 1;
                 report.iterations = iterations;
                 report.time_s = start.elapsed().as_secs_f64();
@@ -713,8 +912,9 @@ impl<const D: usize> NonlinearContact<D> {
     }
 
     /// Newton's method at `t` with the loads and prescribed displacements scaled by `scale`,
-    /// from the committed state; nothing is committed.
-    #[allow(clippy::type_complexity)]
+    /// from the committed state, with the extra terms of a level (`B` of the constant matrix,
+    /// `g`, slip bounds); nothing is committed.
+    #[allow(clippy::type_complexity, clippy::too_many_arguments)]
     fn newton(
         &mut self,
         model: &Model<D>,
@@ -723,6 +923,7 @@ impl<const D: usize> NonlinearContact<D> {
         solver: &dyn ContactSolver,
         report: &mut NewtonReport,
         mut control: Option<&mut LoadControl<'_, D>>,
+        terms: Option<&LevelTerms<'_>>,
     ) -> Result<
         (StaticContactResult<D>, Real, Vec<NewtonIteration>, Vec<Real>, Vec<Real>, Real),
         NonlinearError,
@@ -733,6 +934,9 @@ impl<const D: usize> NonlinearContact<D> {
         let mut f_ext = vec![0.0; n];
         add_loads(model, &self.dofs, t, self.params.load_degree, &mut f_ext)?;
         f_ext.iter_mut().for_each(|f| *f *= scale);
+        if let Some(terms) = terms {
+            f_ext.iter_mut().zip(terms.load).for_each(|(f, g)| *f += g);
+        }
         let mut u = self.state.reduced.clone();
         // the converged state (the undeformed reference before the first level): the new
         // prescribed displacements enter through the predictor of the first iteration
@@ -746,17 +950,28 @@ impl<const D: usize> NonlinearContact<D> {
         // the lifts of the current iterate (load control moves `t`, so the lifts with it)
         let mut current_lifts = lifts_old.clone();
         let mut disp = self.dofs.expand(&u, &lifts_old)?;
-        let (mut f_int, _) = internal_force(model, &self.dofs, &self.kinematics, &disp)?;
+        let (mut f_int, _) = self.effective_force(model, &disp, &u)?;
         let mut c = self.state.contact_force.clone();
-        // friction frozen from the committed state (none from the reference configuration)
+        // friction frozen from the committed state (none from the reference configuration),
+        // or the slip bounds given with the level's extra terms
         let previous = self.state.result.as_ref();
-        let friction =
-            previous.is_some() && self.contact.geometry().nodes.iter().any(|node| node.friction > 0.0);
-        let slip_bound = match (friction, previous) {
-            (true, Some(p)) => Some(self.contact.geometry().slip_bounds_from_pressure(&p.solution.lambda_n)),
-            _ => None,
+        let (slip_bound, previous_disp) = match terms {
+            Some(terms) => match terms.slip_bound.filter(|g| g.iter().any(|v| *v > 0.0)) {
+                Some(g) => (Some(g.to_vec()), Some(disp.clone())),
+                None => (None, None),
+            },
+            None => {
+                let friction = previous.is_some()
+                    && self.contact.geometry().nodes.iter().any(|node| node.friction > 0.0);
+                let slip_bound = match (friction, previous) {
+                    (true, Some(p)) => {
+                        Some(self.contact.geometry().slip_bounds_from_pressure(&p.solution.lambda_n))
+                    }
+                    _ => None,
+                };
+                (slip_bound, if friction { previous.map(|p| p.displacement.clone()) } else { None })
+            }
         };
-        let previous_disp = if friction { previous.map(|p| p.displacement.clone()) } else { None };
         // (`Λ_t` on the friction cells of this level's slip bounds: the committed level may
         // have had other cells, or none from the reference configuration)
         let mut warm: Option<ContactSolution> = previous.map(|p| match slip_bound.as_deref() {
@@ -830,6 +1045,7 @@ impl<const D: usize> NonlinearContact<D> {
             }
             let kin = &self.kinematics;
             let at = &disp;
+            let constant = self.constant.as_ref();
             let reuse = self.params.tangent_reuse.is_some() && self.tangent_kept;
             // K_T away from equilibrium (strong compression, the geometric stiffness of
             // compressive stresses) may be indefinite: then K_T + γ D (D = diag K_T, γ = 1e-4,
@@ -839,6 +1055,9 @@ impl<const D: usize> NonlinearContact<D> {
                 loop {
                     let result = self.contact.refactorise(|dofs, m| {
                         assemble_tangent(model, dofs, kin, at, m)?;
+                        if let Some(b) = constant {
+                            m.add_scaled(1.0, b)?;
+                        }
                         if shift > 0.0 {
                             for (k, d) in m.diagonal().into_iter().enumerate() {
                                 m.add(k, k, shift * d.abs())?;
@@ -986,7 +1205,7 @@ impl<const D: usize> NonlinearContact<D> {
                 let u_try: Vec<Real> = (0..n).map(|i| u[i] + alpha * delta[i]).collect();
                 let c_try: Vec<Real> = (0..n).map(|i| c[i] + alpha * (c_star[i] - c[i])).collect();
                 let disp_try = self.dofs.expand(&u_try, &lifts)?;
-                match internal_force(model, &self.dofs, &self.kinematics, &disp_try) {
+                match self.effective_force(model, &disp_try, &u_try) {
                     Ok((f_try, e_try)) => {
                         let r_try = norm(&residual_of(&f_ext, &f_try, &c_try));
                         if !self.params.line_search

@@ -142,7 +142,7 @@ impl DynamicBody {
         Ok(Self { density: material.density(), damping: material.damping(), viscous })
     }
 
-    fn check(&self, body: &str, nv: usize) -> Result<(), TimeError> {
+    pub(crate) fn check(&self, body: &str, nv: usize) -> Result<(), TimeError> {
         let bad = |m: String| Err(TimeError::InvalidParameter(format!("body `{body}`: {m}")));
         if !(self.density.is_finite() && self.density > 0.0) {
             return bad(format!("density ρ = {} must be positive and finite", self.density));
@@ -268,7 +268,7 @@ impl DynamicParams {
         }
     }
 
-    fn check(&self) -> Result<(), TimeError> {
+    pub(crate) fn check(&self) -> Result<(), TimeError> {
         let bad = |m: String| Err(TimeError::InvalidParameter(m));
         if !(self.dt.is_finite() && self.dt > 0.0) {
             return bad(format!("time step Δt = {} must be positive and finite", self.dt));
@@ -1144,16 +1144,20 @@ fn add_into(a: &mut [Real], b: &[Real]) {
     }
 }
 
-fn all_zero<const D: usize>(v: &[Vector<D>]) -> bool {
+pub(crate) fn all_zero<const D: usize>(v: &[Vector<D>]) -> bool {
     v.iter().all(|x| x.iter().all(|c| *c == 0.0))
 }
 
 /// `(a − b) · s` node by node.
-fn nodal_diff<const D: usize>(a: &[Vec<Vector<D>>], b: &[Vec<Vector<D>>], s: Real) -> Vec<Vec<Vector<D>>> {
+pub(crate) fn nodal_diff<const D: usize>(
+    a: &[Vec<Vector<D>>],
+    b: &[Vec<Vector<D>>],
+    s: Real,
+) -> Vec<Vec<Vector<D>>> {
     a.iter().zip(b).map(|(x, y)| x.iter().zip(y).map(|(p, q)| (p - q) * s).collect()).collect()
 }
 
-fn check_nodal<const D: usize>(
+pub(crate) fn check_nodal<const D: usize>(
     model: &Model<D>,
     field: &[Vec<Vector<D>>],
     what: &str,

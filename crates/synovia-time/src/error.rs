@@ -24,6 +24,21 @@ pub enum TimeError {
     /// A contact error outside a step (set-up).
     #[error(transparent)]
     ContactSetup(#[from] ContactError),
+    /// A step of the nonlinear dynamic scheme failed after its cut-backs
+    /// ([`crate::nonlinear_dynamic::NonlinearDynamicStepper`]).
+    #[error("time step {step} (t = {time}): {source}")]
+    Nonlinear {
+        /// Step index.
+        step: usize,
+        /// Time of the sub-step that failed.
+        time: f64,
+        /// The error of the Newton iteration.
+        #[source]
+        source: synovia_nonlinear::NonlinearError,
+    },
+    /// An error of the Newton iteration outside a step (set-up, initial state).
+    #[error(transparent)]
+    NonlinearSetup(#[from] synovia_nonlinear::NonlinearError),
     /// A finite-element error.
     #[error(transparent)]
     Fem(#[from] FemError),
