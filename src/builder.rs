@@ -64,7 +64,9 @@ use crate::rigid::{ForceControlParams, LevelMode, RigidBody, RigidDriver};
 use crate::session::JointSession;
 
 mod setup;
+mod tfeti;
 pub use setup::{InitialPenetration, SetupInfo, PENETRATION_TOLERANCE};
+pub use tfeti::{TfetiSettings, TFETI};
 
 /// Everything that can go wrong while building or running a [`JointModel`].
 #[derive(Debug, thiserror::Error)]
@@ -91,6 +93,19 @@ pub enum JointError {
     /// Nonlinear solve errors (Newton without convergence after the cut-backs, ...).
     #[error(transparent)]
     Nonlinear(#[from] synovia_nonlinear::NonlinearError),
+    /// A TFETI set-up or solve error (solver `"tfeti"`: decomposition, SMALBE without
+    /// convergence, communication).
+    #[error(transparent)]
+    Feti(#[from] synovia_feti::FetiError),
+    /// The chosen solver does not treat a feature of the model or analysis (e.g. `"tfeti"`
+    /// with a dynamic analysis or rigid bodies with mixed control).
+    #[error("the `{solver}` solver does not support {feature}")]
+    Unsupported {
+        /// The solver's name.
+        solver: String,
+        /// What it does not support, and what to do instead.
+        feature: String,
+    },
     /// A part already has a kind that contradicts the requested condition.
     #[error("body `{body}`, part `{part}` is already of kind {current:?}; it cannot also be {requested:?}")]
     PartKind {
@@ -280,6 +295,7 @@ pub struct JointModel<const D: usize> {
     screening_band: Option<Real>,
     kinematics: Vec<Kinematics>,
     newton: NewtonParams,
+    tfeti: TfetiSettings,
 }
 
 impl<const D: usize> fmt::Debug for JointModel<D> {
@@ -354,6 +370,7 @@ impl<const D: usize> JointModel<D> {
             screening_band: None,
             kinematics: Vec::new(),
             newton: NewtonParams::default(),
+            tfeti: TfetiSettings::default(),
         }
     }
 
@@ -923,12 +940,16 @@ impl<const D: usize> JointModel<D> {
 
     // ----- solver and analysis -----
 
-    /// Chooses the contact solver by name (one of [`crate::solvers::SOLVER_NAMES`]).
+    /// Chooses the contact solver by name (one of [`crate::solvers::SOLVER_NAMES`],
+    /// [`crate::solvers::COMBINATOR_NAMES`], or [`TFETI`]: the model decomposed into
+    /// subdomains, parameters by [`JointModel::tfeti`], run by [`JointModel::run_on`]).
     ///
     /// # Errors
     /// [`JointError::Contact`] for an unknown name.
     pub fn solver(&mut self, name: &str) -> Result<&mut Self, JointError> {
-        crate::solvers::by_name_with(name, self.contact_params)?;
+        if name != TFETI {
+            crate::solvers::by_name_with(name, self.contact_params)?;
+        }
         self.solver = name.to_string();
         Ok(self)
     }
@@ -1032,8 +1053,17 @@ impl<const D: usize> JointModel<D> {
     /// The contact solver with its parameters.
     ///
     /// # Errors
-    /// [`JointError::Contact`] for an unknown solver name.
+    /// [`JointError::Contact`] for an unknown solver name; [`JointError::Unsupported`] for
+    /// [`TFETI`], which is not a solver on the assembled operator (it runs through
+    /// [`JointModel::run_on`], [`JointModel::run`], [`JointModel::run_static`] and
+    /// [`JointModel::run_quasistatic`]).
     pub fn build_solver(&self) -> Result<Box<dyn ContactSolver>, JointError> {
+        if self.uses_tfeti() {
+            return Err(JointError::Unsupported {
+                solver: TFETI.into(),
+                feature: "use as a contact solver on the assembled, factorised stiffness (dynamic analyses, re-solve sessions, the C API); it solves static and quasi-static analyses of the decomposed model (run, run_static, run_quasistatic, run_on)".into(),
+            });
+        }
         Ok(crate::solvers::by_name_with(&self.solver, self.contact_params)?)
     }
 
@@ -1055,6 +1085,9 @@ impl<const D: usize> JointModel<D> {
         &self,
         mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
+        if self.uses_tfeti() {
+            return self.run_on(&synovia_feti::SingleProcess, observer);
+        }
         self.check_penetration_policy()?;
         let solver = self.solver.clone();
         // one log line per step (`tracing`, level debug; the library installs no subscriber)
@@ -1183,6 +1216,10 @@ impl<const D: usize> JointModel<D> {
         times: &[Real],
         mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
+        if self.uses_tfeti() {
+            self.check_penetration_policy()?;
+            return self.run_tfeti_levels(times, &synovia_feti::SingleProcess, observer);
+        }
         let start = Instant::now();
         self.model.validate()?;
         let solver = self.build_solver()?;

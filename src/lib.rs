@@ -63,6 +63,7 @@
 
 pub use synovia_contact as contact_ops;
 pub use synovia_fem as fem;
+pub use synovia_feti as feti;
 pub use synovia_io as io;
 pub use synovia_linalg as linalg;
 pub use synovia_material as material;

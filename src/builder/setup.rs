@@ -121,7 +121,7 @@ impl<const D: usize> JointModel<D> {
         Ok(self.penetration_in(&geometry))
     }
 
-    fn penetration_in(&self, geometry: &ContactGeometry<D>) -> Vec<InitialPenetration> {
+    pub(super) fn penetration_in(&self, geometry: &ContactGeometry<D>) -> Vec<InitialPenetration> {
         let mut lo = [Real::INFINITY; D];
         let mut hi = [Real::NEG_INFINITY; D];
         for b in self.model.bodies() {
@@ -161,7 +161,7 @@ impl<const D: usize> JointModel<D> {
     }
 
     /// The first penetration that the policy refuses.
-    fn refused(&self, found: &[InitialPenetration]) -> Result<(), JointError> {
+    pub(super) fn refused(&self, found: &[InitialPenetration]) -> Result<(), JointError> {
         match found.iter().find(|p| self.refuses_initial_penetration(&p.pair)) {
             Some(p) => Err(JointError::InitialPenetration(Box::new(p.clone()))),
             None => Ok(()),
@@ -187,6 +187,9 @@ impl<const D: usize> JointModel<D> {
     /// # Errors
     /// The first error a run would meet before solving.
     pub fn check(&self) -> Result<SetupInfo, JointError> {
+        if self.uses_tfeti() {
+            return self.check_tfeti();
+        }
         self.model.validate()?;
         self.build_solver()?;
         let dynamic = matches!(self.analysis, Some(super::Analysis::Dynamic { .. }));

@@ -15,6 +15,12 @@
 //!
 //! For tests, the environment variable `SYNOVIA_STOP_AFTER_STEPS=N` raises the interrupt flag
 //! once `N` steps are done, exactly as Ctrl-C would then.
+//!
+//! Built with the feature `mpi`, `synovia run` initialises MPI and runs on the ranks it is
+//! launched on (`mpirun -np N synovia run s.toml --out D`): with the solver `tfeti` each rank
+//! owns a share of the subdomains, every rank computes the same results, and only rank 0
+//! prints and writes the output folder. A failure on any rank aborts all of them
+//! (`MPI_Abort` with the exit code).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
@@ -24,6 +30,7 @@ use std::sync::Arc;
 
 use clap::{ArgAction, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use synovia::feti::Communicator;
 use synovia_cli::run::{self, Progress, RunError, RunOptions, SweepSummary};
 use synovia_cli::Scenario;
 use synovia_scenario::sweep;
@@ -200,6 +207,20 @@ fn main() -> ExitCode {
             }
         }
         Command::Run { scenario, out, force, task_index, tasks } => {
+            #[cfg(feature = "mpi")]
+            let Some(universe) = mpi::initialize() else {
+                eprintln!("error: MPI could not be initialised");
+                return ExitCode::FAILURE;
+            };
+            #[cfg(feature = "mpi")]
+            let ranks = Ranks {
+                comm: synovia::feti::MpiCommunicator::new(universe.world()),
+                world: universe.world(),
+            };
+            #[cfg(not(feature = "mpi"))]
+            let ranks = Ranks { comm: synovia::feti::SingleProcess };
+            // only rank 0 reports (every rank computes the same results)
+            let quiet = quiet || ranks.comm.rank() != 0;
             let sc = match Scenario::from_file(&scenario) {
                 Ok(sc) => sc,
                 Err(e) => {
@@ -234,7 +255,7 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
                 let options = RunOptions { force, interrupt: Some(Arc::clone(&interrupt)), sweep: None };
-                return run_one(&sc, &scenario, out.as_deref(), &options, quiet, cli.verbose);
+                return run_one(&sc, &scenario, out.as_deref(), &options, quiet, cli.verbose, &ranks);
             };
             let (index, count) = match task_of(task_index, tasks) {
                 Ok(t) => t,
@@ -266,7 +287,7 @@ fn main() -> ExitCode {
                 let record = SweepSummary::of(case, cases.len());
                 let options =
                     RunOptions { force, interrupt: Some(Arc::clone(&interrupt)), sweep: Some(record) };
-                let r = run_one(&case_sc, &scenario, out.as_deref(), &options, quiet, cli.verbose);
+                let r = run_one(&case_sc, &scenario, out.as_deref(), &options, quiet, cli.verbose, &ranks);
                 if r == ExitCode::from(130) {
                     return r;
                 }
@@ -312,6 +333,30 @@ fn task_of(index: Option<usize>, tasks: Option<usize>) -> Result<(usize, usize),
     }
 }
 
+/// The processes a run is shared among: one ([`synovia::feti::SingleProcess`]) or the MPI
+/// ranks (feature `mpi`).
+struct Ranks {
+    #[cfg(feature = "mpi")]
+    comm: synovia::feti::MpiCommunicator,
+    #[cfg(feature = "mpi")]
+    world: mpi::topology::SimpleCommunicator,
+    #[cfg(not(feature = "mpi"))]
+    comm: synovia::feti::SingleProcess,
+}
+
+impl Ranks {
+    /// Ends a run that failed with exit code `code`: on more than one rank, every rank is
+    /// stopped (`MPI_Abort`: the others may be waiting for this one in a collective);
+    /// otherwise `code` is returned.
+    fn fail(&self, code: u8) -> ExitCode {
+        #[cfg(feature = "mpi")]
+        if self.comm.size() > 1 {
+            mpi::topology::Communicator::abort(&self.world, i32::from(code));
+        }
+        ExitCode::from(code)
+    }
+}
+
 /// Runs one scenario (a plain one, or one case of a sweep) with the progress bar and the
 /// report; returns the exit code.
 fn run_one(
@@ -321,6 +366,7 @@ fn run_one(
     options: &RunOptions,
     quiet: bool,
     verbose: u8,
+    ranks: &Ranks,
 ) -> ExitCode {
     let Some(interrupt) = options.interrupt.as_ref() else { return ExitCode::FAILURE };
     {
@@ -338,7 +384,7 @@ fn run_one(
             }
             let stop_after =
                 std::env::var("SYNOVIA_STOP_AFTER_STEPS").ok().and_then(|v| v.parse::<usize>().ok());
-            let result = run::run_with_options(sc, out, options, &mut |p| match p {
+            let result = run::run_on(sc, out, options, &ranks.comm, &mut |p| match p {
                 Progress::Start { steps } => bar.set_length(steps as u64),
                 Progress::Step { index, time } => {
                     bar.set_message(format!("t = {time:.4e}"));
@@ -401,11 +447,11 @@ fn run_one(
                 }
                 Err(e @ RunError::Failed(_)) => {
                     report_error(scenario, &e);
-                    ExitCode::FAILURE
+                    ranks.fail(1)
                 }
                 Err(e) => {
                     report_error(scenario, &e);
-                    ExitCode::from(2)
+                    ranks.fail(2)
                 }
             }
         }

@@ -8,6 +8,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 use synovia::builder::JointError;
+use synovia::feti::{Communicator, SingleProcess};
 use synovia::time::quasistatic::QuasiStaticOutput;
 use synovia::time::results::{write_csv_with_units, PairRecord, StepRecord, Units};
 
@@ -461,9 +462,30 @@ pub fn run_with_options(
     options: &RunOptions,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunReport, RunError> {
+    run_on(sc, out, options, &SingleProcess, progress)
+}
+
+/// [`run_with_options`] on the ranks of `comm` (e.g. MPI ranks: `synovia` built with the
+/// feature `mpi` under `mpirun`). Collective: every rank calls it with the same scenario. With
+/// the solver `tfeti` the subdomains are shared among the ranks
+/// ([`JointModel::run_on`](synovia::builder::JointModel::run_on)), and every rank computes the
+/// same results; only rank 0 touches the output folder (clears it, writes the files, the
+/// summary and the manifest). The other ranks write nothing and return the same summary
+/// (with `files` naming what rank 0 wrote). Other solvers run on one rank only.
+///
+/// # Errors
+/// As [`run_with_options`]; a solver other than `tfeti` on more than one rank is refused
+/// ([`RunError::Failed`]).
+pub fn run_on(
+    sc: &Scenario,
+    out: Option<&Path>,
+    options: &RunOptions,
+    comm: &dyn Communicator,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunReport, RunError> {
     match dimension(sc)? {
-        2 => run_dim::<2>(sc, out, options, progress),
-        _ => run_dim::<3>(sc, out, options, progress),
+        2 => run_dim::<2>(sc, out, options, comm, progress),
+        _ => run_dim::<3>(sc, out, options, comm, progress),
     }
 }
 fn file_name(p: &Path) -> String {
@@ -511,6 +533,7 @@ fn run_dim<const D: usize>(
     sc: &Scenario,
     out: Option<&Path>,
     options: &RunOptions,
+    comm: &dyn Communicator,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunReport, RunError> {
     let start = Instant::now();
@@ -562,7 +585,11 @@ fn run_dim<const D: usize>(
         Some(case) => out_dir.join(case.folder()),
         None => out_dir,
     };
-    let mut folder = OutDir::prepare(&out_dir, &sc.source.file, &name, options.force)?;
+    // only rank 0 writes (the other ranks of a distributed run compute the same results)
+    let mut folder = match comm.rank() {
+        0 => Some(OutDir::prepare(&out_dir, &sc.source.file, &name, options.force)?),
+        _ => None,
+    };
     let plan = built.output.clone();
     let n_steps = built.analysis.n_records();
     progress(Progress::Start { steps: n_steps });
@@ -573,13 +600,14 @@ fn run_dim<const D: usize>(
     let mut first_step_at: Option<f64> = None;
     let mut interrupted = false;
     let kinematics = built.joint.kinematics().to_vec();
-    let result = built.joint.run_with(|view| {
+    let result = built.joint.run_on(comm, |view| {
         let index = steps.len();
         if first_step_at.is_none() {
             first_step_at = Some(start.elapsed().as_secs_f64() - view.record.step_s);
             contact_nodes = view.geometry.len();
         }
-        let vtu = if plan.vtu_every > 0 && (index % plan.vtu_every == 0 || index + 1 == view.n_steps) {
+        let due = plan.vtu_every > 0 && (index % plan.vtu_every == 0 || index + 1 == view.n_steps);
+        let vtu = if let (true, Some(folder)) = (due, folder.as_mut()) {
             if writer.is_none() {
                 writer = Some(
                     QuasiStaticOutput::with_encoding(folder.dir(), &name, view.geometry, plan.encoding)?
@@ -599,6 +627,10 @@ fn run_dim<const D: usize>(
                 }
                 None => None,
             }
+        } else if due {
+            // the file rank 0 writes for this step (numbered by the files written before)
+            let written = steps.iter().filter(|s| s.vtu.is_some()).count();
+            Some(format!("{name}_{written:04}.vtu"))
         } else {
             None
         };
@@ -634,7 +666,9 @@ fn run_dim<const D: usize>(
         }
         Err(e) => {
             // keep the folder explained: what was written before the failure
-            let _ = folder.write_manifest("failed");
+            if let Some(folder) = &folder {
+                let _ = folder.write_manifest("failed");
+            }
             return Err(RunError::Failed(anyhow::Error::new(e)));
         }
     };
@@ -648,13 +682,15 @@ fn run_dim<const D: usize>(
     }
     let final_kkt = steps.last().map_or(0.0, |s| s.kkt);
     let csv = format!("{name}.csv");
-    let csv_tmp = out_dir.join(format!("{csv}.tmp"));
-    write_csv_with_units(&csv_tmp, &records, &built.units, D).map_err(anyhow::Error::new)?;
-    std::fs::rename(&csv_tmp, out_dir.join(&csv)).map_err(|e| {
-        let _ = std::fs::remove_file(&csv_tmp);
-        anyhow::anyhow!("cannot write `{}`: {e}", out_dir.join(&csv).display())
-    })?;
-    folder.record(&csv);
+    if let Some(folder) = folder.as_mut() {
+        let csv_tmp = out_dir.join(format!("{csv}.tmp"));
+        write_csv_with_units(&csv_tmp, &records, &built.units, D).map_err(anyhow::Error::new)?;
+        std::fs::rename(&csv_tmp, out_dir.join(&csv)).map_err(|e| {
+            let _ = std::fs::remove_file(&csv_tmp);
+            anyhow::anyhow!("cannot write `{}`: {e}", out_dir.join(&csv).display())
+        })?;
+        folder.record(&csv);
+    }
     let summary = Summary {
         scenario: sc.source.file.clone(),
         name: name.clone(),
@@ -675,7 +711,7 @@ fn run_dim<const D: usize>(
         setup_s,
         total_s,
         files: FilesSummary {
-            pvd: writer.as_ref().map(|w| file_name(w.pvd_path())),
+            pvd: steps.iter().any(|s| s.vtu.is_some()).then(|| format!("{name}.pvd")),
             csv,
             vtu: steps.iter().filter(|s| s.vtu.is_some()).count(),
             manifest: MANIFEST.to_string(),
@@ -688,8 +724,10 @@ fn run_dim<const D: usize>(
         units: UnitsSummary::of(&built.units, D),
         sweep: options.sweep.clone(),
     };
-    let json = serde_json::to_string_pretty(&summary).map_err(anyhow::Error::new)?;
-    folder.write(SUMMARY, (json + "\n").as_bytes())?;
-    folder.write_manifest(if interrupted { "interrupted" } else { "complete" })?;
+    if let Some(folder) = folder.as_mut() {
+        let json = serde_json::to_string_pretty(&summary).map_err(anyhow::Error::new)?;
+        folder.write(SUMMARY, (json + "\n").as_bytes())?;
+        folder.write_manifest(if interrupted { "interrupted" } else { "complete" })?;
+    }
     Ok(RunReport { summary, out_dir })
 }

@@ -124,6 +124,16 @@ impl TfetiParams {
         self.max_outer = max_outer;
         self
     }
+    /// Sets [`Self::rho_factor`].
+    pub fn with_rho_factor(mut self, rho_factor: f64) -> Self {
+        self.rho_factor = rho_factor;
+        self
+    }
+    /// Sets [`Self::max_inner`].
+    pub fn with_max_inner(mut self, max_inner: usize) -> Self {
+        self.max_inner = max_inner;
+        self
+    }
 }
 
 /// What a TFETI solve did.

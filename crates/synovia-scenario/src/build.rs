@@ -8,10 +8,11 @@ use std::ops::Range;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use synovia::builder::{Analysis, BodyMaterial, JointModel};
+use synovia::builder::{Analysis, BodyMaterial, JointError, JointModel, TfetiSettings, TFETI};
 use synovia::contact_ops::operators::{ContactPair, CylinderObstacle, PlaneObstacle, SphereObstacle};
 use synovia::contact_ops::{ContactParams, ExponentialFriction};
 use synovia::fem::{ComponentMask, ElasticParams, FemError, OrderingChoice};
+use synovia::feti::{DecompositionParams, Partitioner, Preconditioner, TfetiParams};
 use synovia::io::gmsh::GmshMesh;
 use synovia::io::Encoding;
 use synovia::material::{
@@ -392,6 +393,17 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
         }
     }
     joint.set_analysis(analysis.clone());
+    if joint.uses_tfeti() {
+        // what TFETI does not treat (dynamic analyses, rigid bodies with mixed control, …),
+        // at the solver's name
+        if let Err(e @ JointError::Unsupported { .. }) = joint.tfeti_support() {
+            let (k, span) = match doc.solver.as_ref().and_then(|s| s.get_ref().name.as_ref()) {
+                Some(n) => ("solver.name".to_string(), n.span()),
+                None => ("solver".to_string(), doc.analysis.span()),
+            };
+            return Err(cx.err(k, span, e.to_string()));
+        }
+    }
     let output = output(&cx, doc.output.as_ref())?;
     let units = units(&cx, doc, &joint, &analysis)?;
     Ok(Built { joint, analysis, output, name: sc.name(), warnings: cx.warnings.into_inner(), units })
@@ -1659,6 +1671,20 @@ fn obstacle<const D: usize>(
 fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverSpec>) -> R<()> {
     let k = "solver";
     let s = s.get_ref();
+    let present = present!(s;
+        "tolerance" => tolerance, "max_iterations" => max_iterations, "rho_scale" => rho_scale,
+        "nested_iteration" => nested_iteration, "ordering" => ordering, "load_degree" => load_degree,
+        "memory_limit_mb" => memory_limit_mb, "interface_block_dofs" => interface_block_dofs,
+        "screening_band" => screening_band, "subdomains" => subdomains, "partitioner" => partitioner,
+        "preconditioner" => preconditioner, "rho" => rho,
+    );
+    if s.name.as_ref().is_some_and(|n| n.get_ref() == TFETI) {
+        return tfeti_solver(cx, joint, s, &present);
+    }
+    let tfeti_keys = ["subdomains", "partitioner", "preconditioner", "rho"];
+    let direct: Vec<&str> = present.iter().map(|(n, _)| *n).filter(|n| !tfeti_keys.contains(n)).collect();
+    let name = s.name.as_ref().map_or(synovia::solvers::DEFAULT_SOLVER, |n| n.get_ref().as_str());
+    cx.only(k, &present, &direct, &format!("solver `{name}`; they are keys of `{TFETI}`"))?;
     let mut params = ContactParams::default();
     if let Some(t) = &s.tolerance {
         params.tolerance = cx.positive(t, "solver.tolerance")?;
@@ -1708,6 +1734,71 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
     if let Some(m) = &s.memory_limit_mb {
         let mb = cx.positive(m, "solver.memory_limit_mb")?;
         elastic.memory_limit = Some((mb * 1024.0 * 1024.0).min(u64::MAX as f64) as u64);
+    }
+    joint.elastic_params(elastic);
+    Ok(())
+}
+
+/// `[solver]` with `name = "tfeti"`: the decomposition and SMALBE parameters; the keys of the
+/// direct solvers' factorisation and active-set iteration do not apply.
+fn tfeti_solver<const D: usize>(
+    cx: &Cx<'_>,
+    joint: &mut JointModel<D>,
+    s: &SolverSpec,
+    present: &[(&str, Option<std::ops::Range<usize>>)],
+) -> R<()> {
+    let k = "solver";
+    let ok =
+        ["tolerance", "max_iterations", "load_degree", "subdomains", "partitioner", "preconditioner", "rho"];
+    cx.only(k, present, &ok, &format!("solver `{TFETI}`"))?;
+    let mut decomposition = DecompositionParams::default();
+    let mut params = TfetiParams::default();
+    if let Some(n) = &s.subdomains {
+        decomposition = decomposition.with_subdomains(cx.at_least(n, "solver.subdomains", 1)?);
+    }
+    if let Some(p) = &s.partitioner {
+        decomposition = decomposition.with_partitioner(match p.get_ref().as_str() {
+            "metis" => Partitioner::Metis,
+            "bisection" => Partitioner::Bisection,
+            other => {
+                return Err(cx.err(
+                    "solver.partitioner",
+                    p.span(),
+                    format!("partitioner is `metis` or `bisection`, got `{other}`"),
+                ))
+            }
+        });
+    }
+    if let Some(p) = &s.preconditioner {
+        params = params.with_preconditioner(match p.get_ref().as_str() {
+            "dirichlet" => Preconditioner::Dirichlet,
+            "lumped" => Preconditioner::Lumped,
+            "none" => Preconditioner::None,
+            other => {
+                return Err(cx.err(
+                    "solver.preconditioner",
+                    p.span(),
+                    format!("preconditioner is `dirichlet`, `lumped` or `none`, got `{other}`"),
+                ))
+            }
+        });
+    }
+    if let Some(t) = &s.tolerance {
+        params = params.with_tolerance(cx.positive(t, "solver.tolerance")?);
+    }
+    if let Some(r) = &s.rho {
+        params = params.with_rho_factor(cx.positive(r, "solver.rho")?);
+    }
+    if let Some(m) = &s.max_iterations {
+        params = params.with_max_outer(cx.at_least(m, "solver.max_iterations", 1)?);
+    }
+    if let Some(n) = &s.name {
+        joint.solver(n.get_ref()).map_err(|e| cx.err(key(k, "name"), n.span(), e.to_string()))?;
+    }
+    joint.tfeti(TfetiSettings::new(decomposition, params));
+    let mut elastic = ElasticParams::default();
+    if let Some(d) = &s.load_degree {
+        elastic.load_degree = cx.at_least(d, "solver.load_degree", 1)?;
     }
     joint.elastic_params(elastic);
     Ok(())

@@ -635,6 +635,14 @@ pub struct SolverSpec {
     /// Gap screening of whole-factor solves (length): each solve runs on the contact rows with
     /// gap at most this and adds the others that come into contact (exact).
     pub screening_band: Option<Sp<f64>>,
+    /// `tfeti`: number of parts the model is cut into (default 8).
+    pub subdomains: Option<Sp<usize>>,
+    /// `tfeti`: `metis` (default) or `bisection`.
+    pub partitioner: Option<Sp<String>>,
+    /// `tfeti`: `dirichlet` (default), `lumped` or `none`.
+    pub preconditioner: Option<Sp<String>>,
+    /// `tfeti`: the penalty `ρ` of SMALBE as a multiple of `‖PFP‖` (default 1).
+    pub rho: Option<Sp<f64>>,
 }
 
 /// The analysis (flat table; `type` says which keys apply).
