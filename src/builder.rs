@@ -26,7 +26,8 @@
 //! * [`JointModel::run_quasistatic`]: the quasi-static scheme of docs/model.md §7 over the given times;
 //! * [`JointModel::run_dynamic`]: the semi-implicit Kelvin–Voigt scheme with `dt` and `steps`
 //!   (every body needs a density: a [`KelvinVoigt`] material, [`JointModel::set_density`] or
-//!   [`JointModel::set_dynamic`]);
+//!   [`JointModel::set_dynamic`]; a model with a nonlinear material or finite strain runs the
+//!   scheme of docs/model.md (12.2), each step solved by Newton's method);
 //! * [`JointModel::run`] runs the [`Analysis`] set with [`JointModel::set_analysis`];
 //! * [`JointModel::prepare`] factorises once and returns a [`JointSession`] that re-solves
 //!   the static problem or advances the quasi-static scheme level by level with new loads,
@@ -56,6 +57,7 @@ use synovia_mesh::{BoundaryKind, Mesh, MeshError};
 use synovia_nonlinear::{NewtonParams, NonlinearContact};
 use synovia_time::dynamic::{DynamicBody, DynamicParams, DynamicStepper};
 use synovia_time::history::{pressure, scaled, scaled_traction, LoadHistory, RigidMotion};
+use synovia_time::nonlinear_dynamic::NonlinearDynamicStepper;
 use synovia_time::quasistatic::{QuasiStaticParams, QuasiStaticStepper};
 use synovia_time::results::StepRecord;
 use synovia_time::TimeError;
@@ -978,7 +980,8 @@ impl<const D: usize> JointModel<D> {
     /// (default) or [`Kinematics::FiniteStrain`] (total Lagrangian, the contact geometry on
     /// the deformed configuration). A model with a finite-strain body or a nonlinear material
     /// (no [`Material::linear_stiffness`], e.g. [`synovia_material::neo_hookean`]) is solved by
-    /// the Newton iteration of [`synovia_nonlinear`] (static and quasi-static analyses).
+    /// the Newton iteration of [`synovia_nonlinear`] (static, quasi-static and dynamic analyses;
+    /// the dynamic one by [`synovia_time::nonlinear_dynamic::NonlinearDynamicStepper`]).
     ///
     /// # Errors
     /// Unknown body.
@@ -1204,9 +1207,17 @@ impl<const D: usize> JointModel<D> {
     }
 
     /// The dynamic scheme: `steps` steps of `dt` (records: the initial state and each step).
+    /// Linear models run the semi-implicit Kelvin–Voigt scheme of docs/model.md (7.3) on one
+    /// factorisation; a model with a nonlinear material or finite strain
+    /// ([`JointModel::is_nonlinear`]) runs the same scheme with the internal force `F_int(U)`
+    /// in place of `A⁽⁰⁾ U`, docs/model.md (12.2): every step a nonlinear contact problem
+    /// solved by the Newton iteration with [`JointModel::newton_params`], cut back into half
+    /// steps on failure; the Kelvin–Voigt viscosity stays the linear `C⁽¹⁾ ε(u')`.
     ///
     /// # Errors
-    /// [`JointError::Invalid`] for a body without density; the stepper's errors.
+    /// [`JointError::Invalid`] for a body without density, or rigid bodies with mixed control
+    /// in a nonlinear model; the stepper's errors ([`JointError::Time`], e.g. a step whose
+    /// Newton iteration fails after the cut-backs).
     pub fn run_dynamic(&self, dt: Real, steps: usize) -> Result<RunResult<D>, JointError> {
         self.run_dynamic_with(dt, steps, |_| Ok(()))
     }
@@ -1459,23 +1470,10 @@ impl<const D: usize> JointModel<D> {
     ) -> Result<RunResult<D>, JointError> {
         let start = Instant::now();
         self.model.validate()?;
-        if self.is_nonlinear() {
-            return Err(JointError::Invalid(
-                "the dynamic analysis of nonlinear materials or finite strain is not available yet; use a static or quasi-static analysis".into(),
-            ));
-        }
         let solver = self.build_solver()?;
-        let mut bodies = Vec::with_capacity(self.dynamic.len());
-        for (body, data) in self.model.bodies().iter().zip(&self.dynamic) {
-            match data {
-                Some(d) => bodies.push(d.clone()),
-                None => {
-                    return Err(JointError::Invalid(format!(
-                        "body `{}` has no density for the dynamic analysis (give it a Kelvin-Voigt material or a density)",
-                        body.name
-                    )))
-                }
-            }
+        let bodies = self.dynamic_bodies()?;
+        if self.is_nonlinear() {
+            return self.run_nonlinear_dynamic(dt, steps, &bodies, solver.as_ref(), start, observer);
         }
         let params = self.dynamic_params.clone().with_dt(dt);
         let mut stepper = DynamicStepper::new(&self.model, &bodies, &self.pairs, params)?;
@@ -1529,6 +1527,114 @@ impl<const D: usize> JointModel<D> {
             contact: last.filter(|_| !self.pairs.is_empty()),
             n_dofs: stepper.info().n_dofs,
             contact_nodes: geometry.len(),
+            solver: solver.name().to_string(),
+            setup_s,
+            total_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The dynamic data of every body.
+    fn dynamic_bodies(&self) -> Result<Vec<DynamicBody>, JointError> {
+        let mut bodies = Vec::with_capacity(self.dynamic.len());
+        for (body, data) in self.model.bodies().iter().zip(&self.dynamic) {
+            match data {
+                Some(d) => bodies.push(d.clone()),
+                None => {
+                    return Err(JointError::Invalid(format!(
+                        "body `{}` has no density for the dynamic analysis (give it a Kelvin-Voigt material or a density)",
+                        body.name
+                    )))
+                }
+            }
+        }
+        Ok(bodies)
+    }
+
+    /// The dynamic scheme of a nonlinear model (nonlinear materials or finite strain): each
+    /// step the nonlinear contact problem of docs/model.md (12.2) solved by the Newton
+    /// iteration with the model's [`NewtonParams`], cut back into halves on failure
+    /// ([`synovia_time::nonlinear_dynamic::NonlinearDynamicStepper`]).
+    fn run_nonlinear_dynamic(
+        &self,
+        dt: Real,
+        steps: usize,
+        bodies: &[DynamicBody],
+        solver: &dyn ContactSolver,
+        start: Instant,
+        mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
+    ) -> Result<RunResult<D>, JointError> {
+        if !self.rigid_bodies.is_empty() {
+            return Err(JointError::Invalid(
+                "rigid bodies (mixed control) are not supported with nonlinear materials or finite strain yet; \
+                 prescribe the partner's motion or use a linear material"
+                    .into(),
+            ));
+        }
+        let params = self.dynamic_params.clone().with_dt(dt);
+        let mut stepper = NonlinearDynamicStepper::new(
+            &self.model,
+            bodies,
+            &self.pairs,
+            &self.kinematics,
+            params,
+            self.newton,
+        )?;
+        for (pair, law) in &self.friction_laws {
+            stepper.set_friction_law(pair, law.clone())?;
+        }
+        if self.initial_velocity.iter().any(Option::is_some) {
+            let v: Vec<Vec<Vector<D>>> = self
+                .model
+                .bodies()
+                .iter()
+                .zip(&self.initial_velocity)
+                .map(|(b, v)| vec![v.unwrap_or_else(Vector::<D>::zeros); b.mesh.n_nodes()])
+                .collect();
+            stepper.set_initial_state(&self.model, None, Some(&v))?;
+        }
+        let setup_s = start.elapsed().as_secs_f64();
+        let n_steps = steps + 1;
+        let mut records = Vec::with_capacity(n_steps);
+        let initial = stepper.initial_record();
+        let result = zero_result(stepper.displacement().to_vec(), stepper.geometry().len());
+        observer(&StepView {
+            model: &self.model,
+            geometry: stepper.geometry(),
+            record: &initial,
+            result: &result,
+            n_steps,
+        })?;
+        records.push(initial);
+        let mut last = None;
+        for _ in 0..steps {
+            let record = stepper.step(&self.model, solver)?;
+            let report = stepper.last_report();
+            tracing::debug!(
+                step = record.step,
+                newton = report.newton_iterations,
+                cutbacks = report.cutbacks,
+                "nonlinear dynamic step"
+            );
+            let result = match stepper.last_contact() {
+                Some(r) if !self.pairs.is_empty() => r.clone(),
+                _ => zero_result(stepper.displacement().to_vec(), stepper.geometry().len()),
+            };
+            observer(&StepView {
+                model: &self.model,
+                geometry: stepper.geometry(),
+                record: &record,
+                result: &result,
+                n_steps,
+            })?;
+            records.push(record);
+            last = Some(result);
+        }
+        Ok(RunResult {
+            records,
+            displacement: stepper.displacement().to_vec(),
+            contact: last.filter(|_| !self.pairs.is_empty()),
+            n_dofs: stepper.dofs().n_dofs(),
+            contact_nodes: stepper.geometry().len(),
             solver: solver.name().to_string(),
             setup_s,
             total_s: start.elapsed().as_secs_f64(),
