@@ -24,6 +24,7 @@
 //! model (unknown body or part names, missing data, invalid materials or histories).
 #![warn(missing_docs)]
 
+pub mod compare;
 pub mod gather;
 pub mod outdir;
 pub mod run;
