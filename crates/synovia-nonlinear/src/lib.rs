@@ -1190,6 +1190,14 @@ impl<const D: usize> NonlinearContact<D> {
             k.mul_vec(u_star, &mut k_star);
             let c_star: Vec<Real> = (0..n).map(|i| load[i] - k_star[i]).collect();
             let delta: Vec<Real> = (0..n).map(|i| u_star[i] - u[i]).collect();
+            // a level with extra terms (a time step): a Newton correction below √tol of the
+            // solution is taken whole and ends the iteration — with quadratic convergence the
+            // error left is of the order of its square; this is what ends the iteration when
+            // the residual is at its rounding floor (the cancellation in the stress of tiny
+            // strains, e.g. `μ (I − C⁻¹)`, caps its relative accuracy at `ε_mach / |e|`)
+            let tiny = terms.is_some()
+                && !reuse
+                && norm(&delta) <= self.params.tolerance.sqrt() * norm(u_star).max(Real::MIN_POSITIVE);
             // backtracking line search on ‖R‖ along (δũ, δc); a trial whose residual is already
             // at the tolerance is accepted (no decrease can be asked of rounding noise)
             let settled =
@@ -1211,6 +1219,7 @@ impl<const D: usize> NonlinearContact<D> {
                         if !self.params.line_search
                             || predictor
                             || rebuilt
+                            || tiny
                             || r_try <= settled
                             || r_try <= (1.0 - 1e-4 * alpha) * r_norm
                             || alpha < 1.0 / 64.0
@@ -1218,6 +1227,7 @@ impl<const D: usize> NonlinearContact<D> {
                             forced = self.params.line_search
                                 && !predictor
                                 && !rebuilt
+                                && !tiny
                                 && r_try > settled
                                 && r_try > (1.0 - 1e-4 * alpha) * r_norm;
                             break Some((u_try, c_try, disp_try, f_try, e_try, r_try));
@@ -1291,7 +1301,8 @@ impl<const D: usize> NonlinearContact<D> {
             // the iterate (a residual at rounding level of a level that barely changed)
             let converged = relative <= self.params.tolerance
                 || force_scale == 0.0
-                || (alpha == 1.0 && increment <= self.params.tolerance);
+                || (alpha == 1.0 && increment <= self.params.tolerance)
+                || (tiny && alpha == 1.0);
             // a pass whose geometry is still moving ends at the looser pass tolerance
             let pass_converged = converged
                 || (finite

@@ -194,7 +194,10 @@ fn amplitude_run(a: Real, neo: bool, steps: usize, dt: Real, nx: usize) -> Nodal
         )
         .unwrap();
         st.set_initial_state(&model, Some(&u0), Some(&u1)).unwrap();
-        st.run(&model, &pdas(), steps).unwrap();
+        for _ in 0..steps {
+            st.step(&model, &pdas()).unwrap();
+            assert_eq!(st.last_report().cutbacks, 0, "amplitude {a}: cut-back at step {}", st.step_index());
+        }
         st.displacement().to_vec()
     } else {
         let mut st = DynamicStepper::new(&model, &[kv_body(1.0)], &[], params).unwrap();
@@ -205,10 +208,11 @@ fn amplitude_run(a: Real, neo: bool, steps: usize, dt: Real, nx: usize) -> Nodal
 }
 
 /// (b) Neo-Hookean in finite strain at small amplitude equals the linear scheme, with a
-/// relative difference of first order in the amplitude.
+/// relative difference of first order in the amplitude — down to amplitudes where the stress
+/// of the neo-Hookean law is at its rounding floor (`1e-4`: strains of ≈ 1e-7).
 #[test]
 fn neo_hookean_at_small_amplitude_tends_to_the_linear_scheme() {
-    let amplitudes = [2.0, 1.0, 0.5, 0.25, 0.125];
+    let amplitudes = [2.0, 1.0, 0.5, 0.25, 0.125, 1e-2, 1e-4];
     let diffs: Vec<Real> = amplitudes
         .iter()
         .map(|&a| {
@@ -217,11 +221,15 @@ fn neo_hookean_at_small_amplitude_tends_to_the_linear_scheme() {
             max_diff(&nh, &lin) / max_norm(&lin)
         })
         .collect();
-    let rates: Vec<Real> = diffs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    let rates: Vec<Real> = diffs
+        .windows(2)
+        .zip(amplitudes.windows(2))
+        .map(|(d, a)| (d[0] / d[1]).ln() / (a[0] / a[1]).ln())
+        .collect();
     println!("(b) amplitudes {amplitudes:?}: relative difference neo-Hookean vs linear {diffs:?}, rates {rates:.3?}");
-    assert!(diffs[diffs.len() - 1] < 1e-2);
+    assert!(diffs[diffs.len() - 1] < 1e-5);
     for r in &rates {
-        assert!((r - 1.0).abs() < 0.15, "rate {r}");
+        assert!((r - 1.0).abs() < 0.05, "rate {r}");
     }
 }
 
