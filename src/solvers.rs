@@ -64,6 +64,11 @@ pub fn by_name_with(name: &str, params: ContactParams) -> Result<Box<dyn Contact
         )),
         "dual-mprgp" => Box::new(synovia_uzawa::DualMprgp::new(params)),
         "pdas-fallback" => Box::new(PdasFallback::new(params)),
+        crate::builder::TFETI => {
+            return Err(ContactError::InvalidParameter(format!(
+                "`{name}` is not a solver on the assembled, factorised stiffness: choose it with JointModel::solver(\"{name}\") (scenario `solver.name`), which runs static and quasi-static analyses of the model decomposed into subdomains (JointModel::run_on)"
+            )))
+        }
         _ => {
             return Err(ContactError::InvalidParameter(format!(
                 "unknown contact solver `{name}`; choose one of {SOLVER_NAMES:?} or {COMBINATOR_NAMES:?}"

@@ -556,3 +556,124 @@ impl<const D: usize> JointModel<D> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+    use synovia_contact::operators::PlaneObstacle;
+    use synovia_contact::ExponentialFriction;
+    use synovia_material::plane_strain;
+    use synovia_mesh::generators::{rectangle, Grading};
+    use synovia_mesh::math::Point;
+    use synovia_time::history::PiecewiseLinear;
+    use synovia_time::quasistatic::QuasiStaticParams;
+
+    /// Two blocks tied on top of each other, the lower one pressed onto a rigid flat and sheared
+    /// through the upper one's top (friction 0.4): ties, friction, three quasi-static levels.
+    fn stack(solver: &str, params: QuasiStaticParams, law: bool) -> JointModel<2> {
+        let mut jm = JointModel::<2>::new();
+        let lo = rectangle(-1.0, 1.0, 0.0, 0.5, 12, 3, Grading::Uniform, Grading::Uniform).unwrap();
+        let hi = rectangle(-1.0, 1.0, 0.5, 1.0, 12, 3, Grading::Uniform, Grading::Uniform).unwrap();
+        let a = jm.add_body("lower", lo, plane_strain(1.0, 0.3).unwrap()).unwrap();
+        let b = jm.add_body("upper", hi, plane_strain(3.0, 0.25).unwrap()).unwrap();
+        jm.tie(a, "top", b, "bottom").unwrap();
+        let h = PiecewiseLinear::new(&[(0.0, 0.4), (1.0, 1.0)]).unwrap();
+        jm.prescribe(b, "top", Vector::<2>::new(0.01, -0.02), h).unwrap();
+        let floor = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::y()).unwrap();
+        jm.contact_rigid("floor", a, "bottom", floor, 0.4).unwrap();
+        if law {
+            let exp = ExponentialFriction {
+                static_coefficient: 0.4,
+                kinetic_coefficient: 0.2,
+                characteristic_speed: 0.01,
+            };
+            jm.friction_law("floor", Arc::new(exp)).unwrap();
+        }
+        jm.quasistatic_params(params);
+        jm.solver(solver).unwrap();
+        jm.tfeti(TfetiSettings::new(
+            DecompositionParams::default().with_subdomains(6),
+            TfetiParams::default().with_tolerance(1e-12),
+        ));
+        jm
+    }
+
+    fn max_rel(a: &[Vec<Vector<2>>], b: &[Vec<Vector<2>>]) -> f64 {
+        let (mut d, mut s) = (0.0_f64, 0.0_f64);
+        for (x, y) in a.iter().flatten().zip(b.iter().flatten()) {
+            d = d.max((x - y).amax());
+            s = s.max(x.amax());
+        }
+        d / s
+    }
+
+    #[test]
+    fn tfeti_levels_equal_the_direct_ones() {
+        let times = [0.0, 0.5, 1.0];
+        for (params, law) in [
+            (QuasiStaticParams::default(), false),
+            (QuasiStaticParams::default().with_initial_friction(true), true),
+            (QuasiStaticParams::default().with_coulomb_fixed_point(true), false),
+        ] {
+            let direct = stack("pdas", params, law).run_quasistatic(&times).unwrap();
+            let feti = stack(TFETI, params, law).run_quasistatic(&times).unwrap();
+            assert_eq!(feti.solver, TFETI);
+            assert_eq!(feti.n_dofs, direct.n_dofs);
+            let du = max_rel(&direct.displacement, &feti.displacement);
+            assert!(du < 1e-8, "{params:?} {law}: U differs by {du:e}");
+            for (r, s) in direct.records.iter().zip(&feti.records) {
+                let (p, q) = (&r.pairs[0], &s.pairs[0]);
+                assert!((p.normal_force - q.normal_force).abs() <= 1e-8 * p.normal_force.abs());
+                assert!((p.tangential_force - q.tangential_force).abs() <= 1e-8 * p.normal_force.abs());
+                assert!(p.tangential_force > 0.0 || r.step == 0);
+                assert_eq!(s.solver, TFETI);
+            }
+            let kkt = feti.contact.as_ref().unwrap().kkt.max();
+            assert!(kkt < 1e-8, "{kkt}");
+        }
+    }
+
+    #[test]
+    fn unsupported_features_are_named() {
+        // a body held only by contact (no Dirichlet data)
+        let mut jm = JointModel::<2>::new();
+        let m = rectangle(0.0, 1.0, 0.0, 1.0, 4, 4, Grading::Uniform, Grading::Uniform).unwrap();
+        let b = jm.add_body("puck", m, plane_strain(1.0, 0.3).unwrap()).unwrap();
+        jm.pressure(b, "top", 0.01, synovia_time::history::Constant(1.0)).unwrap();
+        let floor = PlaneObstacle::new(Point::<2>::new(0.0, 0.0), Vector::<2>::y()).unwrap();
+        jm.contact_rigid("floor", b, "bottom", floor, 0.0).unwrap();
+        jm.solver(TFETI).unwrap();
+        let e = jm.run_static(0.0).unwrap_err();
+        assert!(matches!(e, JointError::Unsupported { .. }), "{e}");
+        assert!(
+            e.to_string().contains("bodies held only by contact") && e.to_string().contains("`puck`"),
+            "{e}"
+        );
+        // dynamic analyses, and uses as a ContactSolver
+        let mut jm = stack(TFETI, QuasiStaticParams::default(), false);
+        jm.set_analysis(Analysis::Dynamic { dt: 0.1, steps: 1 });
+        let e = jm.run().unwrap_err();
+        assert!(e.to_string().contains("does not support dynamic analyses"), "{e}");
+        let e = jm.run_dynamic(0.1, 1).unwrap_err();
+        assert!(matches!(e, JointError::Unsupported { .. }), "{e}");
+        assert!(jm.build_solver().is_err() && jm.prepare().is_err());
+        // other solvers do not run on several ranks
+        struct TwoRanks;
+        impl Communicator for TwoRanks {
+            fn rank(&self) -> usize {
+                0
+            }
+            fn size(&self) -> usize {
+                2
+            }
+            fn all_gather(&self, _: &[f64], _: &[usize]) -> Result<Vec<f64>, synovia_feti::FetiError> {
+                Err(synovia_feti::FetiError::Communication("test".into()))
+            }
+        }
+        let mut jm = stack("pdas", QuasiStaticParams::default(), false);
+        jm.set_analysis(Analysis::Static { time: 0.0 });
+        let e = jm.run_on(&TwoRanks, |_| Ok(())).unwrap_err();
+        assert!(e.to_string().contains("the `pdas` solver does not support runs on 2 MPI ranks"), "{e}");
+    }
+}
