@@ -171,10 +171,14 @@ fn main() -> ExitCode {
                         for (p, n) in &info.contact_nodes {
                             println!("  contact pair {p}: {n} contact candidates");
                         }
-                        println!(
-                            "  factorisation: ≈ {} of memory",
-                            synovia::linalg::error::fmt_bytes(info.memory_bytes)
-                        );
+                        if info.solver == synovia::builder::TFETI {
+                            println!("  factorisation: subdomains only (solver tfeti: the whole model is never factorised)");
+                        } else {
+                            println!(
+                                "  factorisation: ≈ {} of memory",
+                                synovia::linalg::error::fmt_bytes(info.memory_bytes)
+                            );
+                        }
                         println!("  ok: {} warning(s)", info.warnings.len());
                     }
                     ExitCode::SUCCESS
