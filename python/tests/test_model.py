@@ -141,6 +141,34 @@ def test_dynamic_run():
     assert r.records[-1]["kinetic_energy"] > 0.0
 
 
+def test_neo_hookean_dynamic_run():
+    """The dynamic scheme with a nonlinear elastic part (Newton iteration per step): at a small
+    load the neo-Hookean block in finite strain moves as the linear one; without a density the
+    run is refused with the body's name."""
+
+    def run(material, load, kinematics=None, density=True):
+        m = synovia.Model(2)
+        nodes, cells, parts = rectangle(0.0, 1.0, 0.0, 1.0, 4, 4)
+        m.add_body("b", nodes, cells, material, parts=parts)
+        if kinematics:
+            m.set_kinematics("b", kinematics)
+        if density:
+            m.set_density("b", 1.0)
+        m.clamp("b", "bottom")
+        m.traction("b", "top", [load, -load])
+        return m.run_dynamic(0.01, 10)
+
+    load = 1e-4
+    lin = run(synovia.Material.plane_strain(E, NU), load)
+    nh = run(synovia.Material.neo_hookean(E, NU), load, "finite")
+    assert len(nh) == 11
+    u_lin, u_nh = lin.displacement("b"), nh.displacement("b")
+    assert np.max(np.abs(u_nh - u_lin)) <= 1e-3 * np.max(np.abs(u_lin))
+    assert nh.records[-1]["kinetic_energy"] == pytest.approx(lin.records[-1]["kinetic_energy"], rel=1e-2)
+    with pytest.raises(synovia.SynoviaError, match="no density"):
+        run(synovia.Material.neo_hookean(E, NU), load, "finite", density=False)
+
+
 def cubes(discretisation, n_upper=2):
     """Two stacked unit cubes, symmetry planes x = 0 and y = 0, the upper top pushed down
     by 0.02: uniaxial stress σ_zz = −E · 0.01 in both."""
