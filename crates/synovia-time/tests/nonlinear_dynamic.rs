@@ -487,3 +487,55 @@ fn bad_input_gives_typed_errors() {
     }
     assert_eq!(st.step_index(), 0);
 }
+
+/// Cut-back: a step whose Newton iteration fails (here: at most `k` iterations per step) is
+/// replaced by halves; with one halving the step equals two steps of `Δt/2` from the same
+/// state (the variable-step form (12.2) with `r = ½`, then `r = 1`).
+#[test]
+fn a_failing_step_is_cut_into_halves() {
+    let mut mesh = rectangle(0.0, 4.0, 0.0, 1.0, 16, 4, Grading::Uniform, Grading::Uniform).unwrap();
+    mesh.set_part_kind("left", BoundaryKind::Clamped).unwrap();
+    let mut model = Model::<2>::new();
+    model.add_body("beam", mesh, Arc::new(neo_hookean(1.0e3, 0.3).unwrap())).unwrap();
+    let nodes = model.bodies()[0].mesh.nodes().to_vec();
+    let u1: Nodal = vec![nodes.iter().map(|x| Vector::<2>::new(0.0, 4.0 * (x[0] / 4.0).powi(2))).collect()];
+    let stepper = |dt: Real, max_it: usize| {
+        let mut st = NonlinearDynamicStepper::new(
+            &model,
+            &[kv_body(1.0)],
+            &[],
+            &[Kinematics::SmallStrain],
+            DynamicParams::new(dt),
+            newton().with_max_iterations(max_it),
+        )
+        .unwrap();
+        st.set_initial_state(&model, None, Some(&u1)).unwrap();
+        st
+    };
+    // at most 3 Newton iterations: Δt = 0.2 fails, and so does Δt/2; Δt/4 converges
+    let (dt, max_it) = (0.2, 3);
+    let mut cut = stepper(dt, max_it);
+    cut.step(&model, &pdas()).unwrap();
+    let report = cut.last_report().clone();
+    assert!(report.cutbacks >= 1, "no cut-back");
+    assert_eq!(report.substeps, 1 << report.cutbacks);
+    assert!((cut.time() - dt).abs() < 1e-15);
+    // the reference: steps of Δt/2^k with a Newton iteration free to converge
+    let k = report.cutbacks;
+    let mut fine = stepper(dt / (1 << k) as Real, 30);
+    for _ in 0..report.substeps {
+        fine.step(&model, &pdas()).unwrap();
+        assert_eq!(fine.last_report().cutbacks, 0);
+    }
+    let d = max_diff(&cut.displacement().to_vec(), &fine.displacement().to_vec())
+        / max_norm(&fine.displacement().to_vec());
+    let dv = max_diff(&cut.velocity(), &fine.velocity()) / max_norm(&fine.velocity());
+    println!(
+        "(cut-back) Δt = {dt} with at most {max_it} Newton iterations: {k} halvings, {} sub-steps; vs {} steps of Δt/{}: displacement {d:.2e}, velocity {dv:.2e}",
+        report.substeps,
+        report.substeps,
+        1 << k
+    );
+    assert!(d < 1e-10 && dv < 1e-10, "{d:e} {dv:e}");
+    assert_eq!(cut.step_index(), 1);
+}
