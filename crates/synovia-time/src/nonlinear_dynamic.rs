@@ -154,11 +154,14 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
     /// Validates the data, assembles `M̃_ρ` and `M̃_α + Ã⁽¹⁾` on the tangent's pattern, sets up
     /// the Newton iteration ([`NonlinearContact::with_constant_matrix`] with
     /// `B = (M̃_ρ + Δt (M̃_α + Ã⁽¹⁾))/Δt²`) and starts at rest at the lifts of `t_0`
-    /// ([`Self::set_initial_state`]). One [`Kinematics`] per body.
+    /// ([`Self::set_initial_state`]). One [`Kinematics`] per body. Of the
+    /// [`DynamicParams`], `dt`, `t0`, `mass`, `ordering` and `load_degree` apply (the Newton
+    /// iteration always warm-starts its contact solves).
     ///
     /// # Errors
     /// [`TimeError::InvalidParameter`] for invalid parameters or body data (a density that is
-    /// not positive, a viscosity that is not symmetric positive semi-definite, wrong counts);
+    /// not positive, a viscosity that is not symmetric positive semi-definite, wrong counts,
+    /// `coulomb_iterations > 0`);
     /// [`TimeError::Nonlinear`] for the set-up of the Newton iteration (invalid
     /// [`NewtonParams`], contact pairs).
     pub fn new(
@@ -183,6 +186,15 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
         for (b, data) in model.bodies().iter().zip(bodies) {
             data.check(&b.name, nv)?;
         }
+        if params.coulomb_iterations > 0 {
+            return Err(TimeError::InvalidParameter(
+                "the Coulomb fixed point per step (coulomb_iterations > 0) is not available with a nonlinear \
+                 elastic part: friction is Tresca with the slip bound of the previous level"
+                    .into(),
+            ));
+        }
+        // the loads of the Newton iteration with the stepper's quadrature
+        let newton = newton.with_load_degree(params.load_degree);
         let zero_c = DMatrix::<Real>::zeros(nv, nv);
         let c1: Vec<DMatrix<Real>> =
             bodies.iter().map(|b| b.viscous.clone().unwrap_or_else(|| zero_c.clone())).collect();

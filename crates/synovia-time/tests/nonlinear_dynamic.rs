@@ -469,6 +469,15 @@ fn bad_input_gives_typed_errors() {
     assert!(
         matches!(make(bad_c1, &fs, 0.1, newton()), Err(TimeError::InvalidParameter(m)) if m.contains("viscosity"))
     );
+    let coulomb = NonlinearDynamicStepper::new(
+        &model,
+        std::slice::from_ref(&ok),
+        &[],
+        &fs,
+        DynamicParams::new(0.1).with_coulomb_iterations(3),
+        newton(),
+    );
+    assert!(matches!(coulomb, Err(TimeError::InvalidParameter(m)) if m.contains("Coulomb")));
     let mut st = make(ok, &fs, 0.1, newton()).unwrap();
     assert!(matches!(
         st.set_initial_state(&model, Some(&[vec![Vector::<2>::zeros(); 2]]), None),
