@@ -145,7 +145,10 @@ fn init_logging(verbose: u8, quiet: bool) {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let quiet = cli.quiet;
-    init_logging(cli.verbose, quiet);
+    // `run` installs the logger once it knows its MPI rank (the other ranks log errors only)
+    if !matches!(cli.command, Command::Run { .. }) {
+        init_logging(cli.verbose, quiet);
+    }
     match cli.command {
         Command::Check { scenario } => {
             let checked =
@@ -225,6 +228,7 @@ fn main() -> ExitCode {
             let ranks = Ranks { comm: synovia::feti::SingleProcess };
             // only rank 0 reports (every rank computes the same results)
             let quiet = quiet || ranks.comm.rank() != 0;
+            init_logging(cli.verbose, quiet);
             let sc = match Scenario::from_file(&scenario) {
                 Ok(sc) => sc,
                 Err(e) => {
