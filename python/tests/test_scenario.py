@@ -35,6 +35,7 @@ def check_against_rust(path, ref, result):
         "cattaneo_mindlin2d.toml",
         "tibial_plateau2d.toml",
         "dynamic_drop2d.toml",
+        "dynamic_drop2d_neo_hookean.toml",
         "gmsh_block2d.toml",
         "hertz3d.toml",
     ],
