@@ -29,6 +29,10 @@
 //!   [`JointModel::set_dynamic`]; a model with a nonlinear material or finite strain runs the
 //!   scheme of docs/model.md (12.2), each step solved by Newton's method);
 //! * [`JointModel::run`] runs the [`Analysis`] set with [`JointModel::set_analysis`];
+//! * [`JointModel::run_on`] runs it with the solver [`TFETI`] on the ranks of a
+//!   [`Communicator`](synovia_feti::Communicator) (one process or MPI ranks): the model is
+//!   decomposed into subdomains and never factorised whole (static and quasi-static analyses;
+//!   `builder/tfeti.rs`, docs/scale-out.md);
 //! * [`JointModel::prepare`] factorises once and returns a [`JointSession`] that re-solves
 //!   the static problem or advances the quasi-static scheme level by level with new loads,
 //!   warm-started, without refactorising (navigation; see [`crate::session`]).
