@@ -385,7 +385,7 @@ impl<const D: usize> JointModel<D> {
     /// subdomains it owns; only interface data travel). Collective: every rank builds the same
     /// model and calls it; every rank gets the same result (bitwise, for any number of ranks:
     /// docs/scale-out.md) and its observer is called after every step — a program writes
-    /// output on one rank only. With one process ([`SingleProcess`]) it is
+    /// output on one rank only. With one process ([`SingleProcess`](synovia_feti::SingleProcess)) it is
     /// [`JointModel::run_with`].
     ///
     /// # Errors
