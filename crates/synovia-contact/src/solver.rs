@@ -104,4 +104,15 @@ pub trait ContactSolver {
         problem: &ContactProblem<'_>,
         context: &SolveContext,
     ) -> Result<ContactSolution, ContactError>;
+
+    /// The solver's single active-set update, as a solver of its own: one semismooth Newton
+    /// step of the contact conditions from the warm start's displacement and multipliers,
+    /// returned whether or not it solves the problem (its report's one history entry says
+    /// how far it is: `set_changes` and the NCP residuals after the step). Used by a caller
+    /// that iterates on the sets itself, e.g. the `Combined` active-set strategy of
+    /// `synovia-nonlinear`. `None` (the default) for a solver without such a step; `synovia-pdas`'s
+    /// `Pdas` returns its `PdasStep`.
+    fn active_set_step(&self) -> Option<Box<dyn ContactSolver>> {
+        None
+    }
 }

@@ -133,6 +133,33 @@ pub struct NewtonParams {
     /// geometry has not settled yet (default `None`: [`Self::tolerance`]); the last pass is
     /// always converged to [`Self::tolerance`].
     pub geometry_pass_tolerance: Option<Real>,
+    /// How the contact's active sets are iterated against the material's Newton iteration
+    /// (default [`ActiveSetStrategy::Nested`]).
+    pub active_sets: ActiveSetStrategy,
+}
+
+/// How the active sets of the contact conditions (contact/no contact, stick/slip) are found
+/// relative to the Newton iteration of the material (docs/nonlinear.md, "Active sets and the
+/// Newton iteration").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ActiveSetStrategy {
+    /// Each Newton iteration solves its linearised contact problem to convergence with the
+    /// contact solver (PDAS: its semismooth Newton iterated until the sets settle),
+    /// warm-started from the previous iteration's multipliers: the contact's Newton nested
+    /// inside the material's. Works with any [`ContactSolver`] (default).
+    #[default]
+    Nested,
+    /// One semismooth Newton iteration on the whole nonsmooth system: each Newton iteration
+    /// takes a single active-set step of the contact solver
+    /// ([`ContactSolver::active_set_step`], e.g. `synovia_pdas::PdasStep`) — the sets
+    /// classified from the current iterate's multipliers and gaps `(ν_k, C ũ_k − d)` (in 3D
+    /// the slip rows linearised at `ζ_k`), the linearised problem solved once on them. The
+    /// iteration ends when the equilibrium residual is at [`NewtonParams::tolerance`] **and**
+    /// the last step left the sets unchanged with its complementarity residuals at the same
+    /// tolerance, so the result satisfies the contact conditions. Needs a contact solver with
+    /// an active-set step ([`NonlinearError::InvalidParameter`] otherwise) and is not
+    /// available under load control ([`NonlinearContact::step_controlled`]).
+    Combined,
 }
 
 /// When a finite-strain solve rebuilds the contact geometry on the deformed configuration.
@@ -173,6 +200,7 @@ impl Default for NewtonParams {
             tangent_reuse: None,
             geometry_aitken: false,
             geometry_pass_tolerance: None,
+            active_sets: ActiveSetStrategy::Nested,
         }
     }
 }
@@ -232,6 +260,11 @@ impl NewtonParams {
     /// Sets [`Self::load_degree`].
     pub fn with_load_degree(mut self, load_degree: usize) -> Self {
         self.load_degree = load_degree;
+        self
+    }
+    /// Sets [`Self::active_sets`].
+    pub fn with_active_sets(mut self, strategy: ActiveSetStrategy) -> Self {
+        self.active_sets = strategy;
         self
     }
     /// Sets [`Self::max_cutbacks`].
@@ -928,6 +961,25 @@ impl<const D: usize> NonlinearContact<D> {
         (StaticContactResult<D>, Real, Vec<NewtonIteration>, Vec<Real>, Vec<Real>, Real),
         NonlinearError,
     > {
+        // the contact solve of an iteration: the solver itself, or its single active-set step
+        let step_solver = match self.params.active_sets {
+            ActiveSetStrategy::Nested => None,
+            ActiveSetStrategy::Combined => {
+                if control.is_some() {
+                    return Err(NonlinearError::InvalidParameter(
+                        "the Combined active-set strategy is not available under load control; use ActiveSetStrategy::Nested".into(),
+                    ));
+                }
+                Some(solver.active_set_step().ok_or_else(|| {
+                    NonlinearError::InvalidParameter(format!(
+                        "the Combined active-set strategy needs a contact solver with an active-set step (e.g. PDAS); `{}` has none",
+                        solver.name()
+                    ))
+                })?)
+            }
+        };
+        let combined = step_solver.is_some();
+        let solver: &dyn ContactSolver = step_solver.as_deref().unwrap_or(solver);
         let mut t = t;
         let n = self.dofs.n_dofs();
         let mut lifts: Vec<Vector<D>> = self.dofs.lifts(model, t)?.into_iter().map(|l| l * scale).collect();
@@ -1299,13 +1351,23 @@ impl<const D: usize> NonlinearContact<D> {
             }
             // converged: the residual at the tolerance, or a full step that no longer moves
             // the iterate (a residual at rounding level of a level that barely changed)
-            let converged = relative <= self.params.tolerance
-                || force_scale == 0.0
-                || (alpha == 1.0 && increment <= self.params.tolerance)
-                || (tiny && alpha == 1.0);
+            // Combined: the last active-set step left its sets unchanged and solved the
+            // complementarity conditions (the slip rows of 3D are linearised in a step)
+            let contact_settled = !combined
+                || result.solution.report.history.last().is_some_and(|h| {
+                    h.set_changes == 0
+                        && h.normal <= self.params.tolerance
+                        && h.tangential <= self.params.tolerance
+                });
+            let converged = contact_settled
+                && (relative <= self.params.tolerance
+                    || force_scale == 0.0
+                    || (alpha == 1.0 && increment <= self.params.tolerance)
+                    || (tiny && alpha == 1.0));
             // a pass whose geometry is still moving ends at the looser pass tolerance
             let pass_converged = converged
                 || (finite
+                    && contact_settled
                     && pass_increment > self.params.geometry_tolerance
                     && self.params.geometry_pass_tolerance.is_some_and(|p| relative <= p));
             // a converged pass ends the level when the geometry it started from was already
@@ -1331,6 +1393,12 @@ impl<const D: usize> NonlinearContact<D> {
             }
             let done = converged && geometry_settled;
             warm = Some(result.solution.clone());
+            if combined {
+                // the next step's sets come from the iterate reached (after the line search)
+                if let Some(w) = warm.as_mut() {
+                    w.u.clone_from(&u);
+                }
+            }
             if done {
                 let mut result = result;
                 result.displacement = disp;

@@ -126,5 +126,5 @@ mod pdas;
 mod sets;
 
 pub use aupdas::AuPdas;
-pub use pdas::{Pdas, PdasTrace, CYCLE_WINDOW};
+pub use pdas::{Pdas, PdasStep, PdasTrace, CYCLE_WINDOW};
 pub use synovia_contact::{ContactError, ContactParams, ContactSolution, ContactSolver, SolverReport};

@@ -125,7 +125,8 @@ impl Pdas {
             stagnation: false,
         };
         let mut last_nu = None;
-        trace.result = self.iterate(problem, context, stop_on_cycling, &mut trace, &mut last_nu);
+        trace.result =
+            self.iterate(problem, context, stop_on_cycling, Mode::Converge, &mut trace, &mut last_nu);
         if let Some((nu, u)) = last_nu {
             let (lambda_n, lambda_t) = problem.split_multipliers(&nu);
             trace.last_iterate =
@@ -140,14 +141,24 @@ impl Pdas {
         problem: &ContactProblem<'_>,
         context: &SolveContext,
         stop_on_cycling: bool,
+        mode: Mode,
         trace: &mut PdasTrace,
         last_nu: &mut Option<(Vec<f64>, Vec<f64>)>,
     ) -> Result<ContactSolution, ContactError> {
         let start = Instant::now();
-        let name = "pdas";
+        let name = match mode {
+            Mode::Converge => "pdas",
+            Mode::Step => "pdas-step",
+        };
         let mut st = State::new(problem, context, &self.params)?;
         let mut nu = st.initial_nu(problem, context.warm_start())?;
         let mut y = st.values(&nu)?;
+        if mode == Mode::Step {
+            // the sets of the step from the warm start's own interface values `C U`
+            if let Some(u) = context.warm_start().map(|w| &w.u).filter(|u| u.len() == problem.load.len()) {
+                y = problem.apply(u);
+            }
+        }
         let mut sets =
             Sets { normal: st.classify_normal(&nu, &y, None), cells: st.classify_cells(&nu, &y, None) };
         let mut history = Vec::new();
@@ -212,7 +223,8 @@ impl Pdas {
                     recent.pop_front();
                 }
                 sets = new_sets;
-                let converged = (set_changes == 0 && normal <= tol && tangential <= tol)
+                let converged = mode == Mode::Step
+                    || (set_changes == 0 && normal <= tol && tangential <= tol)
                     || stalled_but_kkt_converged(&mut st, problem, &nu, &history, tol)?;
                 if converged {
                     let report = SolverReport {
@@ -247,6 +259,77 @@ impl Pdas {
     }
 }
 
+/// Whether [`Pdas`] iterates to convergence or takes one active-set step ([`PdasStep`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Converge,
+    Step,
+}
+
+/// One active-set update of [`Pdas`]: a single semismooth Newton step of the contact
+/// conditions, for a caller that iterates on the sets itself (the `Combined` active-set
+/// strategy of `synovia-nonlinear`, where one Newton iteration updates the material and the
+/// contact sets together).
+///
+/// From the warm start `(U⁰, ν⁰)` (or `U⁰ = A⁻¹ F`, `ν⁰ = 0` without one) it computes the
+/// sets of [`Pdas`] step 1 from the warm start's **own** interface values `y⁰ = C U⁰` —
+/// `𝒜_n = {r : ν⁰_r + ρ_r (y⁰_r − d_r) > 0}`, stick/slip from
+/// `ζ_c = Λ⁰_t,c + ρ_c (y⁰_c − s_c)` — solves the linear interface system of [`Pdas`] step 2
+/// for those sets once (the 3D slip rows linearised at `ζ_c`), and returns
+/// `ν¹`, `U¹ = A⁻¹ (F − Cᵀ ν¹)` whether or not it solves the contact problem. Its report has
+/// `iterations = 1` and one history entry: the sets computed from `(ν¹, C U¹)` differ from
+/// the step's in `set_changes` rows/cells, and `normal`, `tangential` are the relative NCP
+/// residuals of [`Pdas`] at `(ν¹, C U¹)`. `U¹` solves the problem exactly when
+/// `set_changes = 0` and both residuals vanish (in 2D `set_changes = 0` suffices; in 3D the
+/// slip rows are linearised and need further steps).
+///
+/// With `U⁰ = A⁻¹ (F − Cᵀ ν⁰)` (the warm start a previous [`Pdas`] step on the same
+/// problem returns) this is exactly one iteration of [`Pdas`]. In a Newton iteration on a
+/// nonlinear material the warm start is the current iterate, `C U⁰ − d` its gap, and the
+/// step is a semismooth Newton step of the whole nonsmooth system.
+///
+/// Only `params.tolerance` and `params.rho_scale` are used (the iteration limit is 1).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PdasStep {
+    /// The parameters of the [`Pdas`] iteration the step is taken from.
+    pub params: ContactParams,
+}
+
+impl PdasStep {
+    /// The step of [`Pdas`] with the given parameters.
+    pub fn new(params: ContactParams) -> Self {
+        Self { params }
+    }
+}
+
+impl ContactSolver for PdasStep {
+    fn name(&self) -> &str {
+        "pdas-step"
+    }
+
+    fn solve(
+        &self,
+        problem: &ContactProblem<'_>,
+        context: &SolveContext,
+    ) -> Result<ContactSolution, ContactError> {
+        let mut params = self.params;
+        params.max_iterations = 1;
+        let pdas = Pdas::new(params);
+        let mut trace = PdasTrace {
+            result: Ok(empty_solution()),
+            last_iterate: None,
+            cycle_period: None,
+            stagnation: false,
+        };
+        let mut last_nu = None;
+        pdas.iterate(problem, context, false, Mode::Step, &mut trace, &mut last_nu)
+    }
+
+    fn active_set_step(&self) -> Option<Box<dyn ContactSolver>> {
+        Some(Box::new(*self))
+    }
+}
+
 fn empty_solution() -> ContactSolution {
     ContactSolution {
         u: Vec::new(),
@@ -267,5 +350,9 @@ impl ContactSolver for Pdas {
         context: &SolveContext,
     ) -> Result<ContactSolution, ContactError> {
         self.solve_traced(problem, context, false).result
+    }
+
+    fn active_set_step(&self) -> Option<Box<dyn ContactSolver>> {
+        Some(Box::new(PdasStep::new(self.params)))
     }
 }
