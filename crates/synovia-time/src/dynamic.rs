@@ -551,32 +551,8 @@ impl<const D: usize> DynamicStepper<D> {
             }
         }
         let dt = self.params.dt;
-        let lifts0 = self.dofs().lifts(model, self.params.t0)?;
-        let n = self.dofs().n_dofs();
-        let mut u0 = vec![0.0; n];
-        let mut um1 = vec![0.0; n];
-        let mut lifts_m1 = vec![Vector::<D>::zeros(); self.dofs().groups().len()];
-        for (gi, grp) in self.dofs().groups().iter().enumerate() {
-            let (body, node) = grp.origin;
-            let x0 = displacement.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
-            let v0 = velocity.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
-            // U^0 = u_p(t0) + N Nᵀ u₀
-            let mut full0 = lifts0[gi];
-            for k in 0..grp.n_dofs {
-                let c = grp.basis[k].dot(&x0);
-                u0[grp.first_dof + k] = c;
-                full0 += grp.basis[k] * c;
-            }
-            // U^{-1} = U^0 − Δt u₁, split into N Nᵀ part and the rest (the lift of level −1)
-            let wm1 = full0 - v0 * dt;
-            let mut free = Vector::<D>::zeros();
-            for k in 0..grp.n_dofs {
-                let c = grp.basis[k].dot(&wm1);
-                um1[grp.first_dof + k] = c;
-                free += grp.basis[k] * c;
-            }
-            lifts_m1[gi] = wm1 - free;
-        }
+        let InitialLevels { u0, um1, lifts0, lifts_m1 } =
+            initial_levels(model, self.dofs(), self.params.t0, dt, displacement, velocity)?;
         self.disp = self.dofs().expand(&u0, &lifts0)?;
         self.disp_prev = self.dofs().expand(&um1, &lifts_m1)?;
         self.u = u0;
@@ -942,32 +918,7 @@ impl<const D: usize> DynamicStepper<D> {
 
     /// `Σ_T v_Tᵀ K_T v_T` over all cells for a full nodal field.
     fn full_form(&self, model: &Model<D>, v: &[Vec<Vector<D>>], kernel: Kernel) -> Real {
-        let nl = D * (D + 1);
-        let mut ke = [0.0; KE_MAX];
-        let mut total = 0.0;
-        for (bi, body) in model.bodies().iter().enumerate() {
-            for c in 0..body.mesh.n_cells() {
-                let cell = body.mesh.cell(c);
-                let mut x = [0.0; 12];
-                let mut nz = false;
-                for (a, &i) in cell.iter().enumerate() {
-                    for k in 0..D {
-                        x[D * a + k] = v[bi][i][k];
-                        nz |= v[bi][i][k] != 0.0;
-                    }
-                }
-                if !nz {
-                    continue;
-                }
-                let Some(geo) = SimplexGeometry::new(&body.mesh.cell_points(c)) else { continue };
-                self.element_kernel(kernel, bi, &geo, &mut ke[..nl * nl]);
-                for p in 0..nl {
-                    let row: Real = (0..nl).map(|q| ke[p * nl + q] * x[q]).sum();
-                    total += x[p] * row;
-                }
-            }
-        }
-        total
+        full_form(model, v, |bi, geo, out| self.element_kernel(kernel, bi, geo, out))
     }
 
     /// Current step index `i` (0 = initial state).
@@ -1142,6 +1093,95 @@ fn add_into(a: &mut [Real], b: &[Real]) {
     for (x, y) in a.iter_mut().zip(b) {
         *x += y;
     }
+}
+
+/// The two starting levels of the scheme from an initial displacement `u₀` and velocity `u₁`
+/// (docs/model.md (7.9)), node by node: `U⁰ = u_p(t₀) + N Nᵀ u₀` and `U⁻¹ = U⁰ − Δt u₁`, the
+/// latter split into its reduced part `N Nᵀ U⁻¹` and the rest (the lift of level −1). Shared by
+/// the linear [`DynamicStepper`] and [`crate::nonlinear_dynamic::NonlinearDynamicStepper`].
+pub(crate) struct InitialLevels<const D: usize> {
+    /// Reduced `U⁰`.
+    pub u0: Vec<Real>,
+    /// Reduced `U⁻¹`.
+    pub um1: Vec<Real>,
+    /// Lifts of level 0, `u_p(t₀)` per dof group.
+    pub lifts0: Vec<Vector<D>>,
+    /// Lifts of level −1, `U⁻¹ − N Nᵀ U⁻¹` per dof group.
+    pub lifts_m1: Vec<Vector<D>>,
+}
+
+/// [`InitialLevels`] of `dofs` at `t0` with the step `dt` (zero fields where `None`).
+///
+/// # Errors
+/// [`TimeError::Fem`] when the prescribed displacements cannot be evaluated at `t0`.
+pub(crate) fn initial_levels<const D: usize>(
+    model: &Model<D>,
+    dofs: &DofMap<D>,
+    t0: Real,
+    dt: Real,
+    displacement: Option<&[Vec<Vector<D>>]>,
+    velocity: Option<&[Vec<Vector<D>>]>,
+) -> Result<InitialLevels<D>, TimeError> {
+    let lifts0 = dofs.lifts(model, t0)?;
+    let n = dofs.n_dofs();
+    let mut u0 = vec![0.0; n];
+    let mut um1 = vec![0.0; n];
+    let mut lifts_m1 = vec![Vector::<D>::zeros(); dofs.groups().len()];
+    for (gi, grp) in dofs.groups().iter().enumerate() {
+        let (body, node) = grp.origin;
+        let x0 = displacement.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
+        let v0 = velocity.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
+        // U^0 = u_p(t0) + N Nᵀ u₀
+        let mut full0 = lifts0[gi];
+        for k in 0..grp.n_dofs {
+            let c = grp.basis[k].dot(&x0);
+            u0[grp.first_dof + k] = c;
+            full0 += grp.basis[k] * c;
+        }
+        // U^{-1} = U^0 − Δt u₁, split into N Nᵀ part and the rest (the lift of level −1)
+        let wm1 = full0 - v0 * dt;
+        let mut free = Vector::<D>::zeros();
+        for k in 0..grp.n_dofs {
+            let c = grp.basis[k].dot(&wm1);
+            um1[grp.first_dof + k] = c;
+            free += grp.basis[k] * c;
+        }
+        lifts_m1[gi] = wm1 - free;
+    }
+    Ok(InitialLevels { u0, um1, lifts0, lifts_m1 })
+}
+/// `Σ_T v_Tᵀ K_T v_T` over all cells of a full nodal field with the element kernel `kernel`.
+pub(crate) fn full_form<const D: usize>(
+    model: &Model<D>,
+    v: &[Vec<Vector<D>>],
+    kernel: impl Fn(usize, &SimplexGeometry<D>, &mut [Real]),
+) -> Real {
+    let nl = D * (D + 1);
+    let mut ke = [0.0; KE_MAX];
+    let mut total = 0.0;
+    for (bi, body) in model.bodies().iter().enumerate() {
+        for c in 0..body.mesh.n_cells() {
+            let cell = body.mesh.cell(c);
+            let mut x = [0.0; 12];
+            let mut nz = false;
+            for (a, &i) in cell.iter().enumerate() {
+                for k in 0..D {
+                    x[D * a + k] = v[bi][i][k];
+                    nz |= v[bi][i][k] != 0.0;
+                }
+            }
+            if !nz {
+                continue;
+            }
+            let Some(geo) = SimplexGeometry::new(&body.mesh.cell_points(c)) else { continue };
+            kernel(bi, &geo, &mut ke[..nl * nl]);
+            for p in 0..nl {
+                let row: Real = (0..nl).map(|q| ke[p * nl + q] * x[q]).sum();
+                total += x[p] * row;
+            }
+        }
+    }
+    total
 }
 
 pub(crate) fn all_zero<const D: usize>(v: &[Vector<D>]) -> bool {

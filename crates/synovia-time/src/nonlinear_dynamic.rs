@@ -67,7 +67,8 @@ use synovia_mesh::math::{Real, Vector};
 use synovia_nonlinear::{LevelTerms, NewtonParams, NewtonReport, NonlinearContact, NonlinearError};
 
 use crate::dynamic::{
-    all_zero, check_nodal, nodal_diff, DynamicBody, DynamicParams, EnergyBalance, MassKind,
+    all_zero, check_nodal, full_form, initial_levels, nodal_diff, DynamicBody, DynamicParams, EnergyBalance,
+    InitialLevels, MassKind,
 };
 use crate::error::TimeError;
 use crate::quasistatic::friction_dissipation;
@@ -297,29 +298,8 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
         }
         let dt = self.params.dt;
         let t0 = self.params.t0;
-        let lifts0 = self.dofs().lifts(model, t0)?;
-        let n = self.dofs().n_dofs();
-        let (mut u0, mut um1) = (vec![0.0; n], vec![0.0; n]);
-        let mut lifts_m1 = vec![Vector::<D>::zeros(); self.dofs().groups().len()];
-        for (gi, grp) in self.dofs().groups().iter().enumerate() {
-            let (body, node) = grp.origin;
-            let x0 = displacement.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
-            let v0 = velocity.map_or(Vector::<D>::zeros(), |f| f[body.0][node]);
-            let mut full0 = lifts0[gi];
-            for k in 0..grp.n_dofs {
-                let c = grp.basis[k].dot(&x0);
-                u0[grp.first_dof + k] = c;
-                full0 += grp.basis[k] * c;
-            }
-            let wm1 = full0 - v0 * dt;
-            let mut free = Vector::<D>::zeros();
-            for k in 0..grp.n_dofs {
-                let c = grp.basis[k].dot(&wm1);
-                um1[grp.first_dof + k] = c;
-                free += grp.basis[k] * c;
-            }
-            lifts_m1[gi] = wm1 - free;
-        }
+        let InitialLevels { u0, um1, lifts0, lifts_m1 } =
+            initial_levels(model, self.dofs(), t0, dt, displacement, velocity)?;
         self.disp = self.dofs().expand(&u0, &lifts0)?;
         self.disp_prev = self.dofs().expand(&um1, &lifts_m1)?;
         let (_, energy) =
@@ -710,38 +690,4 @@ fn damping_kernel<const D: usize>(
         stiffness_into(geo, c1, &mut k1[..nn]);
         out[..nn].iter_mut().zip(&k1[..nn]).for_each(|(o, k)| *o += k);
     }
-}
-
-/// `Σ_T v_Tᵀ K_T v_T` over all cells of a full nodal field with the element kernel `kernel`.
-fn full_form<const D: usize>(
-    model: &Model<D>,
-    v: &[Vec<Vector<D>>],
-    kernel: impl Fn(usize, &SimplexGeometry<D>, &mut [Real]),
-) -> Real {
-    let nl = D * (D + 1);
-    let mut ke = [0.0; KE_MAX];
-    let mut total = 0.0;
-    for (bi, body) in model.bodies().iter().enumerate() {
-        for c in 0..body.mesh.n_cells() {
-            let cell = body.mesh.cell(c);
-            let mut x = [0.0; 12];
-            let mut nz = false;
-            for (a, &i) in cell.iter().enumerate() {
-                for k in 0..D {
-                    x[D * a + k] = v[bi][i][k];
-                    nz |= v[bi][i][k] != 0.0;
-                }
-            }
-            if !nz {
-                continue;
-            }
-            let Some(geo) = SimplexGeometry::new(&body.mesh.cell_points(c)) else { continue };
-            kernel(bi, &geo, &mut ke[..nl * nl]);
-            for p in 0..nl {
-                let row: Real = (0..nl).map(|q| ke[p * nl + q] * x[q]).sum();
-                total += x[p] * row;
-            }
-        }
-    }
-    total
 }
