@@ -1484,14 +1484,7 @@ impl<const D: usize> JointModel<D> {
         for (pair, law) in &self.friction_laws {
             stepper.set_friction_law(pair, law.clone())?;
         }
-        if self.initial_velocity.iter().any(Option::is_some) {
-            let v: Vec<Vec<Vector<D>>> = self
-                .model
-                .bodies()
-                .iter()
-                .zip(&self.initial_velocity)
-                .map(|(b, v)| vec![v.unwrap_or_else(Vector::<D>::zeros); b.mesh.n_nodes()])
-                .collect();
+        if let Some(v) = self.initial_velocity_field() {
             stepper.set_initial_state(&self.model, None, Some(&v))?;
         }
         let setup_s = start.elapsed().as_secs_f64();
@@ -1534,6 +1527,19 @@ impl<const D: usize> JointModel<D> {
             solver: solver.name().to_string(),
             setup_s,
             total_s: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The nodal initial velocity of every body (each body's uniform velocity, zero for bodies
+    /// without one), or `None` when no body has one.
+    fn initial_velocity_field(&self) -> Option<Vec<Vec<Vector<D>>>> {
+        self.initial_velocity.iter().any(Option::is_some).then(|| {
+            self.model
+                .bodies()
+                .iter()
+                .zip(&self.initial_velocity)
+                .map(|(b, v)| vec![v.unwrap_or_else(Vector::<D>::zeros); b.mesh.n_nodes()])
+                .collect()
         })
     }
 
@@ -1586,14 +1592,7 @@ impl<const D: usize> JointModel<D> {
         for (pair, law) in &self.friction_laws {
             stepper.set_friction_law(pair, law.clone())?;
         }
-        if self.initial_velocity.iter().any(Option::is_some) {
-            let v: Vec<Vec<Vector<D>>> = self
-                .model
-                .bodies()
-                .iter()
-                .zip(&self.initial_velocity)
-                .map(|(b, v)| vec![v.unwrap_or_else(Vector::<D>::zeros); b.mesh.n_nodes()])
-                .collect();
+        if let Some(v) = self.initial_velocity_field() {
             stepper.set_initial_state(&self.model, None, Some(&v))?;
         }
         let setup_s = start.elapsed().as_secs_f64();
