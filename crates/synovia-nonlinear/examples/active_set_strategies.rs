@@ -135,6 +135,18 @@ fn run<const D: usize>(
     let results: Vec<NonlinearResult<D>> =
         nl.run(model, &times, &counting, |_| Ok::<(), NonlinearError>(()))?;
     let wall = start.elapsed().as_secs_f64();
+    if std::env::var_os("ASM_TRACE").is_some() {
+        // the Newton iterations of each level's last solve: (residual, step α, active rows)
+        for (k, r) in results.iter().enumerate() {
+            let it: Vec<String> = r
+                .report
+                .iterations
+                .iter()
+                .map(|i| format!("{:.1e}/{}/{}", i.residual, i.step, i.active))
+                .collect();
+            eprintln!("{label} level {k}: {}", it.join(" "));
+        }
+    }
     let newton: usize = results.iter().map(|r| r.report.total_iterations).sum();
     let factorisations: usize = results.iter().map(|r| r.report.factorisations).sum();
     let cutbacks: usize = results.iter().map(|r| r.report.cutbacks).sum();
