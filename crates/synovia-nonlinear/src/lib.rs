@@ -20,7 +20,8 @@
 //! `F̄ = F_ext − F_int(u_k) + K_T(u_k) ũ_k` — solved by any [`ContactSolver`] (PDAS, the
 //! semismooth Newton of the contact conditions, warm-started from the previous iteration's
 //! multipliers, so the two Newton methods run nested: the material's outside, the contact's
-//! inside). With small-strain contact the constraints are linear in `u`, so the iteration is
+//! inside; [`ActiveSetStrategy`] offers one semismooth Newton iteration on the whole system,
+//! or the sets iterated around Newton, instead). With small-strain contact the constraints are linear in `u`, so the iteration is
 //! Newton's method (sequential quadratic programming) on the whole nonsmooth system. With
 //! finite strain the contact geometry (re-pairing, normals, gaps in total form) is that of the
 //! deformed configuration: it is frozen during a pass of Newton iterations — each pass is
@@ -160,6 +161,17 @@ pub enum ActiveSetStrategy {
     /// an active-set step ([`NonlinearError::InvalidParameter`] otherwise) and is not
     /// available under load control ([`NonlinearContact::step_controlled`]).
     Combined,
+    /// Active sets around Newton: the sets (and in 3D the slip linearisation) are fixed —
+    /// classified by the active-set step from an anchor `(ν_o, ũ_o)`, the level's starting
+    /// state — while the material's Newton iteration converges the equilibrium residual to
+    /// [`NewtonParams::tolerance`] with the contact rows of those sets (equalities on the
+    /// active and sticking rows, the slip forces of the slipping cells); then the converged
+    /// iterate becomes the anchor and the sets are updated by the PDAS rule; repeated until
+    /// an update leaves the sets unchanged with the complementarity residuals at the
+    /// tolerance. The first step on updated sets is taken whole (the equilibrium residual was
+    /// at its minimum for the old sets, so the line search would refuse any move toward the
+    /// new sets' solution). Same requirements as [`Self::Combined`].
+    Outer,
 }
 
 /// When a finite-strain solve rebuilds the contact geometry on the deformed configuration.
@@ -964,21 +976,22 @@ impl<const D: usize> NonlinearContact<D> {
         // the contact solve of an iteration: the solver itself, or its single active-set step
         let step_solver = match self.params.active_sets {
             ActiveSetStrategy::Nested => None,
-            ActiveSetStrategy::Combined => {
+            strategy @ (ActiveSetStrategy::Combined | ActiveSetStrategy::Outer) => {
                 if control.is_some() {
-                    return Err(NonlinearError::InvalidParameter(
-                        "the Combined active-set strategy is not available under load control; use ActiveSetStrategy::Nested".into(),
-                    ));
+                    return Err(NonlinearError::InvalidParameter(format!(
+                        "the {strategy:?} active-set strategy is not available under load control; use ActiveSetStrategy::Nested"
+                    )));
                 }
                 Some(solver.active_set_step().ok_or_else(|| {
                     NonlinearError::InvalidParameter(format!(
-                        "the Combined active-set strategy needs a contact solver with an active-set step (e.g. PDAS); `{}` has none",
+                        "the {strategy:?} active-set strategy needs a contact solver with an active-set step (e.g. PDAS); `{}` has none",
                         solver.name()
                     ))
                 })?)
             }
         };
         let combined = step_solver.is_some();
+        let outer = self.params.active_sets == ActiveSetStrategy::Outer;
         let solver: &dyn ContactSolver = step_solver.as_deref().unwrap_or(solver);
         let mut t = t;
         let n = self.dofs.n_dofs();
@@ -1056,6 +1069,8 @@ impl<const D: usize> NonlinearContact<D> {
         };
         // consecutive steps the line search took without a decrease of the residual
         let mut forced_steps = 0usize;
+        // Outer: the anchor (and so the sets) changed in the last iteration
+        let mut new_anchor = false;
         for _ in 0..self.params.max_iterations * passes_allowed {
             report.total_iterations += 1;
             if refresh {
@@ -1259,6 +1274,10 @@ impl<const D: usize> NonlinearContact<D> {
             // `‖R‖` of the old geometry was at its minimum there, so any move toward the new
             // geometry's solution raises it; the step is taken whole, as the predictor
             let rebuilt = finite && first_of_pass && (passes > 1 || self.state.scale > 0.0);
+            // Outer: the first step on updated sets is taken whole for the same reason: the
+            // equilibrium residual was at its minimum for the old sets (measured: damped to
+            // α = 1/128 three times running, a failed level, on every Hertz case)
+            let rebuilt = rebuilt || std::mem::take(&mut new_anchor);
             let mut alpha = 1.0;
             let mut forced = false;
             let accepted = loop {
@@ -1351,7 +1370,7 @@ impl<const D: usize> NonlinearContact<D> {
             }
             // converged: the residual at the tolerance, or a full step that no longer moves
             // the iterate (a residual at rounding level of a level that barely changed)
-            // Combined: the last active-set step left its sets unchanged and solved the
+            // Combined, Outer: the last active-set step left its sets unchanged and solved the
             // complementarity conditions (the slip rows of 3D are linearised in a step)
             let contact_settled = !combined
                 || result.solution.report.history.last().is_some_and(|h| {
@@ -1359,11 +1378,11 @@ impl<const D: usize> NonlinearContact<D> {
                         && h.normal <= self.params.tolerance
                         && h.tangential <= self.params.tolerance
                 });
-            let converged = contact_settled
-                && (relative <= self.params.tolerance
-                    || force_scale == 0.0
-                    || (alpha == 1.0 && increment <= self.params.tolerance)
-                    || (tiny && alpha == 1.0));
+            let equilibrium = relative <= self.params.tolerance
+                || force_scale == 0.0
+                || (alpha == 1.0 && increment <= self.params.tolerance)
+                || (tiny && alpha == 1.0);
+            let converged = contact_settled && equilibrium;
             // a pass whose geometry is still moving ends at the looser pass tolerance
             let pass_converged = converged
                 || (finite
@@ -1392,11 +1411,20 @@ impl<const D: usize> NonlinearContact<D> {
                 refresh = true;
             }
             let done = converged && geometry_settled;
-            warm = Some(result.solution.clone());
-            if combined {
-                // the next step's sets come from the iterate reached (after the line search)
-                if let Some(w) = warm.as_mut() {
-                    w.u.clone_from(&u);
+            // Outer: the anchor the sets are classified from is kept while the equilibrium
+            // converges on its sets (unless it does not fit the rows, e.g. after a rebuild of the
+            // geometry: then this iteration's state is the anchor); Nested, Combined: the last
+            // solution warm-starts the next iteration
+            let keep_anchor =
+                outer && !equilibrium && warm.as_ref().is_some_and(|w| w.lambda_n.len() == rows);
+            new_anchor = outer && equilibrium && !contact_settled;
+            if !keep_anchor {
+                warm = Some(result.solution.clone());
+                if combined {
+                    // the next step's sets come from the iterate reached (after the line search)
+                    if let Some(w) = warm.as_mut() {
+                        w.u.clone_from(&u);
+                    }
                 }
             }
             if done {

@@ -159,8 +159,26 @@ impl Pdas {
                 y = problem.apply(u);
             }
         }
-        let mut sets =
-            Sets { normal: st.classify_normal(&nu, &y, None), cells: st.classify_cells(&nu, &y, None) };
+        // a step: the states of the warm start (loaded rows active, cells with ‖Λ_t‖ = 1
+        // slipping) are the previous sets, so the switching band and the slip-reversal
+        // safeguard apply to its classification as to a PDAS iteration's
+        let warm_sets = (mode == Mode::Step && context.warm_start().is_some()).then(|| Sets {
+            normal: (0..st.m).map(|r| nu[r] > 0.0).collect(),
+            cells: (0..st.n_cells)
+                .map(|c| {
+                    let z: f64 = (0..st.comps).map(|k| nu[st.cell_row(c, k)].powi(2)).sum();
+                    if z.sqrt() >= 1.0 - 1e-12 {
+                        CellState::Slip
+                    } else {
+                        CellState::Stick
+                    }
+                })
+                .collect(),
+        });
+        let mut sets = Sets {
+            normal: st.classify_normal(&nu, &y, warm_sets.as_ref().map(|s| &s.normal[..])),
+            cells: st.classify_cells(&nu, &y, warm_sets.as_ref().map(|s| &s.cells[..])),
+        };
         let mut history = Vec::new();
         let mut recent: VecDeque<(Sets, Vec<bool>, f64)> = VecDeque::with_capacity(CYCLE_WINDOW + 1);
         let mut best_before = f64::INFINITY;
@@ -274,7 +292,9 @@ enum Mode {
 /// From the warm start `(U⁰, ν⁰)` (or `U⁰ = A⁻¹ F`, `ν⁰ = 0` without one) it computes the
 /// sets of [`Pdas`] step 1 from the warm start's **own** interface values `y⁰ = C U⁰` —
 /// `𝒜_n = {r : ν⁰_r + ρ_r (y⁰_r − d_r) > 0}`, stick/slip from
-/// `ζ_c = Λ⁰_t,c + ρ_c (y⁰_c − s_c)` — solves the linear interface system of [`Pdas`] step 2
+/// `ζ_c = Λ⁰_t,c + ρ_c (y⁰_c − s_c)`, with the warm start's own states (rows with `ν⁰_r > 0`
+/// active, cells with `‖Λ⁰_t,c‖ = 1` slipping) as the previous sets of the switching band and
+/// the slip-reversal safeguard — solves the linear interface system of [`Pdas`] step 2
 /// for those sets once (the 3D slip rows linearised at `ζ_c`), and returns
 /// `ν¹`, `U¹ = A⁻¹ (F − Cᵀ ν¹)` whether or not it solves the contact problem. Its report has
 /// `iterations = 1` and one history entry: the sets computed from `(ν¹, C U¹)` differ from
