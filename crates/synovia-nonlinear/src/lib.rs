@@ -21,10 +21,11 @@
 //! semismooth Newton of the contact conditions, warm-started from the previous iteration's
 //! multipliers, so the two Newton methods run nested: the material's outside, the contact's
 //! inside; [`ActiveSetStrategy`] offers one semismooth Newton iteration on the whole system,
-//! or the sets iterated around Newton, instead). With small-strain contact the constraints are linear in `u`, so the iteration is
-//! Newton's method (sequential quadratic programming) on the whole nonsmooth system. With
-//! finite strain the contact geometry (re-pairing, normals, gaps in total form) is that of the
-//! deformed configuration: it is frozen during a pass of Newton iterations — each pass is
+//! or the sets iterated around Newton, instead). With small-strain contact the constraints are
+//! linear in `u`, so the iteration is Newton's method (sequential quadratic programming) on the
+//! whole nonsmooth system. With finite strain the contact geometry (re-pairing, normals, gaps in
+//! total form) is that of the deformed configuration: it is frozen during a pass of Newton
+//! iterations — each pass is
 //! Newton's method on a fixed constraint operator and converges quadratically — and rebuilt
 //! on `x + u` between passes until a rebuild moves the solution by less than
 //! [`NewtonParams::geometry_tolerance`] (a fixed point in the geometry: rebuilding it at every
@@ -990,7 +991,7 @@ impl<const D: usize> NonlinearContact<D> {
                 })?)
             }
         };
-        let combined = step_solver.is_some();
+        let single_steps = step_solver.is_some();
         let outer = self.params.active_sets == ActiveSetStrategy::Outer;
         let solver: &dyn ContactSolver = step_solver.as_deref().unwrap_or(solver);
         let mut t = t;
@@ -1372,7 +1373,7 @@ impl<const D: usize> NonlinearContact<D> {
             // the iterate (a residual at rounding level of a level that barely changed)
             // Combined, Outer: the last active-set step left its sets unchanged and solved the
             // complementarity conditions (the slip rows of 3D are linearised in a step)
-            let contact_settled = !combined
+            let contact_settled = !single_steps
                 || result.solution.report.history.last().is_some_and(|h| {
                     h.set_changes == 0
                         && h.normal <= self.params.tolerance
@@ -1420,7 +1421,7 @@ impl<const D: usize> NonlinearContact<D> {
             new_anchor = outer && equilibrium && !contact_settled;
             if !keep_anchor {
                 warm = Some(result.solution.clone());
-                if combined {
+                if single_steps {
                     // the next step's sets come from the iterate reached (after the line search)
                     if let Some(w) = warm.as_mut() {
                         w.u.clone_from(&u);
