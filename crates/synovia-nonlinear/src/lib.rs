@@ -852,27 +852,7 @@ impl<const D: usize> NonlinearContact<D> {
                 control.target, control.slope
             )));
         }
-        let start = Instant::now();
-        let mut report = NewtonReport::default();
-        match self.newton(model, t_guess, 1.0, solver, &mut report, Some(control), None) {
-            Ok((result, energy, iterations, reduced, force, t)) => {
-                report.sublevels = 1;
-                report.iterations = iterations;
-                report.time_s = start.elapsed().as_secs_f64();
-                self.state = State {
-                    time: t,
-                    scale: 1.0,
-                    reduced,
-                    contact_force: force,
-                    result: Some(result.clone()),
-                };
-                Ok(NonlinearResult { time: t, contact: result, strain_energy: energy, report })
-            }
-            Err(e) => {
-                self.tangent_kept = false;
-                Err(e)
-            }
-        }
+        self.whole_level(model, t_guess, solver, Some(control), None)
     }
 
     /// Solves one level `t` with extra terms from the committed state (docs/model.md (12.1)):
@@ -912,10 +892,25 @@ impl<const D: usize> NonlinearContact<D> {
                 "a level with extra terms starts from a loaded state (set_state)".into(),
             ));
         }
+        self.whole_level(model, t, solver, None, Some(terms))
+    }
+
+    /// One level solved whole (no cut-back) from the committed state by the Newton iteration,
+    /// with load control and/or extra terms, committed on success at the level's time (the
+    /// one load control found, else `t`); on failure the committed state is unchanged and the
+    /// kept tangent dropped.
+    fn whole_level(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        control: Option<&mut LoadControl<'_, D>>,
+        terms: Option<&LevelTerms<'_>>,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
         let start = Instant::now();
         let mut report = NewtonReport::default();
-        match self.newton(model, t, 1.0, solver, &mut report, None, Some(terms)) {
-            Ok((result, energy, iterations, reduced, force, _)) => {
+        match self.newton(model, t, 1.0, solver, &mut report, control, terms) {
+            Ok((result, energy, iterations, reduced, force, t)) => {
                 report.sublevels = 1;
                 report.iterations = iterations;
                 report.time_s = start.elapsed().as_secs_f64();
