@@ -903,14 +903,7 @@ impl<const D: usize> DynamicStepper<D> {
             Kernel::Stiffness => stiffness_into(geo, &self.c0[b], out),
             Kernel::DampingDt => {
                 let nn = (D * (D + 1)) * (D * (D + 1));
-                mass_into(geo, data.damping, lumped, out);
-                if let Some(c1) = &data.viscous {
-                    let mut k1 = [0.0; KE_MAX];
-                    stiffness_into(geo, c1, &mut k1[..nn]);
-                    for (o, k) in out[..nn].iter_mut().zip(&k1[..nn]) {
-                        *o += k;
-                    }
-                }
+                damping_into(geo, data.damping, data.viscous.as_ref(), lumped, out);
                 out[..nn].iter_mut().for_each(|v| *v *= self.params.dt);
             }
         }
@@ -1092,6 +1085,25 @@ struct ContactStep<const D: usize> {
 fn add_into(a: &mut [Real], b: &[Real]) {
     for (x, y) in a.iter_mut().zip(b) {
         *x += y;
+    }
+}
+
+/// Element matrix of `M_α + A⁽¹⁾` of a body (docs/model.md §7): the mass-proportional damping
+/// `α` plus, when given and not zero, the Kelvin–Voigt viscosity `C⁽¹⁾`. Shared by the linear
+/// and the nonlinear dynamic steppers.
+pub(crate) fn damping_into<const D: usize>(
+    geo: &SimplexGeometry<D>,
+    alpha: Real,
+    viscous: Option<&DMatrix<Real>>,
+    lumped: bool,
+    out: &mut [Real],
+) {
+    let nn = (D * (D + 1)) * (D * (D + 1));
+    mass_into(geo, alpha, lumped, out);
+    if let Some(c1) = viscous.filter(|c| c.iter().any(|v| *v != 0.0)) {
+        let mut k1 = [0.0; KE_MAX];
+        stiffness_into(geo, c1, &mut k1[..nn]);
+        out[..nn].iter_mut().zip(&k1[..nn]).for_each(|(o, k)| *o += k);
     }
 }
 

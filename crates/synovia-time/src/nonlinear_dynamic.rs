@@ -56,26 +56,22 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use nalgebra::DMatrix;
 use synovia_contact::operators::{ContactGeometry, ContactPair};
 use synovia_contact::{slip_speeds, ContactSolver, FrictionLaw, PairFrictionLaws, StaticContactResult};
 use synovia_fem::assembly::{add_loads, assemble_matrix, subtract_lift};
-use synovia_fem::element::{mass_into, stiffness_into, SimplexGeometry};
+use synovia_fem::element::mass_into;
 use synovia_fem::{DofMap, ElasticParams, FemError, Kinematics, Model, SymmetricMatrix};
 use synovia_material::voigt_len;
 use synovia_mesh::math::{Real, Vector};
 use synovia_nonlinear::{LevelTerms, NewtonParams, NewtonReport, NonlinearContact, NonlinearError};
 
 use crate::dynamic::{
-    all_zero, check_nodal, full_form, initial_levels, nodal_diff, DynamicBody, DynamicParams, EnergyBalance,
-    InitialLevels, MassKind,
+    all_zero, check_nodal, damping_into, full_form, initial_levels, nodal_diff, DynamicBody, DynamicParams,
+    EnergyBalance, InitialLevels, MassKind,
 };
 use crate::error::TimeError;
 use crate::quasistatic::friction_dissipation;
 use crate::results::{empty_pair_records, pair_records, StepRecord};
-
-/// Largest element matrix size `(D(D+1))²` for `D ≤ 3`.
-const KE_MAX: usize = 144;
 
 /// What a step of [`NonlinearDynamicStepper`] did besides its [`StepRecord`].
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -196,9 +192,6 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
         }
         // the loads of the Newton iteration with the stepper's quadrature
         let newton = newton.with_load_degree(params.load_degree);
-        let zero_c = DMatrix::<Real>::zeros(nv, nv);
-        let c1: Vec<DMatrix<Real>> =
-            bodies.iter().map(|b| b.viscous.clone().unwrap_or_else(|| zero_c.clone())).collect();
         let rho: Vec<Real> = bodies.iter().map(|b| b.density).collect();
         let alpha: Vec<Real> = bodies.iter().map(|b| b.damping).collect();
         let lumped = params.mass == MassKind::Lumped;
@@ -212,7 +205,7 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
             assemble_matrix(model, dofs, &mut mass, |bi, _, geo, out| mass_into(geo, rho[bi], lumped, out))?;
             if has_alpha || has_c1 {
                 assemble_matrix(model, dofs, &mut damping, |bi, _, geo, out| {
-                    damping_kernel(geo, alpha[bi], &c1[bi], lumped, out);
+                    damping_into(geo, alpha[bi], bodies[bi].viscous.as_ref(), lumped, out);
                 })?;
             }
             *b = combined(&mass, &damping, dt)?;
@@ -457,10 +450,8 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
             let first: Vec<Vector<D>> = lifts_new.iter().zip(&self.lifts).map(|(a, b)| a - b).collect();
             if !all_zero(&first) {
                 let bodies = &self.bodies;
-                let zero_c = DMatrix::<Real>::zeros(voigt_len(D), voigt_len(D));
                 subtract_lift(model, self.dofs(), &first, &mut g, |b, _, geo, out| {
-                    let c1 = bodies[b].viscous.as_ref().unwrap_or(&zero_c);
-                    damping_kernel(geo, bodies[b].damping, c1, lumped, out);
+                    damping_into(geo, bodies[b].damping, bodies[b].viscous.as_ref(), lumped, out);
                     out.iter_mut().for_each(|v| *v /= h);
                 })?;
             }
@@ -579,10 +570,9 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
     /// `Σ_T v_Tᵀ (M_α + A⁽¹⁾)_T v_T` for a full nodal field.
     fn full_damping_form(&self, model: &Model<D>, v: &[Vec<Vector<D>>]) -> Real {
         let lumped = self.params.mass == MassKind::Lumped;
-        let zero_c = DMatrix::<Real>::zeros(voigt_len(D), voigt_len(D));
         full_form(model, v, |b, geo, out| {
             let data = &self.bodies[b];
-            damping_kernel(geo, data.damping, data.viscous.as_ref().unwrap_or(&zero_c), lumped, out);
+            damping_into(geo, data.damping, data.viscous.as_ref(), lumped, out);
         })
     }
 
@@ -673,21 +663,4 @@ fn combined(mass: &SymmetricMatrix, damping: &SymmetricMatrix, h: Real) -> Resul
     b.add_scaled(h, damping)?;
     b.values_mut().iter_mut().for_each(|v| *v /= h * h);
     Ok(b)
-}
-
-/// Element matrix of `M_α + A⁽¹⁾`.
-fn damping_kernel<const D: usize>(
-    geo: &SimplexGeometry<D>,
-    alpha: Real,
-    c1: &DMatrix<Real>,
-    lumped: bool,
-    out: &mut [Real],
-) {
-    let nn = (D * (D + 1)) * (D * (D + 1));
-    mass_into(geo, alpha, lumped, out);
-    if c1.iter().any(|v| *v != 0.0) {
-        let mut k1 = [0.0; KE_MAX];
-        stiffness_into(geo, c1, &mut k1[..nn]);
-        out[..nn].iter_mut().zip(&k1[..nn]).for_each(|(o, k)| *o += k);
-    }
 }
