@@ -118,12 +118,7 @@ impl Pdas {
         context: &SolveContext,
         stop_on_cycling: bool,
     ) -> PdasTrace {
-        let mut trace = PdasTrace {
-            result: Ok(empty_solution()),
-            last_iterate: None,
-            cycle_period: None,
-            stagnation: false,
-        };
+        let mut trace = PdasTrace::empty();
         let mut last_nu = None;
         trace.result =
             self.iterate(problem, context, stop_on_cycling, Mode::Converge, &mut trace, &mut last_nu);
@@ -335,18 +330,20 @@ impl ContactSolver for PdasStep {
         let mut params = self.params;
         params.max_iterations = 1;
         let pdas = Pdas::new(params);
-        let mut trace = PdasTrace {
-            result: Ok(empty_solution()),
-            last_iterate: None,
-            cycle_period: None,
-            stagnation: false,
-        };
+        let mut trace = PdasTrace::empty();
         let mut last_nu = None;
         pdas.iterate(problem, context, false, Mode::Step, &mut trace, &mut last_nu)
     }
 
     fn active_set_step(&self) -> Option<Box<dyn ContactSolver>> {
         Some(Box::new(*self))
+    }
+}
+
+impl PdasTrace {
+    /// A trace before the first iteration (an empty successful result, nothing detected).
+    fn empty() -> Self {
+        Self { result: Ok(empty_solution()), last_iterate: None, cycle_period: None, stagnation: false }
     }
 }
 
