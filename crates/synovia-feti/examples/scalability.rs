@@ -14,8 +14,8 @@ use synovia_contact::obstacle::SphereObstacle;
 use synovia_contact::operators::ContactPair;
 use synovia_fem::model::Model;
 use synovia_feti::{
-    Decomposition, DecompositionParams, Gluing, ModelProblem, Partitioner, Preconditioner, SingleProcess,
-    TfetiParams,
+    CoarseConstraint, Decomposition, DecompositionParams, Gluing, ModelProblem, Partitioner, Preconditioner,
+    SingleProcess, TfetiParams,
 };
 use synovia_material::plane_strain;
 use synovia_mesh::generators::{rectangle, Grading};
@@ -78,6 +78,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "prec=none" => params.preconditioner = Preconditioner::None,
                 "prec=lumped" => params.preconditioner = Preconditioner::Lumped,
                 "prec=dirichlet" => params.preconditioner = Preconditioner::Dirichlet,
+                "coarse=projector" => params.coarse = CoarseConstraint::Projector,
+                "coarse=penalty" => params.coarse = CoarseConstraint::Penalty,
                 _ => {}
             }
         }
@@ -110,12 +112,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let s = tresca.solve(&dec, &SingleProcess, &params)?;
         let r = &s.report;
         let row = serde_json::json!({
-            "k": k, "gluing": format!("{gluing:?}"), "preconditioner": format!("{:?}", params.preconditioner), "partitioner": format!("{partitioner:?}"), "subdomains": r.subdomains, "H_over_h": hh, "dofs": dec.n_reduced(),
+            "k": k, "gluing": format!("{gluing:?}"), "preconditioner": format!("{:?}", params.preconditioner), "coarse": format!("{:?}", params.coarse), "partitioner": format!("{partitioner:?}"), "subdomains": r.subdomains, "H_over_h": hh, "dofs": dec.n_reduced(),
             "primal": dec.n_primal(), "dual": r.dual, "coarse": r.coarse_dim,
             "frictionless": {"outer": s0.report.outer_iterations, "inner": s0.report.inner_iterations, "f_products": s0.report.f_products,
                 "per_outer": s0.report.inner_per_outer, "steps_cg_exp_prop": s0.report.inner_steps},
             "spectrum": spectrum,
-            "tresca": {"outer": r.outer_iterations, "inner": r.inner_iterations, "f_products": r.f_products, "prec_products": r.preconditioner_products,
+            "tresca": {"outer": r.outer_iterations, "inner": r.inner_iterations, "f_products": r.f_products, "prec_products": r.preconditioner_products, "face_factorisations": r.face_factorisations,
                         "per_outer": r.inner_per_outer, "steps_cg_exp_prop": r.inner_steps,
                         "active": s.lambda_n.iter().filter(|&&l| l > 0.0).count(),
                         "slip": s.lambda_t.iter().filter(|l| l.abs() >= 1.0 - 1e-8).count()},

@@ -63,6 +63,48 @@ pub struct TfetiParams {
     /// Preconditioner in face of the inner MPRGP/MPGP conjugate gradient steps (default
     /// [`Preconditioner::Dirichlet`]).
     pub preconditioner: Preconditioner,
+    /// How the coarse condition `G λ = e` is enforced (default [`CoarseConstraint::Penalty`]:
+    /// SMALBE).
+    pub coarse: CoarseConstraint,
+}
+
+/// How the natural coarse condition `G λ = e` of the dual problem is enforced (module docs).
+///
+/// * `Penalty` (SMALBE): `λ = λ₀ + λ̃` with `G̃ λ̃ = 0` enforced by the augmented Lagrangian
+///   `½ λ̃ᵀ(PFP + ρQ)λ̃ − λ̃ᵀb + μᵀG̃λ̃` (outer iterations update `μ`).
+/// * `Projector`: the coarse condition is eliminated through the equality rows. With
+///   `U = [G_Eᵀ; 0]` (coarse columns on the gluing/Dirichlet rows only) the oblique projector
+///
+///   ```text
+///   T = I − U (G_E G_Eᵀ)⁻¹ G,   G T = 0,   T = I on Ker G,   (T x)_I = x_I,
+///   ```
+///
+///   maps every `x` onto `Ker G` without touching the contact rows `I`, so with
+///   `λ = λ₀ + T x` (`λ₀ = U (G_E G_Eᵀ)⁻¹ e`, zero on `I`) the dual becomes the purely bound/disc
+///   constrained problem
+///
+///   ```text
+///   min ½ xᵀ Tᵀ F T x − xᵀ Tᵀ (d̃ − F λ₀)   s.t.  x_I ∈ Ω_I   (x_E free),
+///   ```
+///
+///   solved by one MPRGP/MPGP run (no outer loop). Its gradient `Tᵀ(Fλ − d̃)` is the KKT
+///   residual with the coarse multiplier `α = −(G_E G_Eᵀ)⁻¹ G_E (d̃ − Fλ)_E` of the primal
+///   recovery. The conjugate gradient steps are preconditioned in face `F` (free rows) by
+///   `z = P_F (B A Bᵀ + I/‖H‖) P_F r` with `P_F = I − G_Fᵀ(G_F G_Fᵀ)⁻¹ G_F` the orthogonal
+///   projector onto `Ker G_F` (the coarse columns of the free rows): with the bound rows
+///   fixed, the face problem is a TFETI problem on the free rows, whose preconditioned operator
+///   `P_F B A Bᵀ P_F F` on `Ker G_F` is the projected Dirichlet (or lumped) one of FETI
+///   (`P_F Tᵀ = P_F`, since `T P_F = P_F`), bounded by `C (1 + log H/h)²` for the Dirichlet
+///   preconditioner (Farhat, Mandel, Roux 1994). `G_F G_Fᵀ = G_E G_Eᵀ + Σ_{i ∈ F∩I} g_i g_iᵀ` is
+///   factorised again when the free contact rows change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum CoarseConstraint {
+    /// SMALBE: augmented Lagrangian (penalty `ρ Q`) outer iterations.
+    #[default]
+    Penalty,
+    /// The oblique projector `T` onto `Ker G` along the equality rows' coarse columns.
+    Projector,
 }
 
 /// The preconditioner `M⁻¹ ≈ (P F P + ρ Q)⁻¹` of the inner iterations, applied in face
@@ -104,6 +146,7 @@ impl Default for TfetiParams {
             eta_factor: 0.1,
             beta: 10.0,
             preconditioner: Preconditioner::default(),
+            coarse: CoarseConstraint::default(),
         }
     }
 }
@@ -117,6 +160,11 @@ impl TfetiParams {
     /// Sets [`Self::preconditioner`].
     pub fn with_preconditioner(mut self, preconditioner: Preconditioner) -> Self {
         self.preconditioner = preconditioner;
+        self
+    }
+    /// Sets [`Self::coarse`].
+    pub fn with_coarse(mut self, coarse: CoarseConstraint) -> Self {
+        self.coarse = coarse;
         self
     }
     /// Sets [`Self::max_outer`].
@@ -147,7 +195,7 @@ pub struct TfetiReport {
     pub dual: [usize; 4],
     /// Coarse dimension `Σ r_s`.
     pub coarse_dim: usize,
-    /// SMALBE iterations.
+    /// SMALBE iterations (1 with [`CoarseConstraint::Projector`]).
     pub outer_iterations: usize,
     /// MPRGP/MPGP iterations (all outer iterations together).
     pub inner_iterations: usize,
@@ -160,6 +208,9 @@ pub struct TfetiReport {
     /// Applications of the preconditioner (one interior solve per subdomain each with
     /// [`Preconditioner::Dirichlet`]).
     pub preconditioner_products: usize,
+    /// Factorisations of the face's coarse matrix `G_F G_Fᵀ` ([`CoarseConstraint::Projector`]
+    /// with a preconditioner; one per change of the free contact rows).
+    pub face_factorisations: usize,
     /// Final `‖g^P‖/‖b‖`.
     pub gradient: f64,
     /// Final `‖G̃ λ̃‖/‖b‖`.
@@ -223,6 +274,10 @@ struct Dual<'a> {
     l: DMatrix<f64>,
     /// Cholesky of `G_E G_Eᵀ`.
     ge: nalgebra::Cholesky<f64, nalgebra::Dyn>,
+    /// `G_E G_Eᵀ` itself (for the face projectors of [`CoarseConstraint::Projector`]).
+    ge_gram: DMatrix<f64>,
+    /// Equality rows (the first `n_eq` rows).
+    n_eq: usize,
     products: std::sync::atomic::AtomicUsize,
     /// The preconditioner and, for [`Preconditioner::Dirichlet`], the blocks of the owned
     /// subdomains (`None` elsewhere).
@@ -311,7 +366,8 @@ impl<'a> Dual<'a> {
             }
             a
         };
-        let ge = nalgebra::Cholesky::new(gram(0..n_eq)).ok_or(FetiError::SemiCoercive { pivot: 0 })?;
+        let ge_gram = gram(0..n_eq);
+        let ge = nalgebra::Cholesky::new(ge_gram.clone()).ok_or(FetiError::SemiCoercive { pivot: 0 })?;
         let l = nalgebra::Cholesky::new(gram(0..m)).ok_or(FetiError::SemiCoercive { pivot: 0 })?.l();
         let dirichlet: Vec<Option<crate::subdomain::DirichletBlock>> =
             if preconditioner == Preconditioner::Dirichlet {
@@ -342,6 +398,8 @@ impl<'a> Dual<'a> {
             n_coarse,
             l,
             ge,
+            ge_gram,
+            n_eq,
 
             products: std::sync::atomic::AtomicUsize::new(0),
             preconditioner,
@@ -462,6 +520,34 @@ impl<'a> Dual<'a> {
         let q = self.q(lambda);
         lambda.iter().zip(&q).map(|(a, b)| a - b).collect()
     }
+
+    /// `T x = x − U (G_E G_Eᵀ)⁻¹ G x` with `U = [G_Eᵀ; 0]` ([`CoarseConstraint::Projector`]).
+    fn t(&self, x: &[f64]) -> Vec<f64> {
+        let y = self.ge.solve(&self.g(x, 0..self.m));
+        let u = self.gt(&y, 0..self.n_eq);
+        x.iter().zip(&u).map(|(a, b)| a - b).collect()
+    }
+
+    /// `Tᵀ y = y − Gᵀ (G_E G_Eᵀ)⁻¹ G_E y_E`.
+    fn t_tr(&self, y: &[f64]) -> Vec<f64> {
+        let v = self.ge.solve(&self.g(y, 0..self.n_eq));
+        let w = self.gt(&v, 0..self.m);
+        y.iter().zip(&w).map(|(a, b)| a - b).collect()
+    }
+
+    /// The Cholesky factor of `G_F G_Fᵀ = G_E G_Eᵀ + Σ_{i ∈ free_contact} g_i g_iᵀ`.
+    fn face_gram(&self, free_contact: &[usize]) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, FetiError> {
+        let mut a = self.ge_gram.clone();
+        for &r in free_contact {
+            let col = &self.g_cols[r];
+            for &(i, vi) in col {
+                for &(j, vj) in col {
+                    a[(i, j)] += vi * vj;
+                }
+            }
+        }
+        nalgebra::Cholesky::new(a).ok_or(FetiError::SemiCoercive { pivot: 0 })
+    }
 }
 
 /// `H = P F P + ρ Q` as a [`Hessian`], with `‖H‖` (estimated; `0` if unknown) for the
@@ -516,6 +602,71 @@ impl Hessian for ProjectedHessian<'_, '_> {
                 *zi += r / self.norm;
             }
         }
+        Ok(true)
+    }
+}
+
+/// `H = Tᵀ F T` of [`CoarseConstraint::Projector`] as a [`Hessian`], with `‖H‖` (estimated;
+/// `0` if unknown) for the preconditioner's shift and the factor of `G_F G_Fᵀ` of the last face.
+struct ObliqueHessian<'d, 'a> {
+    dual: &'d Dual<'a>,
+    norm: f64,
+    /// Free contact rows of the last face and the Cholesky factor of its `G_F G_Fᵀ`.
+    face: Option<(Vec<usize>, nalgebra::Cholesky<f64, nalgebra::Dyn>)>,
+    /// Factorisations of `G_F G_Fᵀ` (one per change of the free contact rows).
+    face_factorisations: usize,
+}
+
+impl ObliqueHessian<'_, '_> {
+    /// `P_F v = v − Z_F G_Fᵀ (G_F G_Fᵀ)⁻¹ G_F v` for `v` zero off the face.
+    fn project_face(&self, free: &[bool], v: &[f64]) -> Vec<f64> {
+        let d = self.dual;
+        let Some((_, chol)) = &self.face else { return v.to_vec() };
+        let y = chol.solve(&d.g(v, 0..d.m));
+        let w = d.gt(&y, 0..d.m);
+        v.iter().zip(&w).zip(free).map(|((a, b), &f)| if f { a - b } else { 0.0 }).collect()
+    }
+}
+
+impl Hessian for ObliqueHessian<'_, '_> {
+    fn apply(&mut self, x: &[f64], y: &mut [f64]) -> Result<(), ContactError> {
+        let d = self.dual;
+        let tx = d.t(x);
+        let ftx = d.f(&tx).map_err(ContactError::from)?;
+        y.copy_from_slice(&d.t_tr(&ftx));
+        Ok(())
+    }
+
+    /// `z = P_F (B A Bᵀ + I/‖H‖) P_F Z_Fᵀ r` ([`CoarseConstraint::Projector`]; the shift as in
+    /// [`ProjectedHessian`], for the directions of redundant rows).
+    fn precondition_in_face(
+        &mut self,
+        free: &[bool],
+        r: &[f64],
+        z: &mut [f64],
+    ) -> Result<bool, ContactError> {
+        let d = self.dual;
+        if d.preconditioner == Preconditioner::None {
+            return Ok(false);
+        }
+        let key: Vec<usize> = (d.n_eq..d.m).filter(|&i| free[i]).collect();
+        if self.face.as_ref().is_none_or(|(k, _)| *k != key) {
+            let chol = d.face_gram(&key).map_err(ContactError::from)?;
+            self.face_factorisations += 1;
+            self.face = Some((key, chol));
+        }
+        let rf: Vec<f64> = r.iter().zip(free).map(|(&v, &f)| if f { v } else { 0.0 }).collect();
+        let pr = self.project_face(free, &rf);
+        let mut a = d.bab(&pr).map_err(ContactError::from)?;
+        if self.norm > 0.0 {
+            a.iter_mut().zip(&pr).for_each(|(ai, p)| *ai += p / self.norm);
+        }
+        a.iter_mut().zip(free).for_each(|(ai, &f)| {
+            if !f {
+                *ai = 0.0;
+            }
+        });
+        z.copy_from_slice(&self.project_face(free, &a));
         Ok(true)
     }
 }
@@ -646,7 +797,10 @@ fn set_up<'a>(
     // b = P (d̃ − F λ₀) = P (B K⁺ (f̂ − Bᵀ λ₀) − c)
     let mut r0 = dual.bkb(&lambda0, true)?;
     r0.iter_mut().zip(&dual.offsets).for_each(|(a, c)| *a -= c);
-    let b = dual.p(&r0);
+    let b = match params.coarse {
+        CoarseConstraint::Penalty => dual.p(&r0),
+        CoarseConstraint::Projector => dual.t_tr(&r0),
+    };
     Ok(SetUp { dual, scale, blocks, lambda0, b, n_eq, mn, mt })
 }
 
@@ -784,22 +938,6 @@ pub fn solve(
     let bnorm = norm(&b).max(f64::MIN_POSITIVE);
     let setup_s = t0.elapsed().as_secs_f64();
 
-    // ‖P F P‖, ρ, M, η
-    let mut pfp = ProjectedHessian { dual: &dual, rho: 0.0, norm: 0.0 };
-    let (est, _) = estimate_norm(&mut pfp, m, 30)?;
-    let est = est.max(f64::MIN_POSITIVE);
-    let rho = params.rho_factor * est;
-    let mut hess = ProjectedHessian { dual: &dual, rho, norm: 1.05 * est.max(rho) };
-    let mut big_m = params.m_factor * rho;
-    let eta = params.eta_factor * bnorm;
-    let eps = params.tolerance * bnorm;
-    let chopped = blocks.iter().all(|b| matches!(b, ConvexBlock::Interval { .. }));
-    let mut opts = QpOptions::default()
-        .with_hessian_norm(Some(1.05 * est.max(rho)))
-        .with_precondition(params.preconditioner != Preconditioner::None);
-
-    let mut x = vec![0.0; m];
-    let mut mu = DVector::<f64>::zeros(dual.n_coarse);
     let mut report = TfetiReport {
         subdomains: dec.subdomains.len(),
         ranks: comm.size(),
@@ -808,73 +946,97 @@ pub fn solve(
         setup_s,
         ..Default::default()
     };
-    let mut l_prev = f64::NEG_INFINITY;
-    let mut converged = false;
-    let (mut gp_last, mut gx_last) = (f64::INFINITY, f64::INFINITY);
-    for outer in 1..=params.max_outer {
-        report.outer_iterations = outer;
-        let gtmu = dual.gt_orth_t(&mu);
-        let bk: Vec<f64> = b.iter().zip(&gtmu).map(|(a, c)| a - c).collect();
-        let mut last_g = Vec::new();
-        let mut final_reached = false;
-        let (mut gp_s, mut gx_s) = (0.0, 0.0);
-        opts = opts.with_max_iterations(params.max_inner.saturating_sub(report.inner_iterations).max(1));
-        let rep = {
-            let mut stop = |_it: usize, xi: &[f64], gi: &[f64]| {
-                let gp = projected_gradient(&blocks, xi, gi);
-                let gx = dual.gt_orth(xi).norm();
-                let fin = gp <= eps && gx <= eps;
-                if fin || gp <= (big_m * gx).min(eta) {
-                    final_reached = fin;
-                    last_g = gi.to_vec();
-                    gp_s = gp;
-                    gx_s = gx;
-                    true
-                } else {
-                    false
+    let x = match params.coarse {
+        CoarseConstraint::Projector => solve_projected(&dual, &blocks, &b, params, &mut report)?,
+        CoarseConstraint::Penalty => {
+            // ‖P F P‖, ρ, M, η
+            let mut pfp = ProjectedHessian { dual: &dual, rho: 0.0, norm: 0.0 };
+            let (est, _) = estimate_norm(&mut pfp, m, 30)?;
+            let est = est.max(f64::MIN_POSITIVE);
+            let rho = params.rho_factor * est;
+            let mut hess = ProjectedHessian { dual: &dual, rho, norm: 1.05 * est.max(rho) };
+            let mut big_m = params.m_factor * rho;
+            let eta = params.eta_factor * bnorm;
+            let eps = params.tolerance * bnorm;
+            let chopped = blocks.iter().all(|b| matches!(b, ConvexBlock::Interval { .. }));
+            let mut opts = QpOptions::default()
+                .with_hessian_norm(Some(1.05 * est.max(rho)))
+                .with_precondition(params.preconditioner != Preconditioner::None);
+
+            let mut x = vec![0.0; m];
+            let mut mu = DVector::<f64>::zeros(dual.n_coarse);
+            let mut l_prev = f64::NEG_INFINITY;
+            let mut converged = false;
+            let (mut gp_last, mut gx_last) = (f64::INFINITY, f64::INFINITY);
+            for outer in 1..=params.max_outer {
+                report.outer_iterations = outer;
+                let gtmu = dual.gt_orth_t(&mu);
+                let bk: Vec<f64> = b.iter().zip(&gtmu).map(|(a, c)| a - c).collect();
+                let mut last_g = Vec::new();
+                let mut final_reached = false;
+                let (mut gp_s, mut gx_s) = (0.0, 0.0);
+                opts =
+                    opts.with_max_iterations(params.max_inner.saturating_sub(report.inner_iterations).max(1));
+                let rep = {
+                    let mut stop = |_it: usize, xi: &[f64], gi: &[f64]| {
+                        let gp = projected_gradient(&blocks, xi, gi);
+                        let gx = dual.gt_orth(xi).norm();
+                        let fin = gp <= eps && gx <= eps;
+                        if fin || gp <= (big_m * gx).min(eta) {
+                            final_reached = fin;
+                            last_g = gi.to_vec();
+                            gp_s = gp;
+                            gx_s = gx;
+                            true
+                        } else {
+                            false
+                        }
+                    };
+                    qp_until(&mut hess, &bk, &blocks, &mut x, &opts, chopped, &mut stop)?
+                };
+                report.inner_iterations += rep.iterations;
+                report.inner_per_outer.push(rep.iterations);
+                report.inner_steps[0] += rep.cg_steps;
+                report.inner_steps[1] += rep.expansion_steps;
+                report.inner_steps[2] += rep.proportioning_steps;
+                gp_last = gp_s;
+                gx_last = gx_s;
+                if !rep.converged {
+                    gp_last = rep.projected_gradient_norm;
+                    break;
                 }
-            };
-            qp_until(&mut hess, &bk, &blocks, &mut x, &opts, chopped, &mut stop)?
-        };
-        report.inner_iterations += rep.iterations;
-        report.inner_per_outer.push(rep.iterations);
-        report.inner_steps[0] += rep.cg_steps;
-        report.inner_steps[1] += rep.expansion_steps;
-        report.inner_steps[2] += rep.proportioning_steps;
-        gp_last = gp_s;
-        gx_last = gx_s;
-        if !rep.converged {
-            gp_last = rep.projected_gradient_norm;
-            break;
+                if final_reached {
+                    converged = true;
+                    break;
+                }
+                let gx = dual.gt_orth(&x);
+                // L(λ_k, μ_k) = ½ λ_kᵀ(g + b_k) − bᵀλ_k + μ_kᵀ G̃ λ_k with the multiplier μ_k of this
+                // inner problem; M decreases if L(λ_k, μ_k) < L(λ_{k−1}, μ_{k−1}) + ρ/2 ‖G̃ λ_k‖²
+                // (Dostál 2009, Alg. 6.1, step 3)
+                let half: f64 =
+                    x.iter().zip(last_g.iter().zip(&bk)).map(|(xi, (g, c))| xi * (g + c)).sum::<f64>() * 0.5;
+                let l_new = half - x.iter().zip(&b).map(|(a, c)| a * c).sum::<f64>() + mu.dot(&gx);
+                if outer > 1 && l_new < l_prev + 0.5 * rho * gx.norm_squared() {
+                    big_m /= params.beta;
+                }
+                l_prev = l_new;
+                mu += &gx * rho;
+            }
+            report.gradient = gp_last / bnorm;
+            report.feasibility = gx_last / bnorm;
+            if !converged {
+                report.f_products = dual.products.load(std::sync::atomic::Ordering::Relaxed);
+                return Err(FetiError::NoConvergence {
+                    outer: report.outer_iterations,
+                    inner: report.inner_iterations,
+                    gradient: report.gradient,
+                    feasibility: report.feasibility,
+                });
+            }
+
+            x
         }
-        if final_reached {
-            converged = true;
-            break;
-        }
-        let gx = dual.gt_orth(&x);
-        // L(λ_k, μ_k) = ½ λ_kᵀ(g + b_k) − bᵀλ_k + μ_kᵀ G̃ λ_k with the multiplier μ_k of this
-        // inner problem; M decreases if L(λ_k, μ_k) < L(λ_{k−1}, μ_{k−1}) + ρ/2 ‖G̃ λ_k‖²
-        // (Dostál 2009, Alg. 6.1, step 3)
-        let half: f64 =
-            x.iter().zip(last_g.iter().zip(&bk)).map(|(xi, (g, c))| xi * (g + c)).sum::<f64>() * 0.5;
-        let l_new = half - x.iter().zip(&b).map(|(a, c)| a * c).sum::<f64>() + mu.dot(&gx);
-        if outer > 1 && l_new < l_prev + 0.5 * rho * gx.norm_squared() {
-            big_m /= params.beta;
-        }
-        l_prev = l_new;
-        mu += &gx * rho;
-    }
-    report.gradient = gp_last / bnorm;
-    report.feasibility = gx_last / bnorm;
-    if !converged {
-        report.f_products = dual.products.load(std::sync::atomic::Ordering::Relaxed);
-        return Err(FetiError::NoConvergence {
-            outer: report.outer_iterations,
-            inner: report.inner_iterations,
-            gradient: report.gradient,
-            feasibility: report.feasibility,
-        });
-    }
+    };
 
     // primal recovery
     let lambda: Vec<f64> = x.iter().zip(&lambda0).map(|(a, c)| a + c).collect();
@@ -889,6 +1051,56 @@ pub fn solve(
     report.preconditioner_products = dual.prec_products.load(std::sync::atomic::Ordering::Relaxed);
     report.solve_s = t0.elapsed().as_secs_f64() - setup_s;
     Ok(TfetiSolution { u, lambda_n, lambda_t, report })
+}
+
+/// [`CoarseConstraint::Projector`]: one MPRGP/MPGP run on `min ½ xᵀ Tᵀ F T x − xᵀ b`,
+/// `x_I ∈ Ω_I`, until `‖g^P‖ ≤ ε ‖b‖`; returns `λ̃ = T x` (so `λ = λ₀ + λ̃`, `G λ̃ = 0`).
+fn solve_projected(
+    dual: &Dual<'_>,
+    blocks: &[ConvexBlock],
+    b: &[f64],
+    params: &TfetiParams,
+    report: &mut TfetiReport,
+) -> Result<Vec<f64>, FetiError> {
+    let m = dual.m;
+    let bnorm = norm(b).max(f64::MIN_POSITIVE);
+    let eps = params.tolerance * bnorm;
+    let mut hess = ObliqueHessian { dual, norm: 0.0, face: None, face_factorisations: 0 };
+    let (est, _) = estimate_norm(&mut hess, m, 30)?;
+    let hnorm = 1.05 * est.max(f64::MIN_POSITIVE);
+    hess.norm = hnorm;
+    let chopped = blocks.iter().all(|b| matches!(b, ConvexBlock::Interval { .. }));
+    let opts = QpOptions::default()
+        .with_hessian_norm(Some(hnorm))
+        .with_precondition(params.preconditioner != Preconditioner::None)
+        .with_max_iterations(params.max_inner.max(1));
+    let mut x = vec![0.0; m];
+    let mut gp_last = f64::INFINITY;
+    let rep = {
+        let mut stop = |_it: usize, xi: &[f64], gi: &[f64]| {
+            gp_last = projected_gradient(blocks, xi, gi);
+            gp_last <= eps
+        };
+        qp_until(&mut hess, b, blocks, &mut x, &opts, chopped, &mut stop)?
+    };
+    report.outer_iterations = 1;
+    report.inner_iterations = rep.iterations;
+    report.inner_per_outer = vec![rep.iterations];
+    report.inner_steps = [rep.cg_steps, rep.expansion_steps, rep.proportioning_steps];
+    report.face_factorisations = hess.face_factorisations;
+    report.gradient = gp_last / bnorm;
+    let lt = dual.t(&x);
+    report.feasibility = dual.gt_orth(&lt).norm() / bnorm;
+    if !rep.converged {
+        report.f_products = dual.products.load(std::sync::atomic::Ordering::Relaxed);
+        return Err(FetiError::NoConvergence {
+            outer: 1,
+            inner: report.inner_iterations,
+            gradient: report.gradient,
+            feasibility: report.feasibility,
+        });
+    }
+    Ok(lt)
 }
 
 /// `K_s⁺ (f̂_s [with_load] − B_sᵀ λ)` of subdomain `s` (the fields of [`Dual`] it needs are

@@ -50,7 +50,8 @@ pub use comm::MpiCommunicator;
 pub use comm::{Communicator, SingleProcess};
 pub use decomposition::{Decomposition, DecompositionParams, Gluing};
 pub use dual::{
-    face_spectrum, solve, Preconditioner, SpectrumEstimate, TfetiParams, TfetiReport, TfetiSolution,
+    face_spectrum, solve, CoarseConstraint, Preconditioner, SpectrumEstimate, TfetiParams, TfetiReport,
+    TfetiSolution,
 };
 pub use error::FetiError;
 pub use partition::Partitioner;

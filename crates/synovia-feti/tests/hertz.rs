@@ -6,7 +6,7 @@
 //! relative (max norm), and the TFETI solution must satisfy the KKT conditions.
 
 use synovia_contact::{ContactSolver, StaticContact, StaticContactResult};
-use synovia_feti::{DecompositionParams, Tfeti, TfetiParams};
+use synovia_feti::{CoarseConstraint, DecompositionParams, Tfeti, TfetiParams};
 use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 use synovia_pdas::Pdas;
 
@@ -23,6 +23,7 @@ fn compare<const D: usize>(
     pairs: &[synovia_contact::operators::ContactPair<D>],
     subdomains: usize,
     shift: f64,
+    params: TfetiParams,
 ) -> [f64; 3] {
     let mut sc = StaticContact::new(model, pairs, Default::default()).expect("factorise");
     sc.set_nested_iteration(None);
@@ -30,12 +31,13 @@ fn compare<const D: usize>(
     let tfeti = Tfeti::for_model(
         model,
         &DecompositionParams::default().with_subdomains(subdomains),
-        TfetiParams::default(),
+        params,
     )
     .expect("decomposition");
     let dec = tfeti.decomposition();
     println!(
-        "{name}: {} subdomains, primal {}, equality rows {:?}, coarse {}",
+        "{name} ({:?}): {} subdomains, primal {}, equality rows {:?}, coarse {}",
+        params.coarse,
         dec.n_subdomains(),
         dec.n_primal(),
         dec.n_equality(),
@@ -77,7 +79,18 @@ fn tfeti_equals_pdas_on_2d_hertz_with_friction() {
     let p = Hertz2d { levels: 6, e2: Some(1.0), push: 0.02, ..Default::default() };
     let (model, mut pairs) = hertz2d_model(&p).expect("model");
     pairs[0].friction = 0.3;
-    compare("hertz2d", &model, &pairs, 8, 0.004);
+    compare("hertz2d", &model, &pairs, 8, 0.004, TfetiParams::default());
+}
+
+/// The coarse condition eliminated by the oblique projector (`CoarseConstraint::Projector`,
+/// one MPRGP run, no SMALBE loop) gives the same solution as PDAS (and so as SMALBE).
+#[test]
+fn tfeti_projector_equals_pdas_on_2d_hertz_with_friction() {
+    let p = Hertz2d { levels: 6, e2: Some(1.0), push: 0.02, ..Default::default() };
+    let (model, mut pairs) = hertz2d_model(&p).expect("model");
+    pairs[0].friction = 0.3;
+    let params = TfetiParams::default().with_coarse(CoarseConstraint::Projector);
+    compare("hertz2d", &model, &pairs, 8, 0.004, params);
 }
 
 #[test]
@@ -85,5 +98,15 @@ fn tfeti_equals_pdas_on_3d_hertz_with_friction() {
     let p = Hertz3d { n: 3, levels: 7, ..Default::default() };
     let (model, mut pairs) = hertz3d_model(&p).expect("model");
     pairs[0].friction = 0.3;
-    compare("hertz3d", &model, &pairs, 8, 0.002);
+    compare("hertz3d", &model, &pairs, 8, 0.002, TfetiParams::default());
+}
+
+/// As the 2D projector test, in 3D (MPGP with discs).
+#[test]
+fn tfeti_projector_equals_pdas_on_3d_hertz_with_friction() {
+    let p = Hertz3d { n: 3, levels: 7, ..Default::default() };
+    let (model, mut pairs) = hertz3d_model(&p).expect("model");
+    pairs[0].friction = 0.3;
+    let params = TfetiParams::default().with_coarse(CoarseConstraint::Projector);
+    compare("hertz3d", &model, &pairs, 8, 0.002, params);
 }
