@@ -1300,26 +1300,22 @@ impl<const D: usize> JointModel<D> {
         mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
         check_levels(times)?;
-        if !self.rigid_bodies.is_empty() {
-            return Err(JointError::Invalid(
-                "rigid bodies (mixed control) are not supported with nonlinear materials or finite strain yet; \
-                 prescribe the partner's motion or use a linear material"
-                    .into(),
-            ));
-        }
+        self.check_nonlinear_rigid()?;
         if !self.friction_laws.is_empty() {
             return Err(JointError::Invalid(
                 "friction laws other than a constant coefficient are not supported with nonlinear materials or finite strain yet"
                     .into(),
             ));
         }
-        let mut nl = NonlinearContact::new(
+        let mut nl = NonlinearContact::with_interface_block(
             &self.model,
             &self.pairs,
             &self.kinematics,
             self.elastic_params,
             self.newton,
+            self.interface_block,
         )?;
+        nl.set_screening_band(self.screening_band)?;
         // the reference configuration before the first level (the same start as the linear
         // quasi-static scheme's first level, which is solved from the undeformed body)
         let t0 = times.first().copied().unwrap_or(0.0).min(0.0);
@@ -1328,21 +1324,34 @@ impl<const D: usize> JointModel<D> {
         let n_dofs = nl.dofs().n_dofs();
         let mut records = Vec::with_capacity(times.len());
         let mut last = None;
+        // rigid bodies with mixed control: posed per level, a force-controlled coordinate found
+        // inside the Newton iteration (crate::rigid)
+        let mut driver = (!self.rigid_bodies.is_empty()).then(|| RigidDriver::new(self));
         for (step, &t) in times.iter().enumerate() {
             let t_step = Instant::now();
-            let level = nl.step_to(&self.model, t, solver)?;
-            let geometry = nl.geometry();
-            let record = StepRecord {
-                step,
-                time: t,
-                pairs: synovia_time::results::pair_records(geometry, &level.contact),
-                strain_energy: level.strain_energy,
-                iterations: level.report.total_iterations,
-                step_s: t_step.elapsed().as_secs_f64(),
-                solver: level.contact.solution.report.solver.clone(),
-                fallback: level.contact.solution.report.fallback.clone(),
-                ..Default::default()
+            let (record, level) = match driver.as_mut() {
+                Some(driver) => {
+                    let (mut record, level) = driver.nonlinear_level(self, &mut nl, t, solver)?;
+                    record.step = step;
+                    (record, level)
+                }
+                None => {
+                    let level = nl.step_to(&self.model, t, solver)?;
+                    let record = StepRecord {
+                        step,
+                        time: t,
+                        pairs: synovia_time::results::pair_records(nl.geometry(), &level.contact),
+                        strain_energy: level.strain_energy,
+                        iterations: level.report.total_iterations,
+                        solver: level.contact.solution.report.solver.clone(),
+                        fallback: level.contact.solution.report.fallback.clone(),
+                        ..Default::default()
+                    };
+                    (record, level)
+                }
             };
+            let record = StepRecord { step_s: t_step.elapsed().as_secs_f64(), ..record };
+            let geometry = nl.geometry();
             tracing::debug!(
                 newton = level.report.iterations.len(),
                 cutbacks = level.report.cutbacks,
@@ -1369,6 +1378,33 @@ impl<const D: usize> JointModel<D> {
             setup_s,
             total_s: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// What the nonlinear path (static and quasi-static) does not take of the rigid bodies:
+    /// parts tied to them, and friction against them (the slip relative to a moving partner is
+    /// not measured in the Newton iteration).
+    fn check_nonlinear_rigid(&self) -> Result<(), JointError> {
+        if !self.rigid_ties.is_empty() {
+            return Err(JointError::Invalid(
+                "rigid bodies (mixed control) are not supported with nonlinear materials or finite strain yet; \
+                 prescribe the partner's motion or use a linear material"
+                    .into(),
+            ));
+        }
+        if let Some(pair) = self
+            .pairs
+            .iter()
+            .find(|p| p.friction > 0.0 && self.rigid_pairs.iter().any(|(name, _)| *name == p.name))
+        {
+            return Err(JointError::Unsupported {
+                solver: "nonlinear (Newton)".into(),
+                feature: format!(
+                    "friction against a rigid body with mixed control (pair `{}`, coefficient {}) with nonlinear materials or finite strain; set the pair's friction to 0",
+                    pair.name, pair.friction
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// The levels of a model with rigid bodies: each level poses them and finds their

@@ -63,6 +63,7 @@ use synovia_time::history::LoadHistory;
 
 use synovia_contact::operators::ContactGeometry;
 use synovia_contact::{ContactSolver, StaticContactResult};
+use synovia_nonlinear::{GapControl, NonlinearContact, NonlinearResult};
 use synovia_time::quasistatic::{QuasiStaticStepper, StepperCheckpoint};
 use synovia_time::results::StepRecord;
 
@@ -732,6 +733,8 @@ pub(crate) struct RigidDriver {
     /// The coordinates of the last accepted level (the slip origin of friction against the
     /// rigid bodies at the next quasi-static level).
     accepted: Option<Vec<Vec<Real>>>,
+    /// Nonlinear models: the slope `dR/dw` of the last level's gap control (its first step).
+    slope: Option<Real>,
 }
 
 type Level<const D: usize> = (StepRecord, StaticContactResult<D>);
@@ -775,7 +778,7 @@ type ForceSystem = ([Real; 3], [Real; 3]);
 impl RigidDriver {
     pub(crate) fn new<const D: usize>(joint: &JointModel<D>) -> Self {
         let zeros = || joint.rigid_bodies().iter().map(|_| vec![0.0; rigid_dofs(D)]).collect();
-        Self { q: zeros(), offset: zeros(), jacobian: None, accepted: None }
+        Self { q: zeros(), offset: zeros(), jacobian: None, accepted: None, slope: None }
     }
 
     /// Forgets the force-controlled coordinates and the Jacobian.
@@ -802,24 +805,7 @@ impl RigidDriver {
     ) -> Result<Level<D>, JointError> {
         let model = joint.model();
         let bodies = joint.rigid_bodies();
-        let values: Vec<Vec<Real>> = bodies.iter().map(|b| b.control_values(t)).collect();
-        for (bi, body) in bodies.iter().enumerate() {
-            for (k, c) in body.controls.iter().enumerate() {
-                match c {
-                    DofControl::Prescribed(_) => self.q[bi][k] = values[bi][k],
-                    DofControl::Force { guess: Some(g), .. } => {
-                        self.q[bi][k] = g.value(t) + self.offset[bi][k]
-                    }
-                    DofControl::Force { guess: None, .. } => {}
-                }
-            }
-            if self.q[bi].iter().chain(&values[bi]).any(|v| !v.is_finite()) {
-                return Err(JointError::Invalid(format!(
-                    "rigid body `{}` at t = {t}: a control value is not finite ({:?})",
-                    body.name, values[bi]
-                )));
-            }
-        }
+        let values = self.set_controls(joint, t)?;
         let unknowns: Vec<(usize, usize)> = bodies
             .iter()
             .enumerate()
@@ -1037,6 +1023,193 @@ impl RigidDriver {
         let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
         self.accepted = Some(self.q.clone());
         Ok((record, result))
+    }
+
+    /// The level's start: the control values `h_k(t)`, `F_k(t)` of every rigid body, the
+    /// prescribed coordinates set, the force-controlled ones at their guess (with the offset of
+    /// the last level) or left at the last level's value.
+    fn set_controls<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        t: Real,
+    ) -> Result<Vec<Vec<Real>>, JointError> {
+        let bodies = joint.rigid_bodies();
+        let values: Vec<Vec<Real>> = bodies.iter().map(|b| b.control_values(t)).collect();
+        for (bi, body) in bodies.iter().enumerate() {
+            for (k, c) in body.controls.iter().enumerate() {
+                match c {
+                    DofControl::Prescribed(_) => self.q[bi][k] = values[bi][k],
+                    DofControl::Force { guess: Some(g), .. } => {
+                        self.q[bi][k] = g.value(t) + self.offset[bi][k]
+                    }
+                    DofControl::Force { guess: None, .. } => {}
+                }
+            }
+            if self.q[bi].iter().chain(&values[bi]).any(|v| !v.is_finite()) {
+                return Err(JointError::Invalid(format!(
+                    "rigid body `{}` at t = {t}: a control value is not finite ({:?})",
+                    body.name, values[bi]
+                )));
+            }
+        }
+        Ok(values)
+    }
+
+    /// One level of a nonlinear model (nonlinear materials or finite strain, docs/model.md
+    /// §12) with rigid contact partners: the prescribed coordinates set, and a force-controlled
+    /// coordinate `q_k` found inside the Newton iteration ([`NonlinearContact::step_gap_controlled`]):
+    /// with `σ = sign F_k` and `w = σ q_k` (the travel along the applied force), each Newton
+    /// iteration chooses `w` on its linearised problem so that
+    ///
+    /// ```text
+    /// R(w) = −σ Q_k = −σ Σ_r κ_r Λ_n,r n_r · v_k(x_r) = σ F_k   (Q_k + F_k = 0, docs/model.md (10.2)),
+    /// ```
+    ///
+    /// the gaps followed to first order in `w` from the pose the geometry was built at,
+    /// `∂d_r/∂w = σ n_r · v_k(x_r)` (10.4); a solution farther than the geometry tolerance from
+    /// that pose is solved again on the geometry rebuilt at it (at most 8 times). One
+    /// force-controlled coordinate, rigid bodies as contact partners, frictionless pairs.
+    ///
+    /// # Errors
+    /// [`JointError::Unsupported`] for several force-controlled coordinates; the errors of the
+    /// Newton iteration (no convergence, a force-controlled body not resisted).
+    pub(crate) fn nonlinear_level<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        nl: &mut NonlinearContact<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+    ) -> Result<(StepRecord, NonlinearResult<D>), JointError> {
+        let model = joint.model();
+        let bodies = joint.rigid_bodies();
+        let values = self.set_controls(joint, t)?;
+        let unknowns: Vec<(usize, usize)> = bodies
+            .iter()
+            .enumerate()
+            .flat_map(|(bi, b)| b.force_dofs().into_iter().map(move |k| (bi, k)))
+            .collect();
+        let length = joint.model_size();
+        let params = joint.force_control_params();
+        self.set_poses(joint);
+        let (level, solves) = match unknowns.as_slice() {
+            [] => {
+                nl.rebuild_geometry(model)?;
+                (nl.step_to(model, t, solver)?, 1)
+            }
+            &[(b, k)] => {
+                let f = values[b][k];
+                let sigma = if f < 0.0 { -1.0 } else { 1.0 };
+                let scale = force_scales(bodies, &values, &unknowns, length)[0];
+                let body = &bodies[b];
+                let q0 = self.q[b].clone();
+                let current = std::cell::Cell::new(q0[k]);
+                let coordinates = |z: Real| {
+                    let mut q = q0.clone();
+                    q[k] = z;
+                    q
+                };
+                let pose = |w: Real| {
+                    current.set(sigma * w);
+                    body.pose.set(body.pose_of(&coordinates(sigma * w)));
+                };
+                let owner = joint.pair_rigid_owner(nl.geometry());
+                let owned = |pair: usize| owner.get(pair).copied().flatten() == Some(b);
+                let sensitivity = |geometry: &ContactGeometry<D>| -> Vec<Real> {
+                    let q = coordinates(current.get());
+                    geometry
+                        .nodes
+                        .iter()
+                        .map(|node| {
+                            if owned(node.pair) {
+                                sigma * node.normal.dot(&body.velocity(&q, k, &node.position))
+                            } else {
+                                0.0
+                            }
+                        })
+                        .collect()
+                };
+                let resultant = |geometry: &ContactGeometry<D>, lambda_n: &[Real]| -> Real {
+                    let q = coordinates(current.get());
+                    let generalised: Real = geometry
+                        .nodes
+                        .iter()
+                        .zip(lambda_n)
+                        .filter(|(node, _)| owned(node.pair))
+                        .map(|(node, l)| node.weight * l * node.normal.dot(&body.velocity(&q, k, &node.position)))
+                        .sum();
+                    -sigma * generalised
+                };
+                let mut w = sigma * q0[k];
+                let mut trials = 0;
+                let mut passes = 0;
+                let level = loop {
+                    let mut control = GapControl {
+                        pose: &pose,
+                        sensitivity: &sensitivity,
+                        resultant: &resultant,
+                        target: sigma * f,
+                        tolerance: params.tolerance * scale,
+                        slope: self.slope.unwrap_or(0.0),
+                        w,
+                        overlap: 1e-4 * length,
+                        base: w,
+                        trials: 0,
+                    };
+                    let level = nl.step_gap_controlled(model, t, solver, &mut control)?;
+                    trials += control.trials;
+                    passes += 1;
+                    if control.slope > 0.0 && control.slope.is_finite() {
+                        self.slope = Some(control.slope);
+                    }
+                    w = control.w;
+                    let moved = (w - control.base).abs() * if k < D { 1.0 } else { length };
+                    tracing::debug!(t, passes, w, base = control.base, trials = control.trials, "gap-controlled level");
+                    if moved <= params.geometry_tolerance * length {
+                        break level;
+                    }
+                    if passes >= 8 {
+                        return Err(JointError::Invalid(format!(
+                            "t = {t}: the force-controlled `{}`.{} moved by {moved:e} from the pose of its contact geometry after {passes} rebuilds (tolerance {:e})",
+                            body.name,
+                            dof_names(D)[k],
+                            params.geometry_tolerance * length
+                        )));
+                    }
+                };
+                self.q[b][k] = sigma * w;
+                (level, trials)
+            }
+            _ => {
+                return Err(JointError::Unsupported {
+                    solver: "nonlinear (Newton)".into(),
+                    feature: format!(
+                        "{} force-controlled degrees of freedom of rigid bodies with nonlinear materials or finite strain (one is supported; prescribe the others)",
+                        unknowns.len()
+                    ),
+                })
+            }
+        };
+        self.set_poses(joint);
+        for (bi, body) in bodies.iter().enumerate() {
+            for (k, c) in body.controls.iter().enumerate() {
+                if let DofControl::Force { guess: Some(g), .. } = c {
+                    self.offset[bi][k] = self.q[bi][k] - g.value(t);
+                }
+            }
+        }
+        let geometry = nl.geometry();
+        let record = StepRecord {
+            time: t,
+            pairs: synovia_time::results::pair_records(geometry, &level.contact),
+            strain_energy: level.strain_energy,
+            iterations: level.report.total_iterations,
+            solver: level.contact.solution.report.solver.clone(),
+            fallback: level.contact.solution.report.fallback.clone(),
+            ..Default::default()
+        };
+        let record = self.finish(joint, geometry, record, &level.contact, &values, t, solves)?;
+        self.accepted = Some(self.q.clone());
+        Ok((record, level))
     }
 
     /// The rigid bodies posed at the force-controlled coordinates `z`, the contact geometry

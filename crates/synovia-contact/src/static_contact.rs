@@ -156,9 +156,24 @@ impl<const D: usize> StaticContact<D> {
         params: ElasticParams,
         assemble: impl FnOnce(&DofMap<D>, &mut SymmetricMatrix) -> Result<(), FemError>,
     ) -> Result<Self, ContactError> {
+        Self::with_system_matrix_block(model, pairs, params, InterfaceBlockParams::default(), assemble)
+    }
+
+    /// [`StaticContact::with_system_matrix`] with the given choice of the interface dofs
+    /// ordered last ([`InterfaceBlockParams`], as [`StaticContact::with_interface_block`]).
+    ///
+    /// # Errors
+    /// As [`StaticContact::with_system_matrix`].
+    pub fn with_system_matrix_block(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        params: ElasticParams,
+        block: InterfaceBlockParams,
+        assemble: impl FnOnce(&DofMap<D>, &mut SymmetricMatrix) -> Result<(), FemError>,
+    ) -> Result<Self, ContactError> {
         let geometry = ContactGeometry::new(model, pairs)?;
         let interface = interface_nodes(model, pairs, &geometry)?;
-        let ordering = interface_ordering(&interface, InterfaceBlockParams::default());
+        let ordering = interface_ordering(&interface, block);
         let elastic = ElasticSolver::with_system_matrix(model, params, &ordering, assemble)?;
         Ok(Self {
             elastic,

@@ -392,6 +392,79 @@ impl<const D: usize> std::fmt::Debug for LoadControl<'_, D> {
     }
 }
 
+/// Control of a level by the position `w` of a rigid contact partner
+/// ([`NonlinearContact::step_gap_controlled`]): `w` is an unknown with the equation
+/// `R(w) = target` on a resultant `R` of the contact multipliers that does not decrease with `w`
+/// (e.g. `w` the travel of a rigid body along its applied force, `R` the contact force on it
+/// along that direction). The partner is posed at `w` whenever the contact geometry is built
+/// (at the start of the level, and between the geometry passes of finite strain), and between
+/// builds the gaps follow `w` to first order, `d_r(w) = d_r(w₀) + s_r (w − w₀)` with the
+/// sensitivities `s_r = ∂d_r/∂w` of the geometry built at `w₀` (docs/model.md (10.4)).
+pub struct GapControl<'a, const D: usize> {
+    /// Poses the partner at `w` (read by the contact shapes when the geometry is built).
+    pub pose: &'a dyn Fn(Real),
+    /// `∂d_r/∂w` per contact node of a geometry built at the current pose.
+    pub sensitivity: &'a dyn Fn(&ContactGeometry<D>) -> Vec<Real>,
+    /// The resultant `R(geometry, Λ_n)`, non-decreasing in `w`.
+    pub resultant: &'a dyn Fn(&ContactGeometry<D>, &[Real]) -> Real,
+    /// Its target value.
+    pub target: Real,
+    /// Absolute tolerance on `|R − target|` (each iteration's linearised problem is balanced to
+    /// a tenth of it).
+    pub tolerance: Real,
+    /// `dR/dw`: the first step's slope (`≤ 0` or not finite: estimated from the first trial),
+    /// updated with every secant step.
+    pub slope: Real,
+    /// In: the guess of `w`; out: the `w` of the solution.
+    pub w: Real,
+    /// Without a slope: the overlap beyond the first contact of the first trials (e.g. 1e-4
+    /// of the model size), doubled while the resultant stays zero.
+    pub overlap: Real,
+    /// Out: the `w` at which the last contact geometry was built (the solution's gaps are
+    /// first order in `w − base`; a caller asking for the exact geometry solves again when
+    /// they differ by more than its tolerance).
+    pub base: Real,
+    /// Out: contact solves (trials) of the search for `w`.
+    pub trials: usize,
+}
+
+impl<const D: usize> std::fmt::Debug for GapControl<'_, D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GapControl")
+            .field("target", &self.target)
+            .field("tolerance", &self.tolerance)
+            .field("slope", &self.slope)
+            .field("w", &self.w)
+            .field("overlap", &self.overlap)
+            .field("base", &self.base)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The gaps of a geometry built at `base`, followed to first order in `w`.
+struct FirstOrderGaps {
+    base: Real,
+    gaps: Vec<Real>,
+    sens: Vec<Real>,
+}
+
+impl FirstOrderGaps {
+    fn at(&self, w: Real) -> Vec<Real> {
+        self.gaps.iter().zip(&self.sens).map(|(g, s)| g + s * (w - self.base)).collect()
+    }
+    /// The smallest `w ≥ from` at which a gap closes (`None`: no gap closes along `w`).
+    fn first_contact(&self, from: Real) -> Option<Real> {
+        self.gaps
+            .iter()
+            .zip(&self.sens)
+            .filter(|(_, s)| **s < 0.0)
+            .map(|(g, s)| self.base + g / -s)
+            .filter(|w| w.is_finite())
+            .fold(None, |m: Option<Real>, w| Some(m.map_or(w, |m| m.min(w))))
+            .map(|w| w.max(from))
+    }
+}
+
 /// The converged state the next level starts from.
 #[derive(Debug, Clone)]
 struct State<const D: usize> {
@@ -459,7 +532,54 @@ impl<const D: usize> NonlinearContact<D> {
         elastic: ElasticParams,
         params: NewtonParams,
     ) -> Result<Self, NonlinearError> {
-        Self::build(model, pairs, kinematics, elastic, params, None)
+        Self::build(
+            model,
+            pairs,
+            kinematics,
+            elastic,
+            params,
+            None,
+            synovia_linalg::InterfaceBlockParams::default(),
+        )
+    }
+
+    /// As [`Self::new`], with the given choice of the interface dofs ordered last
+    /// ([`synovia_linalg::InterfaceBlockParams`], as [`StaticContact::with_interface_block`]):
+    /// e.g. no dense interface block (`max_dofs = 0`) for a large candidate surface whose
+    /// contact patches move, with the whole-factor solves screened by
+    /// [`Self::set_screening_band`].
+    ///
+    /// # Errors
+    /// As [`Self::new`].
+    pub fn with_interface_block(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        kinematics: &[Kinematics],
+        elastic: ElasticParams,
+        params: NewtonParams,
+        block: synovia_linalg::InterfaceBlockParams,
+    ) -> Result<Self, NonlinearError> {
+        Self::build(model, pairs, kinematics, elastic, params, None, block)
+    }
+
+    /// Rebuilds the contact geometry of the pairs on the reference meshes
+    /// ([`StaticContact::rebuild_geometry`]; e.g. after a rigid partner moved: a posed shape
+    /// reads its pose when the geometry is built). In finite strain the next level rebuilds it
+    /// on the deformed configuration anyway.
+    ///
+    /// # Errors
+    /// As [`StaticContact::rebuild_geometry`].
+    pub fn rebuild_geometry(&mut self, model: &Model<D>) -> Result<(), NonlinearError> {
+        self.contact.rebuild_geometry(model, &self.pairs)?;
+        Ok(())
+    }
+
+    /// Gap screening of the contact solves ([`StaticContact::set_screening_band`]).
+    ///
+    /// # Errors
+    /// As [`StaticContact::set_screening_band`].
+    pub fn set_screening_band(&mut self, band: Option<Real>) -> Result<(), NonlinearError> {
+        Ok(self.contact.set_screening_band(band)?)
     }
 
     /// As [`Self::new`], with a constant symmetric matrix `B` (reduced, on the tangent's
@@ -480,7 +600,15 @@ impl<const D: usize> NonlinearContact<D> {
         params: NewtonParams,
         assemble: impl FnOnce(&DofMap<D>, &mut synovia_linalg::SymmetricMatrix) -> Result<(), FemError>,
     ) -> Result<Self, NonlinearError> {
-        Self::build(model, pairs, kinematics, elastic, params, Some(Box::new(assemble)))
+        Self::build(
+            model,
+            pairs,
+            kinematics,
+            elastic,
+            params,
+            Some(Box::new(assemble)),
+            synovia_linalg::InterfaceBlockParams::default(),
+        )
     }
 
     #[allow(clippy::type_complexity)]
@@ -493,6 +621,7 @@ impl<const D: usize> NonlinearContact<D> {
         assemble: Option<
             Box<dyn FnOnce(&DofMap<D>, &mut synovia_linalg::SymmetricMatrix) -> Result<(), FemError> + '_>,
         >,
+        block: synovia_linalg::InterfaceBlockParams,
     ) -> Result<Self, NonlinearError> {
         params.check()?;
         let nb = model.bodies().len();
@@ -505,7 +634,7 @@ impl<const D: usize> NonlinearContact<D> {
         let zero: Vec<Vec<Vector<D>>> =
             model.bodies().iter().map(|b| vec![Vector::<D>::zeros(); b.mesh.n_nodes()]).collect();
         let mut constant = None;
-        let contact = StaticContact::with_system_matrix(model, pairs, elastic, |dofs, m| {
+        let contact = StaticContact::with_system_matrix_block(model, pairs, elastic, block, |dofs, m| {
             assemble_tangent(model, dofs, kinematics, &zero, m)?;
             if let Some(assemble) = assemble {
                 let mut b = m.clone();
@@ -718,6 +847,112 @@ impl<const D: usize> NonlinearContact<D> {
         Ok((f, energy))
     }
 
+    /// The search for `w` of one Newton iteration under [`GapControl`] (see
+    /// [`Self::step_gap_controlled`]): trials on the linearised problem with the load `load`,
+    /// the gaps of `gaps` at each trial's `w`; returns the `w` found and its multipliers (the
+    /// contact geometry's gaps left at that `w`).
+    fn search_gap_control(
+        &mut self,
+        g: &mut GapControl<'_, D>,
+        gaps: &FirstOrderGaps,
+        load: &[Real],
+        lifts: &[Vector<D>],
+        solver: &dyn ContactSolver,
+        warm: Option<&ContactSolution>,
+    ) -> Result<(Real, ContactSolution), NonlinearError> {
+        let rows = self.contact.geometry().len();
+        let inner = 0.1 * g.tolerance;
+        let fail = |w: Real, reason: String| NonlinearError::NoConvergence {
+            time: w,
+            cutbacks: 0,
+            step: 0.0,
+            reason,
+        };
+        let mut w = g.w;
+        // trials below (`lo`) and above (`hi`) the target nearest to it, and the last one
+        let mut lo: Option<(Real, Real)> = None;
+        let mut hi: Option<(Real, Real)> = None;
+        let mut last: Option<(Real, Real)> = None;
+        let mut warm_trial = warm.filter(|s| s.lambda_n.len() == rows).cloned();
+        let mut overlap = 0.5 * g.overlap.abs();
+        for _ in 0..60 {
+            self.contact.set_gaps(&gaps.at(w))?;
+            let (solution, _) =
+                self.contact.solve_load_multipliers(load, lifts, solver, None, None, warm_trial.as_ref())?;
+            g.trials += 1;
+            let r = (g.resultant)(self.contact.geometry(), &solution.lambda_n);
+            if !r.is_finite() {
+                return Err(fail(w, format!("gap control: resultant {r} at w = {w}")));
+            }
+            if (r - g.target).abs() <= inner {
+                return Ok((w, solution));
+            }
+            if r < g.target {
+                if lo.is_none_or(|(a, _)| w > a) {
+                    lo = Some((w, r));
+                }
+            } else if hi.is_none_or(|(b, _)| w < b) {
+                hi = Some((w, r));
+            }
+            if let Some((wp, rp)) = last {
+                let s = (r - rp) / (w - wp);
+                if s > 0.0 && s.is_finite() {
+                    g.slope = s;
+                }
+            }
+            let slope = (g.slope > 0.0 && g.slope.is_finite()).then_some(g.slope);
+            let next = match (lo, hi) {
+                (Some((a, ra)), Some((b, rb))) => {
+                    // the secant if it stays inside the bracket, else regula falsi, else bisection
+                    let secant = slope.map(|s| w + (g.target - r) / s);
+                    let falsi = a + (g.target - ra) * (b - a) / (rb - ra);
+                    match secant {
+                        Some(x) if x > a && x < b => x,
+                        _ if falsi > a && falsi < b => falsi,
+                        _ => 0.5 * (a + b),
+                    }
+                }
+                _ if r <= 0.0 => {
+                    // no contact force: on to the first contact, then by the slope
+                    let touch = gaps.first_contact(w).ok_or_else(|| {
+                        fail(
+                            w,
+                            "gap control: no contact gap closes along w (the partner is not resisted)".into(),
+                        )
+                    })?;
+                    match slope {
+                        Some(s) => touch.max(w) + g.target / s,
+                        None => {
+                            overlap *= 2.0;
+                            touch.max(w) + overlap
+                        }
+                    }
+                }
+                _ => match slope {
+                    Some(s) => w + (g.target - r) / s,
+                    // the secant from the first contact
+                    None => match gaps.first_contact(Real::NEG_INFINITY).filter(|t| *t < w) {
+                        Some(touch) => w + (g.target - r) * (w - touch) / r,
+                        None => return Err(fail(w, "gap control: no slope to step with".into())),
+                    },
+                },
+            };
+            if !next.is_finite() || next == w {
+                return Err(fail(
+                    w,
+                    format!(
+                        "gap control: the search stalled at w = {w} (resultant {r}, target {})",
+                        g.target
+                    ),
+                ));
+            }
+            last = Some((w, r));
+            warm_trial = Some(solution);
+            w = next;
+        }
+        Err(fail(w, format!("gap control: no w balanced the resultant to {} in 60 contact solves", inner)))
+    }
+
     fn finite_strain(&self) -> bool {
         self.kinematics.contains(&Kinematics::FiniteStrain)
     }
@@ -760,7 +995,7 @@ impl<const D: usize> NonlinearContact<D> {
         let mut halvings = 0usize;
         loop {
             let (time, scale) = point(target);
-            match self.newton(model, time, scale, solver, &mut report, None, None) {
+            match self.newton(model, time, scale, solver, &mut report, None, None, None) {
                 Ok((result, energy, iterations, reduced, force, _)) => {
                     report.sublevels += 1;
                     self.state =
@@ -852,7 +1087,60 @@ impl<const D: usize> NonlinearContact<D> {
                 control.target, control.slope
             )));
         }
-        self.whole_level(model, t_guess, solver, Some(control), None)
+        self.whole_level(model, t_guess, solver, Some(control), None, None)
+    }
+
+    /// Solves the level `t` with a rigid contact partner's position `w` as an unknown
+    /// ([`GapControl`]): Newton's method as in [`Self::step_to`] from the committed state
+    /// (loaded or the reference configuration), where every iteration also chooses `w` on the
+    /// linearised problem (frozen tangent, gaps first order in `w`) so that its multipliers
+    /// satisfy `R(w) = target`:
+    ///
+    /// ```text
+    /// K_T δũ + B_hnᵀ κ Λ_n = f_ext(t) − f_int(u_k),   Λ_n ≥ 0 ⟂ B_hn (ũ_k + δũ) ≤ d(w),   R(Λ_n) = target,
+    /// ```
+    ///
+    /// by a safeguarded secant iteration on `w` (each trial a contact solve for the
+    /// multipliers on the kept factorisation; bracketing by regula falsi once a trial on each
+    /// side of the target is known; from no contact, first to the `w` that closes the first
+    /// gap). A step that moved `w` is taken whole, as a predictor. The contact geometry is built
+    /// at the pose `w` at the start of the level (and, in finite strain, on the deformed
+    /// configuration between passes); `control.base` tells where. At convergence the
+    /// equilibrium residual is at the Newton tolerance and `|R − target| ≤ tolerance / 10`.
+    /// Frictionless (the slip of friction against a moving partner is not measured here):
+    /// pairs with a friction coefficient are refused. No cut-back; on failure the committed
+    /// state is unchanged.
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] for a non-finite `t`, guess, target or tolerance,
+    /// or a pair with friction; [`NonlinearError::NoConvergence`] when Newton or the search
+    /// for `w` fails; model and contact errors.
+    pub fn step_gap_controlled(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        control: &mut GapControl<'_, D>,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
+        if !(t.is_finite()
+            && control.w.is_finite()
+            && control.target.is_finite()
+            && control.tolerance.is_finite()
+            && control.tolerance > 0.0)
+        {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "gap control: t {t}, guess {}, target {}, tolerance {} must be finite (tolerance positive)",
+                control.w, control.target, control.tolerance
+            )));
+        }
+        if self.contact.geometry().nodes.iter().any(|n| n.friction > 0.0) {
+            return Err(NonlinearError::InvalidParameter(
+                "gap control is frictionless: the slip against a moving partner is not measured in the nonlinear solve"
+                    .into(),
+            ));
+        }
+        control.trials = 0;
+        self.whole_level(model, t, solver, None, None, Some(control))
     }
 
     /// Solves one level `t` with extra terms from the committed state (docs/model.md (12.1)):
@@ -892,7 +1180,7 @@ impl<const D: usize> NonlinearContact<D> {
                 "a level with extra terms starts from a loaded state (set_state)".into(),
             ));
         }
-        self.whole_level(model, t, solver, None, Some(terms))
+        self.whole_level(model, t, solver, None, Some(terms), None)
     }
 
     /// One level solved whole (no cut-back) from the committed state by the Newton iteration,
@@ -906,10 +1194,11 @@ impl<const D: usize> NonlinearContact<D> {
         solver: &dyn ContactSolver,
         control: Option<&mut LoadControl<'_, D>>,
         terms: Option<&LevelTerms<'_>>,
+        gap: Option<&mut GapControl<'_, D>>,
     ) -> Result<NonlinearResult<D>, NonlinearError> {
         let start = Instant::now();
         let mut report = NewtonReport::default();
-        match self.newton(model, t, 1.0, solver, &mut report, control, terms) {
+        match self.newton(model, t, 1.0, solver, &mut report, control, terms, gap) {
             Ok((result, energy, iterations, reduced, force, t)) => {
                 report.sublevels = 1;
                 report.iterations = iterations;
@@ -965,6 +1254,7 @@ impl<const D: usize> NonlinearContact<D> {
         report: &mut NewtonReport,
         mut control: Option<&mut LoadControl<'_, D>>,
         terms: Option<&LevelTerms<'_>>,
+        mut gap: Option<&mut GapControl<'_, D>>,
     ) -> Result<
         (StaticContactResult<D>, Real, Vec<NewtonIteration>, Vec<Real>, Vec<Real>, Real),
         NonlinearError,
@@ -973,7 +1263,7 @@ impl<const D: usize> NonlinearContact<D> {
         let step_solver = match self.params.active_sets {
             ActiveSetStrategy::Nested => None,
             strategy @ (ActiveSetStrategy::Combined | ActiveSetStrategy::Outer) => {
-                if control.is_some() {
+                if control.is_some() || gap.is_some() {
                     return Err(NonlinearError::InvalidParameter(format!(
                         "the {strategy:?} active-set strategy is not available under load control; use ActiveSetStrategy::Nested"
                     )));
@@ -991,6 +1281,24 @@ impl<const D: usize> NonlinearContact<D> {
         let solver: &dyn ContactSolver = step_solver.as_deref().unwrap_or(solver);
         let mut t = t;
         let n = self.dofs.n_dofs();
+        let finite_geometry =
+            self.finite_strain() && self.params.geometry_update != GeometryUpdate::Reference;
+        // gap control: the partner posed at the guess and, in small strain, the geometry built
+        // there (finite strain: on the deformed configuration at the first pass, below)
+        let mut first_order: Option<FirstOrderGaps> = None;
+        if let Some(g) = gap.as_deref_mut() {
+            (g.pose)(g.w);
+            if !finite_geometry {
+                self.contact.rebuild_geometry(model, &self.pairs)?;
+                let geometry = self.contact.geometry();
+                first_order = Some(FirstOrderGaps {
+                    base: g.w,
+                    gaps: geometry.nodes.iter().map(|node| node.gap).collect(),
+                    sens: (g.sensitivity)(geometry),
+                });
+                g.base = g.w;
+            }
+        }
         let mut lifts: Vec<Vector<D>> = self.dofs.lifts(model, t)?.into_iter().map(|l| l * scale).collect();
         let mut f_ext = vec![0.0; n];
         add_loads(model, &self.dofs, t, self.params.load_degree, &mut f_ext)?;
@@ -1100,7 +1408,19 @@ impl<const D: usize> NonlinearContact<D> {
                     }
                     None => disp.clone(),
                 };
+                if let Some(g) = gap.as_deref() {
+                    (g.pose)(g.w);
+                }
                 self.contact.update_geometry(model, &self.pairs, &at)?;
+                if let Some(g) = gap.as_deref_mut() {
+                    let geometry = self.contact.geometry();
+                    first_order = Some(FirstOrderGaps {
+                        base: g.w,
+                        gaps: geometry.nodes.iter().map(|node| node.gap).collect(),
+                        sens: (g.sensitivity)(geometry),
+                    });
+                    g.base = g.w;
+                }
                 geometry_at = Some(at);
                 refresh = false;
                 first_of_pass = true;
@@ -1229,6 +1549,26 @@ impl<const D: usize> NonlinearContact<D> {
                 lifts = lt;
                 f_ext = fe;
                 (ld, res)
+            } else if let Some(g) = gap.as_deref_mut() {
+                // gap control: the partner's position `w` of this iteration is the one at which
+                // the linearised problem's resultant equals the target (safeguarded secant on
+                // `w`, the gaps first order in `w`; each trial a contact solve for the
+                // multipliers on the kept factorisation)
+                let fo = first_order.as_ref().ok_or_else(|| {
+                    NonlinearError::InvalidParameter("internal: gap control without a geometry".into())
+                })?;
+                let mut load: Vec<Real> = (0..n).map(|i| f_ext[i] - f_int[i] + ku[i]).collect();
+                if predictor {
+                    let before = load.clone();
+                    subtract_tangent_lift(model, &self.dofs, kin, at, &delta_lifts, &mut load)?;
+                    let lift_force: Vec<Real> = (0..n).map(|i| load[i] - before[i]).collect();
+                    r_start = r_start.max(norm(&lift_force));
+                }
+                let (w, solution) = self.search_gap_control(g, fo, &load, &lifts, solver, warm.as_ref())?;
+                let res = self.contact.complete_load(&load, &lifts, None, None, solution)?;
+                predictor = predictor || w != g.w;
+                g.w = w;
+                (load, res)
             } else {
                 let mut load: Vec<Real> = (0..n).map(|i| f_ext[i] - f_int[i] + ku[i]).collect();
                 if predictor {
@@ -1249,6 +1589,7 @@ impl<const D: usize> NonlinearContact<D> {
                 (load, result)
             };
             let u_star = &result.solution.u;
+            let k = self.contact.elastic().stiffness();
             let mut k_star = vec![0.0; n];
             k.mul_vec(u_star, &mut k_star);
             let c_star: Vec<Real> = (0..n).map(|i| load[i] - k_star[i]).collect();

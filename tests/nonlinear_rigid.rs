@@ -1,0 +1,197 @@
+//! Rigid bodies with mixed control in the nonlinear path of `JointModel` (docs/nonlinear.md,
+//! "Rigid bodies"): a rigid spherical indenter on a clamped block, posed in five coordinates
+//! (two translations and three rotations prescribed) and pushed down by a force history along
+//! its vertical translation, the force-controlled coordinate found inside the Newton iteration.
+//!
+//! * a linear law routed through the Newton path (a material that hides its constant stiffness)
+//!   gives the linear path's solution (rigid coordinates, displacements, pressures) to 1e-8;
+//! * a neo-Hookean block (finite strain) at a small load equals the linear one to 1 %;
+//! * the contact resultant equals the applied force (balance) and the KKT residual of the
+//!   contact solution is small.
+
+use std::sync::Arc;
+
+use synovia::fem::Kinematics;
+use synovia::material::{neo_hookean, VoigtMatrix, VoigtVector};
+use synovia::prelude::*;
+use synovia::rigid::{ForceControlParams, RigidBody};
+use synovia::time::history::FnHistory;
+
+type Error = Box<dyn std::error::Error>;
+
+const E: f64 = 1.0e3;
+const NU: f64 = 0.3;
+const RADIUS: f64 = 2.0;
+
+/// A linear material without a constant stiffness: the model goes through the Newton path.
+#[derive(Debug)]
+struct Hidden(LinearElastic<3>);
+
+impl Material<3> for Hidden {
+    fn stress(&self, strain: &VoigtVector) -> VoigtVector {
+        self.0.stress(strain)
+    }
+    fn tangent(&self, strain: &VoigtVector) -> VoigtMatrix {
+        self.0.tangent(strain)
+    }
+    fn energy_density(&self, strain: &VoigtVector) -> f64 {
+        self.0.energy_density(strain)
+    }
+    fn name(&self) -> String {
+        "linear (hidden stiffness)".into()
+    }
+}
+
+/// The block `[-1, 1]² × [0, 1]` (clamped bottom) with `material`, and the indenter: a rigid
+/// sphere of radius 2 touching the top at `(0.15, −0.1, 1)` in its own frame, its reference
+/// point `c = (0, 0, 3)`; `tx`, `ty` and the three rotations prescribed (small, so the sphere
+/// moves and tilts about a point that is not its centre), `tz` loaded by `−force · t`.
+fn model(material: Arc<dyn Material<3>>, force: f64) -> Result<JointModel<3>, Error> {
+    let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [12, 12, 6], [Grading::Uniform; 3])?;
+    let mut joint = JointModel::<3>::new();
+    joint.add_body("block", mesh, material)?;
+    joint.clamp("block", "bottom")?;
+    let centre = Point::<3>::new(0.0, 0.0, 3.0);
+    let indenter = RigidBody::<3>::new("indenter", centre)?
+        .prescribe(0, FnHistory::new(|t| 0.02 * t))?
+        .prescribe(1, Constant(-0.01))?
+        .force_with_guess(2, FnHistory::new(move |t| -force * t), Constant(0.0))?
+        .prescribe(3, FnHistory::new(|t| 0.01 * t))?
+        .prescribe(4, Constant(-0.005))?
+        .prescribe(5, Constant(0.02))?;
+    joint.add_rigid_body(indenter)?;
+    let shape = Arc::new(SphereObstacle::new(Point::<3>::new(0.15, -0.1, 1.0 + RADIUS), RADIUS, false)?);
+    joint.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+    // both paths accept a solution whose contact geometry was built within the geometry
+    // tolerance of its pose (the rows' normals are those of that pose: first order in the
+    // distance): a tight one, so that the two agree to 1e-8 and not to the default 1e-6
+    joint.force_control(ForceControlParams { geometry_tolerance: 1e-10, ..ForceControlParams::default() });
+    Ok(joint)
+}
+
+fn max_abs(u: &[Vec<Vector<3>>]) -> f64 {
+    u.iter().flatten().map(|v| v.amax()).fold(0.0, f64::max)
+}
+
+fn max_diff(a: &[Vec<Vector<3>>], b: &[Vec<Vector<3>>]) -> f64 {
+    a.iter().flatten().zip(b.iter().flatten()).map(|(x, y)| (x - y).amax()).fold(0.0, f64::max)
+}
+
+/// The linear law through the Newton path equals the linear path, level by level.
+#[test]
+fn linear_law_through_newton_equals_the_linear_path() -> Result<(), Error> {
+    let force = 20.0;
+    let times = [0.5, 1.0];
+    let linear = model(Arc::new(isotropic(E, NU)?), force)?;
+    assert!(!linear.is_nonlinear());
+    let routed = model(Arc::new(Hidden(isotropic(E, NU)?)), force)?;
+    assert!(routed.is_nonlinear());
+    let mut runs = Vec::new();
+    for joint in [&linear, &routed] {
+        let mut fields = Vec::new();
+        let run = joint.run_quasistatic_with(&times, |view| {
+            fields.push((view.result.displacement.clone(), view.result.solution.lambda_n.clone()));
+            Ok(())
+        })?;
+        runs.push((run, fields));
+    }
+    let ((lin, lin_fields), (nl, nl_fields)) = (&runs[0], &runs[1]);
+    for (level, (a, b)) in lin.records.iter().zip(&nl.records).enumerate() {
+        let (ra, rb) = (&a.rigid[0], &b.rigid[0]);
+        // the force-controlled travel, relative to itself; the prescribed coordinates exactly
+        let travel = (ra.dofs[2] - rb.dofs[2]).abs() / ra.dofs[2].abs();
+        assert!(travel < 1e-8, "level {level}: tz {} vs {} ({travel:e})", ra.dofs[2], rb.dofs[2]);
+        for k in [0, 1, 3, 4, 5] {
+            assert_eq!(ra.dofs[k], rb.dofs[k], "level {level}, dof {k}");
+        }
+        for k in 0..6 {
+            let d = (ra.reaction[k] - rb.reaction[k]).abs() / force;
+            assert!(d < 1e-8, "level {level}: reaction {k}: {:?} vs {:?}", ra.reaction, rb.reaction);
+        }
+        let (ua, la) = &lin_fields[level];
+        let (ub, lb) = &nl_fields[level];
+        let du = max_diff(ua, ub) / max_abs(ua);
+        assert!(du < 1e-8, "level {level}: displacements differ by {du:e}");
+        let lmax = la.iter().copied().fold(0.0, f64::max);
+        let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
+        assert!(dl < 1e-8, "level {level}: pressures differ by {dl:e}");
+        assert!(a.pairs[0].peak_pressure > 0.0 && b.pairs[0].contact_area > 0.0);
+    }
+    Ok(())
+}
+
+/// Balance and KKT of the Newton path's solution, and neo-Hookean (finite strain) at a small
+/// load against linear: the same travel, force and pressures to 1 %.
+#[test]
+fn neo_hookean_at_a_small_load_equals_linear_and_balances() -> Result<(), Error> {
+    // a strain of about 1e-3 under the indenter
+    let force = 2.0;
+    let linear = model(Arc::new(isotropic(E, NU)?), force)?;
+    let mut hyper = model(Arc::new(neo_hookean(E, NU)?), force)?;
+    hyper.set_kinematics("block", Kinematics::FiniteStrain)?;
+    assert!(hyper.is_nonlinear());
+    let lin = linear.run_static(1.0)?;
+    let mut kkt = Vec::new();
+    let nh = hyper.run_quasistatic_with(&[0.5, 1.0], |view| {
+        kkt.push(view.result.kkt.max());
+        Ok(())
+    })?;
+    for (level, rec) in nh.records.iter().enumerate() {
+        let rigid = &rec.rigid[0];
+        let applied = force * rec.time;
+        // the force-controlled coordinate balances the applied force: the generalised reaction
+        // and the contact resultant along z
+        assert!(rigid.balance_error < 1e-9, "level {level}: {rigid:?}");
+        assert!((rigid.reaction[2] - applied).abs() < 1e-9 * force, "level {level}: {rigid:?}");
+        assert!((rec.pairs[0].force[2] + applied).abs() < 1e-9 * force, "level {level}: {:?}", rec.pairs[0]);
+        assert!(kkt[level] < 1e-8, "level {level}: KKT {:e}", kkt[level]);
+        assert!(rigid.solves > 0);
+    }
+    let (a, b) = (&lin.records[0], &nh.records[1]);
+    let travel = (a.rigid[0].dofs[2] - b.rigid[0].dofs[2]).abs() / a.rigid[0].dofs[2].abs();
+    assert!(travel < 0.01, "travel: linear {} vs neo-Hookean {}", a.rigid[0].dofs[2], b.rigid[0].dofs[2]);
+    let peak = (a.pairs[0].peak_pressure - b.pairs[0].peak_pressure).abs() / a.pairs[0].peak_pressure;
+    assert!(
+        peak < 0.01,
+        "peak pressure: linear {} vs neo-Hookean {}",
+        a.pairs[0].peak_pressure,
+        b.pairs[0].peak_pressure
+    );
+    let normal = (a.pairs[0].normal_force - b.pairs[0].normal_force).abs() / a.pairs[0].normal_force;
+    assert!(normal < 0.01, "normal force: {} vs {}", a.pairs[0].normal_force, b.pairs[0].normal_force);
+    // and the run is not the linear one: the finite-strain solution differs (a test that can fail)
+    assert!(travel > 0.0);
+    Ok(())
+}
+
+/// What the nonlinear path does not take is refused with a typed error: friction against a
+/// rigid body, and several force-controlled coordinates.
+#[test]
+fn unsupported_rigid_cases_are_refused() -> Result<(), Error> {
+    // friction on the rigid pair
+    let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [4, 4, 2], [Grading::Uniform; 3])?;
+    let mut with_friction = JointModel::<3>::new();
+    with_friction.add_body("block", mesh, Arc::new(neo_hookean(E, NU)?) as Arc<dyn Material<3>>)?;
+    with_friction.clamp("block", "bottom")?;
+    let indenter =
+        RigidBody::<3>::new("indenter", Point::<3>::new(0.0, 0.0, 3.0))?.force(2, Constant(-1.0))?;
+    with_friction.add_rigid_body(indenter)?;
+    let shape = Arc::new(SphereObstacle::new(Point::<3>::new(0.0, 0.0, 3.0), RADIUS, false)?);
+    with_friction.contact_rigid_body("indent", "block", "top", "indenter", shape.clone(), 0.1)?;
+    let err = with_friction.run_static(1.0).err().ok_or("friction against a rigid body accepted")?;
+    assert!(matches!(err, JointError::Unsupported { .. }), "{err}");
+    assert!(err.to_string().contains("friction"), "{err}");
+
+    let mut two = JointModel::<3>::new();
+    let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [4, 4, 2], [Grading::Uniform; 3])?;
+    two.add_body("block", mesh, Arc::new(neo_hookean(E, NU)?) as Arc<dyn Material<3>>)?;
+    two.clamp("block", "bottom")?;
+    let indenter = RigidBody::<3>::new("indenter", Point::<3>::new(0.0, 0.0, 3.0))?
+        .force(2, Constant(-1.0))?
+        .force(3, Constant(0.0))?;
+    two.add_rigid_body(indenter)?;
+    two.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+    let err = two.run_static(1.0).err().ok_or("two force-controlled coordinates accepted")?;
+    assert!(matches!(err, JointError::Unsupported { .. }), "{err}");
+    Ok(())
+}
