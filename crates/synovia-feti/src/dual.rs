@@ -95,8 +95,9 @@ pub struct TfetiParams {
 ///   fixed, the face problem is a TFETI problem on the free rows, whose preconditioned operator
 ///   `P_F B A Bᵀ P_F F` on `Ker G_F` is the projected Dirichlet (or lumped) one of FETI
 ///   (`P_F Tᵀ = P_F`, since `T P_F = P_F`), bounded by `C (1 + log H/h)²` for the Dirichlet
-///   preconditioner (Farhat, Mandel, Roux 1994). `G_F G_Fᵀ = G_E G_Eᵀ + Σ_{i ∈ F∩I} g_i g_iᵀ` is
-///   factorised again when the free contact rows change.
+///   preconditioner (Farhat, Mandel, Roux 1994). `(G_F G_Fᵀ)⁻¹` is applied by the Woodbury
+///   update of the factor of `G_E G_Eᵀ` by the free contact rows' columns
+///   (`G_F G_Fᵀ = G_E G_Eᵀ + Σ_{i ∈ F∩I} g_i g_iᵀ`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[non_exhaustive]
 pub enum CoarseConstraint {
@@ -208,8 +209,9 @@ pub struct TfetiReport {
     /// Applications of the preconditioner (one interior solve per subdomain each with
     /// [`Preconditioner::Dirichlet`]).
     pub preconditioner_products: usize,
-    /// Factorisations of the face's coarse matrix `G_F G_Fᵀ` ([`CoarseConstraint::Projector`]
-    /// with a preconditioner; one per change of the free contact rows).
+    /// Factorisations of the face's capacitance matrix `I + Wᵀ(G_E G_Eᵀ)⁻¹W` (the update of
+    /// `G_F G_Fᵀ` by the free contact rows `W`; [`CoarseConstraint::Projector`] with a
+    /// preconditioner; one per change of the free contact rows).
     pub face_factorisations: usize,
     /// Final `‖g^P‖/‖b‖`.
     pub gradient: f64,
@@ -274,8 +276,6 @@ struct Dual<'a> {
     l: DMatrix<f64>,
     /// Cholesky of `G_E G_Eᵀ`.
     ge: nalgebra::Cholesky<f64, nalgebra::Dyn>,
-    /// `G_E G_Eᵀ` itself (for the face projectors of [`CoarseConstraint::Projector`]).
-    ge_gram: DMatrix<f64>,
     /// Equality rows (the first `n_eq` rows).
     n_eq: usize,
     products: std::sync::atomic::AtomicUsize,
@@ -366,8 +366,7 @@ impl<'a> Dual<'a> {
             }
             a
         };
-        let ge_gram = gram(0..n_eq);
-        let ge = nalgebra::Cholesky::new(ge_gram.clone()).ok_or(FetiError::SemiCoercive { pivot: 0 })?;
+        let ge = nalgebra::Cholesky::new(gram(0..n_eq)).ok_or(FetiError::SemiCoercive { pivot: 0 })?;
         let l = nalgebra::Cholesky::new(gram(0..m)).ok_or(FetiError::SemiCoercive { pivot: 0 })?.l();
         let dirichlet: Vec<Option<crate::subdomain::DirichletBlock>> =
             if preconditioner == Preconditioner::Dirichlet {
@@ -398,7 +397,6 @@ impl<'a> Dual<'a> {
             n_coarse,
             l,
             ge,
-            ge_gram,
             n_eq,
 
             products: std::sync::atomic::AtomicUsize::new(0),
@@ -535,18 +533,18 @@ impl<'a> Dual<'a> {
         y.iter().zip(&w).map(|(a, b)| a - b).collect()
     }
 
-    /// The Cholesky factor of `G_F G_Fᵀ = G_E G_Eᵀ + Σ_{i ∈ free_contact} g_i g_iᵀ`.
-    fn face_gram(&self, free_contact: &[usize]) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, FetiError> {
-        let mut a = self.ge_gram.clone();
-        for &r in free_contact {
-            let col = &self.g_cols[r];
-            for &(i, vi) in col {
-                for &(j, vj) in col {
-                    a[(i, j)] += vi * vj;
-                }
-            }
+    /// `(G_E G_Eᵀ)⁻¹ g_r` of row `r`'s coarse column `g_r`.
+    fn ge_solve_col(&self, r: usize) -> DVector<f64> {
+        let mut v = DVector::zeros(self.n_coarse);
+        for &(i, x) in &self.g_cols[r] {
+            v[i] += x;
         }
-        nalgebra::Cholesky::new(a).ok_or(FetiError::SemiCoercive { pivot: 0 })
+        self.ge.solve(&v)
+    }
+
+    /// `g_rᵀ y` of row `r`'s coarse column.
+    fn col_dot(&self, r: usize, y: &DVector<f64>) -> f64 {
+        self.g_cols[r].iter().map(|&(i, v)| v * y[i]).sum()
     }
 }
 
@@ -611,19 +609,66 @@ impl Hessian for ProjectedHessian<'_, '_> {
 struct ObliqueHessian<'d, 'a> {
     dual: &'d Dual<'a>,
     norm: f64,
-    /// Free contact rows of the last face and the Cholesky factor of its `G_F G_Fᵀ`.
-    face: Option<(Vec<usize>, nalgebra::Cholesky<f64, nalgebra::Dyn>)>,
-    /// Factorisations of `G_F G_Fᵀ` (one per change of the free contact rows).
+    /// `a_r = (G_E G_Eᵀ)⁻¹ g_r` of the contact rows met in a face so far (index `r − n_eq`).
+    a_cols: Vec<Option<DVector<f64>>>,
+    /// The free contact rows `W = [g_r]` of the last face and the Cholesky factor of its
+    /// capacitance matrix `C = I + Wᵀ (G_E G_Eᵀ)⁻¹ W`.
+    face: Option<(Vec<usize>, Option<nalgebra::Cholesky<f64, nalgebra::Dyn>>)>,
+    /// Factorisations of `C` (one per change of the free contact rows).
     face_factorisations: usize,
 }
 
-impl ObliqueHessian<'_, '_> {
+impl<'d, 'a> ObliqueHessian<'d, 'a> {
+    fn new(dual: &'d Dual<'a>) -> Self {
+        Self { dual, norm: 0.0, a_cols: vec![None; dual.m - dual.n_eq], face: None, face_factorisations: 0 }
+    }
+
+    /// Sets the face to the free contact rows `key` (Woodbury:
+    /// `(G_E G_Eᵀ + W Wᵀ)⁻¹ = A⁻¹ − A⁻¹ W C⁻¹ Wᵀ A⁻¹` with `A = G_E G_Eᵀ`, `C = I + Wᵀ A⁻¹ W`,
+    /// so only the `k × k` matrix `C` of the `k` free contact rows is factorised).
+    fn set_face(&mut self, key: Vec<usize>) -> Result<(), FetiError> {
+        if self.face.as_ref().is_some_and(|(k, _)| *k == key) {
+            return Ok(());
+        }
+        let d = self.dual;
+        for &r in &key {
+            if self.a_cols[r - d.n_eq].is_none() {
+                self.a_cols[r - d.n_eq] = Some(d.ge_solve_col(r));
+            }
+        }
+        let chol = if key.is_empty() {
+            None
+        } else {
+            let k = key.len();
+            let mut c = DMatrix::<f64>::identity(k, k);
+            for (i, &ri) in key.iter().enumerate() {
+                for (j, &rj) in key.iter().enumerate() {
+                    if let Some(aj) = &self.a_cols[rj - d.n_eq] {
+                        c[(i, j)] += d.col_dot(ri, aj);
+                    }
+                }
+            }
+            self.face_factorisations += 1;
+            Some(nalgebra::Cholesky::new(c).ok_or(FetiError::SemiCoercive { pivot: 0 })?)
+        };
+        self.face = Some((key, chol));
+        Ok(())
+    }
+
     /// `P_F v = v − Z_F G_Fᵀ (G_F G_Fᵀ)⁻¹ G_F v` for `v` zero off the face.
     fn project_face(&self, free: &[bool], v: &[f64]) -> Vec<f64> {
         let d = self.dual;
-        let Some((_, chol)) = &self.face else { return v.to_vec() };
-        let y = chol.solve(&d.g(v, 0..d.m));
-        let w = d.gt(&y, 0..d.m);
+        let mut s = d.ge.solve(&d.g(v, 0..d.m));
+        if let Some((key, Some(chol))) = &self.face {
+            let t = DVector::from_iterator(key.len(), key.iter().map(|&r| d.col_dot(r, &s)));
+            let w = chol.solve(&t);
+            for (&r, wi) in key.iter().zip(w.iter()) {
+                if let Some(a) = &self.a_cols[r - d.n_eq] {
+                    s.axpy(-wi, a, 1.0);
+                }
+            }
+        }
+        let w = d.gt(&s, 0..d.m);
         v.iter().zip(&w).zip(free).map(|((a, b), &f)| if f { a - b } else { 0.0 }).collect()
     }
 }
@@ -650,11 +695,7 @@ impl Hessian for ObliqueHessian<'_, '_> {
             return Ok(false);
         }
         let key: Vec<usize> = (d.n_eq..d.m).filter(|&i| free[i]).collect();
-        if self.face.as_ref().is_none_or(|(k, _)| *k != key) {
-            let chol = d.face_gram(&key).map_err(ContactError::from)?;
-            self.face_factorisations += 1;
-            self.face = Some((key, chol));
-        }
+        self.set_face(key).map_err(ContactError::from)?;
         let rf: Vec<f64> = r.iter().zip(free).map(|(&v, &f)| if f { v } else { 0.0 }).collect();
         let pr = self.project_face(free, &rf);
         let mut a = d.bab(&pr).map_err(ContactError::from)?;
@@ -810,7 +851,7 @@ fn set_up<'a>(
 pub struct SpectrumEstimate {
     /// Rows of the face.
     pub rows: usize,
-    /// `‖P F P‖` (power method).
+    /// `‖P F P‖` (power method; `‖Tᵀ F T‖` with [`CoarseConstraint::Projector`]).
     pub norm_pfp: f64,
     /// Smallest and largest Ritz values of `H_FF`.
     pub extreme: [f64; 2],
@@ -821,7 +862,8 @@ pub struct SpectrumEstimate {
 }
 
 /// Estimates the spectrum of `H_FF = Z_Fᵀ (P F P + ρ Q) Z_F` (`ρ = rho_factor ‖PFP‖`, `Z_F` the
-/// rows of the face `F`) — preconditioned by `params.preconditioner` in face: of `M_F⁻¹ H_FF` —
+/// rows of the face `F`; with [`CoarseConstraint::Projector`] `H_FF = Z_Fᵀ Tᵀ F T Z_F`, on
+/// `Im Tᵀ`) — preconditioned by `params.preconditioner` in face: of `M_F⁻¹ H_FF` —
 /// by the (preconditioned) conjugate gradient method on `H_FF x = b_F` from `x = 0`:
 /// the Lanczos tridiagonal matrix `T` built from the CG coefficients
 /// (`T_kk = 1/α_k + β_{k−1}/α_{k−1}`, `T_{k,k+1} = √β_k / α_k`) has Ritz values that converge to
@@ -847,10 +889,20 @@ pub fn face_spectrum(
     let free: Vec<bool> = (0..m)
         .map(|r| r < su.n_eq || contact_free.and_then(|f| f.get(r - su.n_eq).copied()).unwrap_or(false))
         .collect();
-    let mut pfp = ProjectedHessian { dual: &su.dual, rho: 0.0, norm: 0.0 };
-    let (est, _) = estimate_norm(&mut pfp, m, 30)?;
-    let rho = params.rho_factor * est;
-    let mut hess = ProjectedHessian { dual: &su.dual, rho, norm: 1.05 * est.max(rho) };
+    let (est, mut hess): (f64, Box<dyn Hessian + '_>) = match params.coarse {
+        CoarseConstraint::Penalty => {
+            let mut pfp = ProjectedHessian { dual: &su.dual, rho: 0.0, norm: 0.0 };
+            let (est, _) = estimate_norm(&mut pfp, m, 30)?;
+            let rho = params.rho_factor * est;
+            (est, Box::new(ProjectedHessian { dual: &su.dual, rho, norm: 1.05 * est.max(rho) }))
+        }
+        CoarseConstraint::Projector => {
+            let mut h = ObliqueHessian::new(&su.dual);
+            let (est, _) = estimate_norm(&mut h, m, 30)?;
+            h.norm = 1.05 * est;
+            (est, Box::new(h))
+        }
+    };
     let mut r = su.b.clone();
     r.iter_mut().zip(&free).for_each(|(a, &f)| {
         if !f {
@@ -859,14 +911,13 @@ pub fn face_spectrum(
     });
     let r0 = norm(&r).max(f64::MIN_POSITIVE);
     let mut z = vec![0.0; m];
-    let precondition =
-        |hess: &mut ProjectedHessian<'_, '_>, r: &[f64], z: &mut [f64]| -> Result<(), FetiError> {
-            if !hess.precondition_in_face(&free, r, z)? {
-                z.copy_from_slice(r);
-            }
-            Ok(())
-        };
-    precondition(&mut hess, &r, &mut z)?;
+    let precondition = |hess: &mut dyn Hessian, r: &[f64], z: &mut [f64]| -> Result<(), FetiError> {
+        if !hess.precondition_in_face(&free, r, z)? {
+            z.copy_from_slice(r);
+        }
+        Ok(())
+    };
+    precondition(hess.as_mut(), &r, &mut z)?;
     let mut p = z.clone();
     let mut hp = vec![0.0; m];
     let mut rz = r.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>();
@@ -885,7 +936,7 @@ pub fn face_spectrum(
         }
         let a = rz / php;
         r.iter_mut().zip(&hp).for_each(|(ri, h)| *ri -= a * h);
-        precondition(&mut hess, &r, &mut z)?;
+        precondition(hess.as_mut(), &r, &mut z)?;
         let rz_new = r.iter().zip(&z).map(|(a, b)| a * b).sum::<f64>();
         let b = rz_new / rz;
         rz = rz_new;
@@ -1065,7 +1116,7 @@ fn solve_projected(
     let m = dual.m;
     let bnorm = norm(b).max(f64::MIN_POSITIVE);
     let eps = params.tolerance * bnorm;
-    let mut hess = ObliqueHessian { dual, norm: 0.0, face: None, face_factorisations: 0 };
+    let mut hess = ObliqueHessian::new(dual);
     let (est, _) = estimate_norm(&mut hess, m, 30)?;
     let hnorm = 1.05 * est.max(f64::MIN_POSITIVE);
     hess.norm = hnorm;

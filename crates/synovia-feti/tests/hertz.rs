@@ -28,12 +28,8 @@ fn compare<const D: usize>(
     let mut sc = StaticContact::new(model, pairs, Default::default()).expect("factorise");
     sc.set_nested_iteration(None);
     let pdas = Pdas::default();
-    let tfeti = Tfeti::for_model(
-        model,
-        &DecompositionParams::default().with_subdomains(subdomains),
-        params,
-    )
-    .expect("decomposition");
+    let tfeti = Tfeti::for_model(model, &DecompositionParams::default().with_subdomains(subdomains), params)
+        .expect("decomposition");
     let dec = tfeti.decomposition();
     println!(
         "{name} ({:?}): {} subdomains, primal {}, equality rows {:?}, coarse {}",
