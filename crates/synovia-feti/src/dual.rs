@@ -604,6 +604,9 @@ impl Hessian for ProjectedHessian<'_, '_> {
     }
 }
 
+/// A dense Cholesky factor.
+type Factor = nalgebra::Cholesky<f64, nalgebra::Dyn>;
+
 /// `H = Tᵀ F T` of [`CoarseConstraint::Projector`] as a [`Hessian`], with `‖H‖` (estimated;
 /// `0` if unknown) for the preconditioner's shift and the factor of `G_F G_Fᵀ` of the last face.
 struct ObliqueHessian<'d, 'a> {
@@ -613,7 +616,7 @@ struct ObliqueHessian<'d, 'a> {
     a_cols: Vec<Option<DVector<f64>>>,
     /// The free contact rows `W = [g_r]` of the last face and the Cholesky factor of its
     /// capacitance matrix `C = I + Wᵀ (G_E G_Eᵀ)⁻¹ W`.
-    face: Option<(Vec<usize>, Option<nalgebra::Cholesky<f64, nalgebra::Dyn>>)>,
+    face: Option<(Vec<usize>, Option<Factor>)>,
     /// Factorisations of `C` (one per change of the free contact rows).
     face_factorisations: usize,
 }
