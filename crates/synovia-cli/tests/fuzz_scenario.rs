@@ -98,6 +98,10 @@ proptest! {
         for m in &muts {
             apply(&mut input, m, &corpus, b"[");
         }
+        if let Ok(last) = std::env::var("SYNOVIA_FUZZ_LAST") {
+            // The input about to run, for a case that ends the process (out of memory, abort).
+            std::fs::write(last, &input).unwrap();
+        }
         let r = exercise(path, &input);
         prop_assert!(r.is_ok(), "panic {:?} on input:\n{}", r, String::from_utf8_lossy(&input));
     }
@@ -121,5 +125,22 @@ fn regression_huge_times_range_is_an_error() {
         let e = Scenario::parse(Source::new(&path, bad)).and_then(|sc| check(&sc).map(|_| ())).unwrap_err();
         assert!(e.to_string().contains("at most"), "{e}");
         assert_eq!(e.key, "analysis.times", "{e}");
+    }
+}
+
+/// Found by this target in CI (a 256-case run killed by the OOM killer): a dynamic analysis
+/// with `steps = 2³¹` made the build allocate a time level per step (7 GB and growing in
+/// `check`). Now a size error, like `times`.
+#[test]
+fn regression_huge_dynamic_steps_is_an_error() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/dynamic_drop2d.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let current = text.lines().find(|l| l.starts_with("steps = ")).expect("the seed's `steps = …` line");
+    for steps in ["2147483648", "18446744073709551615"] {
+        let bad = text.replace(current, &format!("steps = {steps}"));
+        assert_ne!(bad, text);
+        let e = Scenario::parse(Source::new(&path, bad)).and_then(|sc| check(&sc).map(|_| ())).unwrap_err();
+        assert!(e.to_string().contains("at most"), "{e}");
+        assert_eq!(e.key, "analysis.steps", "{e}");
     }
 }

@@ -1879,7 +1879,17 @@ fn analysis(cx: &Cx<'_>, a: &Sp<AnalysisSpec>) -> R<Analysis> {
                 why,
             )?;
             let dt = cx.positive(cx.req(&s.dt, k, "dt", &span, why)?, "analysis.dt")?;
-            let steps = cx.at_least(cx.req(&s.steps, k, "steps", &span, why)?, "analysis.steps", 1)?;
+            let sp = cx.req(&s.steps, k, "steps", &span, why)?;
+            let steps = cx.at_least(sp, "analysis.steps", 1)?;
+            // a time level per step is kept (records, histories): bounded like `times`
+            let max_steps = limits().max_time_steps;
+            if steps > max_steps {
+                return Err(cx.err(
+                    "analysis.steps",
+                    sp.span(),
+                    format!("at most {max_steps} steps, got {steps}"),
+                ));
+            }
             Ok(Analysis::Dynamic { dt, steps })
         }
         other => Err(cx.err(
