@@ -13,7 +13,8 @@
 //!
 //! ```text
 //! cargo run --release -p synovia-feti --example hemisphere3d_1m -- [levels=19] [subdomains=N]
-//!     [tol=1e-8] [bisection] [prec=lumped|dirichlet|none] [rho=F] [dry | direct]
+//!     [tol=1e-8] [bisection] [prec=lumped|dirichlet|none] [coarse=penalty|projector] [rho=F]
+//!     [dry | direct]
 //! cargo build --release -p synovia-feti --features mpi --example hemisphere3d_1m
 //! mpirun --oversubscribe -np 2 target/release/examples/hemisphere3d_1m levels=19 mpi
 //! ```
@@ -38,8 +39,8 @@ use synovia_fem::assembly::{assemble_matrix, body_stiffnesses, pattern};
 use synovia_fem::element::stiffness_into;
 use synovia_fem::model::Model;
 use synovia_feti::{
-    Communicator, Decomposition, DecompositionParams, ModelProblem, Partitioner, Preconditioner,
-    SingleProcess, TfetiParams, TfetiSolution,
+    CoarseConstraint, Communicator, Decomposition, DecompositionParams, ModelProblem, Partitioner,
+    Preconditioner, SingleProcess, TfetiParams, TfetiSolution,
 };
 use synovia_linalg::{CholeskySolver, FactorisedOperator, LinalgError, SymmetricMatrix};
 use synovia_models::hertz::{hertz3d_model, Hertz3d};
@@ -90,6 +91,7 @@ struct Options {
     tol: f64,
     partitioner: Partitioner,
     preconditioner: Preconditioner,
+    coarse: CoarseConstraint,
     rho: f64,
     dry: bool,
     direct: bool,
@@ -103,6 +105,7 @@ fn options() -> Res<Options> {
         tol: 1e-8,
         partitioner: Partitioner::Metis,
         preconditioner: Preconditioner::Lumped,
+        coarse: CoarseConstraint::default(),
         rho: 1.0,
         dry: false,
         direct: false,
@@ -123,6 +126,13 @@ fn options() -> Res<Options> {
                     "lumped" => Preconditioner::Lumped,
                     "dirichlet" => Preconditioner::Dirichlet,
                     _ => return Err(format!("unknown preconditioner `{v}`").into()),
+                }
+            }
+            "coarse" => {
+                o.coarse = match v {
+                    "penalty" => CoarseConstraint::Penalty,
+                    "projector" => CoarseConstraint::Projector,
+                    _ => return Err(format!("unknown coarse constraint `{v}`").into()),
                 }
             }
             "dry" => o.dry = true,
@@ -203,7 +213,10 @@ fn run(o: &Options, comm: &dyn Communicator) -> Res<()> {
         dec.n_subdomains(),
         dec.owned().len()
     ));
-    let mut params = TfetiParams::default().with_tolerance(o.tol).with_preconditioner(o.preconditioner);
+    let mut params = TfetiParams::default()
+        .with_tolerance(o.tol)
+        .with_preconditioner(o.preconditioner)
+        .with_coarse(o.coarse);
     params.rho_factor = o.rho;
     let t2 = Instant::now();
     let s0 = normal.solve(&dec, comm, &params)?;
@@ -254,7 +267,7 @@ fn run(o: &Options, comm: &dyn Communicator) -> Res<()> {
             "mu": MU, "subdomains": r.subdomains, "ranks": r.ranks,
             "threads_per_rank": rayon::current_num_threads(),
             "subdomains_per_rank": all.chunks(3).map(|c| c[1] as usize).collect::<Vec<_>>(),
-            "partitioner": format!("{:?}", o.partitioner), "preconditioner": format!("{:?}", o.preconditioner),
+            "partitioner": format!("{:?}", o.partitioner), "preconditioner": format!("{:?}", o.preconditioner), "coarse": format!("{:?}", o.coarse),
             "rho_factor": o.rho, "tolerance": o.tol,
             "dual": r.dual, "coarse": r.coarse_dim,
             "time_s": time_s, "model_s": model_s, "decomposition_s": decomposition_s,
