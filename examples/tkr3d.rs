@@ -22,15 +22,24 @@
 //! cargo run --release --example tkr3d -- --free-adduction --free-ml  # femur free in 2 more dofs
 //! cargo run --release --example tkr3d -- --contact-min-ny -0.3  # also the steep flanks as candidates
 //! cargo run --release --example tkr3d -- --stress  # VTU files also with stress and strain tensors
+//! cargo run --release --example tkr3d -- --neo-hookean --poses 0,13,25,50  # linear vs neo-Hookean insert
 //! ```
+//!
+//! `--neo-hookean` runs the poses twice in one process, frictionless: the linear insert (the
+//! main job's model, each pose a static solve of the re-solve session) and the compressible
+//! neo-Hookean insert in finite strain with the same `E`, `ν` (`InsertLaw::NeoHookean`, the
+//! poses as quasi-static levels of the Newton iteration), and prints both per pose, the peak
+//! pressures compared and the cost ratio in its JSON line (docs/tkr3d.md, "Neo-Hookean
+//! insert"); it writes no files.
 
 use std::fmt::Write as _;
 use std::time::Instant;
 
 use plotters::prelude::*;
 use synovia::io::{Encoding, TimeSeriesWriter};
+use synovia::nonlinear::GeometryUpdate;
 use synovia::prelude::*;
-use synovia_models::tkr3d::Tkr3d;
+use synovia_models::tkr3d::{InsertLaw, Tkr3d};
 
 type Error = Box<dyn std::error::Error>;
 
@@ -141,6 +150,21 @@ fn main() -> Result<(), Error> {
         let band: f64 = v.parse()?;
         model.screening_band = (band > 0.0).then_some(band);
     }
+    // `--poses 13,50`: only these percentages of the cycle (e.g. the mesh-convergence study)
+    let percents: Vec<u32> = match std::env::args().skip_while(|a| a != "--poses").nth(1) {
+        Some(list) => list.split(',').map(|v| v.trim().parse::<u32>()).collect::<Result<_, _>>()?,
+        None => (0..=100).collect(),
+    };
+    if percents.is_empty() || percents.iter().any(|&p| p > 100) || percents.windows(2).any(|w| w[0] >= w[1]) {
+        return Err("--poses takes increasing percentages of the cycle in 0..=100, e.g. 13,50".into());
+    }
+    if std::env::args().any(|a| a == "--neo-hookean") {
+        if std::env::args().any(|a| a == "--friction") && model.friction > 0.0 {
+            return Err("--neo-hookean runs frictionless (friction against the moving femur is not in the nonlinear path yet); drop --friction".into());
+        }
+        model.friction = 0.0;
+        return compare_neo_hookean(&model, &percents, start);
+    }
     let joint = model.joint_model()?;
     let measured_si = model.measured_si()?;
 
@@ -152,14 +176,6 @@ fn main() -> Result<(), Error> {
     let mut poses = Vec::new();
     println!("| cycle % | F (N) | SI (mm) | SI measured (mm) | balance | KKT | medial (N) | lateral (N) | area (mm²) | peak p (MPa) | solves | s |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
-    // `--poses 13,50`: only these percentages of the cycle (e.g. the mesh-convergence study)
-    let percents: Vec<u32> = match std::env::args().skip_while(|a| a != "--poses").nth(1) {
-        Some(list) => list.split(',').map(|v| v.trim().parse::<u32>()).collect::<Result<_, _>>()?,
-        None => (0..=100).collect(),
-    };
-    if percents.is_empty() || percents.iter().any(|&p| p > 100) || percents.windows(2).any(|w| w[0] >= w[1]) {
-        return Err("--poses takes increasing percentages of the cycle in 0..=100, e.g. 13,50".into());
-    }
     for &i in &percents {
         let t = f64::from(i) / 100.0;
         let report =
@@ -252,6 +268,132 @@ fn main() -> Result<(), Error> {
         max(&|p| p.medial.force),
         max(&|p| p.lateral.force),
         max(&|p| p.friction_force),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// The figures of one pose of a run of the comparison.
+#[derive(Debug, Clone, Copy)]
+struct Figures {
+    si_mm: f64,
+    balance: f64,
+    kkt: f64,
+    force: f64,
+    area: f64,
+    peak: f64,
+    medial_peak: f64,
+    lateral_peak: f64,
+}
+
+impl Figures {
+    fn of(record: &synovia::time::results::StepRecord, kkt: f64) -> Result<Self, Error> {
+        let pair = record.pairs.first().ok_or("no pair")?;
+        let rigid = record.rigid.first().ok_or("no rigid body")?;
+        let side = |name: &str| pair.sides.iter().find(|s| s.name == name).map_or(0.0, |s| s.peak_pressure);
+        Ok(Self {
+            si_mm: rigid.dofs[1],
+            balance: rigid.balance_error,
+            kkt,
+            force: pair.normal_force,
+            area: pair.contact_area,
+            peak: pair.peak_pressure,
+            medial_peak: side("medial"),
+            lateral_peak: side("lateral"),
+        })
+    }
+}
+
+/// `--neo-hookean`: the poses with the linear insert (re-solve session, static solves) and
+/// with the neo-Hookean insert in finite strain (quasi-static levels of the Newton iteration),
+/// frictionless, in one process; the per-pose figures side by side and one JSON line.
+fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Result<(), Error> {
+    let times: Vec<f64> = percents.iter().map(|&p| f64::from(p) / 100.0).collect();
+    // linear: the main job's model and solves
+    let t_linear = Instant::now();
+    let linear_joint = Tkr3d { insert_law: InsertLaw::Linear, ..model.clone() }.joint_model()?;
+    let mut session = linear_joint.prepare()?;
+    let dofs = session.elastic_info().n_dofs;
+    let mut linear = Vec::with_capacity(times.len());
+    for &t in &times {
+        let report = session.solve_static(t)?;
+        linear.push(Figures::of(session.record().ok_or("no record")?, report.kkt)?);
+    }
+    let linear_s = t_linear.elapsed().as_secs_f64();
+    // neo-Hookean, finite strain
+    let t_nonlinear = Instant::now();
+    let mut nh_joint = Tkr3d { insert_law: InsertLaw::NeoHookean, ..model.clone() }.joint_model()?;
+    // `--nh-geometry converged|per-level|reference`: the contact geometry of the Newton
+    // iteration (docs/nonlinear.md); `--tangent-reuse ρ`: modified Newton
+    let mut newton = nh_joint.newton_parameters();
+    if let Some(v) = std::env::args().skip_while(|a| a != "--nh-geometry").nth(1) {
+        newton = newton.with_geometry_update(match v.as_str() {
+            "converged" => GeometryUpdate::Converged,
+            "per-level" => GeometryUpdate::PerLevel,
+            "reference" => GeometryUpdate::Reference,
+            _ => return Err("--nh-geometry takes converged, per-level or reference".into()),
+        });
+    }
+    if let Some(v) = std::env::args().skip_while(|a| a != "--tangent-reuse").nth(1) {
+        newton = newton.with_tangent_reuse(Some(v.parse()?));
+    }
+    nh_joint.newton_params(newton);
+    let mut nonlinear = Vec::with_capacity(times.len());
+    let mut newton_steps = Vec::with_capacity(times.len());
+    nh_joint.run_quasistatic_with(&times, |view| {
+        nonlinear.push(
+            Figures::of(view.record, view.result.kkt.max())
+                .map_err(|e| JointError::Invalid(e.to_string()))?,
+        );
+        newton_steps.push((
+            view.record.iterations,
+            view.record.rigid.first().map_or(0, |r| r.solves),
+            view.record.step_s,
+        ));
+        Ok(())
+    })?;
+    let nonlinear_s = t_nonlinear.elapsed().as_secs_f64();
+    println!("| cycle % | SI lin / NH (mm) | force (N) | area lin / NH (mm²) | peak p lin / NH (MPa) | Δ peak | medial peak lin / NH | lateral peak lin / NH | balance NH | KKT NH | Newton it. | solves | s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let rel = |a: f64, b: f64| if a > 0.0 { (b - a) / a } else { 0.0 };
+    for (((p, l), n), (it, solves, s)) in percents.iter().zip(&linear).zip(&nonlinear).zip(&newton_steps) {
+        println!(
+            "| {p} | {:.4} / {:.4} | {:.0} | {:.1} / {:.1} | {:.2} / {:.2} | {:+.1} % | {:.2} / {:.2} | {:.2} / {:.2} | {:.1e} | {:.1e} | {it} | {solves} | {s:.2} |",
+            l.si_mm,
+            n.si_mm,
+            n.force,
+            l.area,
+            n.area,
+            l.peak,
+            n.peak,
+            100.0 * rel(l.peak, n.peak),
+            l.medial_peak,
+            n.medial_peak,
+            l.lateral_peak,
+            n.lateral_peak,
+            n.balance,
+            n.kkt
+        );
+    }
+    let list = |f: &dyn Fn(&Figures) -> f64, v: &[Figures]| {
+        v.iter().map(|x| format!("{:.3}", f(x))).collect::<Vec<_>>().join(",")
+    };
+    let max = |f: &dyn Fn(&Figures) -> f64, v: &[Figures]| v.iter().map(f).fold(0.0, f64::max);
+    let changes: Vec<f64> = linear.iter().zip(&nonlinear).map(|(l, n)| rel(l.peak, n.peak)).collect();
+    println!(
+        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":0,\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
+        model.mesh_file(),
+        percents.iter().map(u32::to_string).collect::<Vec<_>>().join(","),
+        list(&|f| f.peak, &linear),
+        list(&|f| f.peak, &nonlinear),
+        list(&|f| f.area, &linear),
+        list(&|f| f.area, &nonlinear),
+        changes.iter().copied().fold(f64::INFINITY, f64::min),
+        changes.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        max(&|f| f.balance, &nonlinear),
+        max(&|f| f.kkt, &nonlinear),
+        newton_steps.iter().map(|n| n.0).sum::<usize>(),
+        nonlinear_s / linear_s,
         start.elapsed().as_secs_f64()
     );
     Ok(())

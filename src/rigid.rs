@@ -1142,6 +1142,7 @@ impl RigidDriver {
                 let mut w = sigma * q0[k];
                 let mut trials = 0;
                 let mut passes = 0;
+                let mut iterations = 0;
                 let level = loop {
                     let mut control = GapControl {
                         pose: &pose,
@@ -1152,11 +1153,14 @@ impl RigidDriver {
                         slope: self.slope.unwrap_or(0.0),
                         w,
                         overlap: 1e-4 * length,
+                        max_step: 1e-2 * length,
                         base: w,
                         trials: 0,
                     };
-                    let level = nl.step_gap_controlled(model, t, solver, &mut control)?;
+                    let mut level = nl.step_gap_controlled(model, t, solver, &mut control)?;
                     trials += control.trials;
+                    iterations += level.report.total_iterations;
+                    level.report.total_iterations = iterations;
                     passes += 1;
                     if control.slope > 0.0 && control.slope.is_finite() {
                         self.slope = Some(control.slope);

@@ -14,10 +14,12 @@ use std::sync::Arc;
 
 use synovia::builder::{JointError, JointModel};
 use synovia::contact_ops::operators::{PairSplit, SignedDistance};
+use synovia::nonlinear::NewtonParams;
 use synovia::rigid::{ForceControlParams, RigidBody};
 use synovia_contact::SurfaceObstacle;
+use synovia_fem::Kinematics;
 use synovia_io::read_stl;
-use synovia_material::isotropic;
+use synovia_material::{isotropic, neo_hookean, Material};
 use synovia_mesh::math::{Point, Real};
 use synovia_mesh::SurfaceError;
 use synovia_time::history::{Constant, FnHistory, LoadHistory, PiecewiseLinear};
@@ -114,6 +116,26 @@ pub enum Superior {
     Prescribed(Arc<dyn LoadHistory>),
 }
 
+/// The constitutive law of the insert.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum InsertLaw {
+    /// Linear elasticity in small strain with `E`, `ν` of [`Tkr3d::insert_material`] (the main
+    /// job).
+    #[default]
+    Linear,
+    /// Compressible neo-Hookean `W = μ/2 (I₁ − 3) − μ ln J + λ/2 (ln J)²` in total Lagrangian
+    /// finite strain (docs/model.md §12), with the Lamé constants of the same `E`, `ν`:
+    /// `μ = E / (2(1 + ν))`, `λ = E ν / ((1 + ν)(1 − 2ν))` (so linear elasticity at `e = 0`;
+    /// UHMWPE: μ = 158.6 MPa, λ = 1 824 MPa). Solved by the Newton iteration of
+    /// `synovia-nonlinear`, the superior–inferior force found inside it; frictionless only
+    /// (`friction = 0`), with the other five coordinates prescribed (docs/tkr3d.md).
+    NeoHookean,
+}
+
+/// The contraction bound of modified Newton for the neo-Hookean insert
+/// (`NewtonParams::with_tangent_reuse`).
+pub const NH_TANGENT_REUSE: Real = 0.5;
+
 /// Options of the model (the defaults are the main job's).
 #[derive(Debug, Clone)]
 pub struct Tkr3d {
@@ -147,6 +169,8 @@ pub struct Tkr3d {
     pub femur_subdivision: usize,
     /// Young's modulus (MPa) and Poisson's ratio of the insert (default [`UHMWPE`]).
     pub insert_material: (Real, Real),
+    /// The insert's law (default [`InsertLaw::Linear`]).
+    pub insert_law: InsertLaw,
 }
 
 impl Default for Tkr3d {
@@ -164,6 +188,7 @@ impl Default for Tkr3d {
             control: ForceControlParams::default(),
             femur_subdivision: FEMUR_SUBDIVISION,
             insert_material: UHMWPE,
+            insert_law: InsertLaw::Linear,
         }
     }
 }
@@ -213,10 +238,21 @@ impl Tkr3d {
             );
         }
         let mut joint = JointModel::<3>::new();
-        let uhmwpe = isotropic(self.insert_material.0, self.insert_material.1)?;
+        let (e, nu) = self.insert_material;
+        let uhmwpe: Arc<dyn Material<3>> = match self.insert_law {
+            InsertLaw::Linear => Arc::new(isotropic(e, nu)?),
+            InsertLaw::NeoHookean => Arc::new(neo_hookean(e, nu)?),
+        };
         joint.add_gmsh_bodies(self.data_dir.join("mesh").join(self.mesh_file()), |_| {
             Some(uhmwpe.clone().into())
         })?;
+        if self.insert_law == InsertLaw::NeoHookean {
+            joint.set_kinematics("insert", Kinematics::FiniteStrain)?;
+            // modified Newton: the factorised tangent (and the Schur columns of the contact rows
+            // solved on it) kept while full steps contract the residual by half, also from pose
+            // to pose (docs/tkr3d.md, "Neo-Hookean insert": 2–3 × less time than fresh tangents)
+            joint.newton_params(NewtonParams::default().with_tangent_reuse(Some(NH_TANGENT_REUSE)));
+        }
         joint.clamp("insert", "tray")?;
         // the contact candidates: every upward-facing facet above the tray (the meshes'
         // `articular` part starts at y = 6 mm and misses the bottom of the dishes, at 5.9 mm;
