@@ -363,10 +363,25 @@ fn pose_resolve_case(scale: f64) -> Res<Value> {
         session.solve_static(times[0])?;
         let setup_s = t_setup.elapsed().as_secs_f64();
         let (mut force_error, mut kkt) = (0.0_f64, 0.0_f64);
+        // `SYNOVIA_POSE_DUMP=<file>`: each pose's femur force, moment and strain energy (to
+        // compare two builds' results; appended, one line per pose)
+        let mut dump = match std::env::var_os("SYNOVIA_POSE_DUMP") {
+            Some(path) => Some(std::fs::OpenOptions::new().create(true).append(true).open(path)?),
+            None => None,
+        };
         let t0 = Instant::now();
         for &t in &times[1..] {
             let report = if friction > 0.0 { session.step(t)? } else { session.solve_static(t)? };
             let record = session.record().ok_or("no record")?;
+            if let Some(file) = dump.as_mut() {
+                use std::io::Write;
+                let r = record.rigid.first().ok_or("no rigid body")?;
+                writeln!(
+                    file,
+                    "{friction} {t:.17e} {:?} {:?} {:.17e}",
+                    r.force, r.moment, record.strain_energy
+                )?;
+            }
             let f = record.rigid.first().ok_or("no rigid body")?.force[1];
             force_error = force_error.max((f - load.value(t)).abs() / load.value(t));
             kkt = kkt.max(report.kkt);

@@ -18,7 +18,7 @@
 //! into the surface's frame and the gradient back ([`SurfaceObstacle::set_pose`]).
 
 use std::collections::HashMap;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 use nalgebra::{Rotation3, Vector3};
 use rstar::{RTree, AABB};
@@ -56,7 +56,23 @@ pub struct SurfaceObstacle {
     /// A smoothed surface's control surface and the bound `δ` on the distance between the two
     /// ([`SurfaceObstacle::smoothed_solid`]).
     coarse: Option<(Box<SurfaceObstacle>, Real)>,
+    /// Far answers of bounded queries, kept for the next ones
+    /// ([`SignedDistance::distance_and_gradient_within`]); shared by clones (they hold
+    /// points in the surface's own frame, valid for every pose).
+    far: Arc<Mutex<HashMap<[u64; 3], FarAnswer>>>,
 }
+
+/// A bounded query's answer beyond its reach: the query point in the surface's frame, a lower
+/// bound `φ₀ > reach` of `φ` there, and the gradient's direction (surface frame).
+#[derive(Debug, Clone, Copy)]
+struct FarAnswer {
+    local: Vector3<Real>,
+    distance: Real,
+    gradient: Vector3<Real>,
+}
+
+/// At most this many far answers are kept (about 80 bytes each); a full store is emptied.
+const FAR_ANSWERS: usize = 1 << 20;
 
 impl SurfaceObstacle {
     /// An obstacle bounded by `surface`, which must be a consistently oriented manifold (open
@@ -169,6 +185,7 @@ impl SurfaceObstacle {
             rotation: Rotation3::identity(),
             translation: Vector3::zeros(),
             coarse: None,
+            far: Arc::default(),
         }
     }
 
@@ -251,19 +268,49 @@ impl SignedDistance<3> for SurfaceObstacle {
         let p = self.closest_point(x);
         (p.distance, p.gradient)
     }
-    /// Smoothed surfaces ([`SurfaceObstacle::smoothed_solid`]) answer points farther than
-    /// `reach + δ` from the control surface with `φ_control − δ` (the closest-point search on
-    /// a fine surface visits more triangles the farther the point); others as
-    /// [`SignedDistance::distance_and_gradient`].
+    /// Points that were answered beyond the reach before, at `y₀` (surface frame) with a
+    /// lower bound `φ₀ ≤ φ(y₀)`, are answered from it while it stays beyond the reach: `φ` is
+    /// 1-Lipschitz, so `φ(y) ≥ φ₀ − |y − y₀|` for the point `y` in the surface's frame now
+    /// (the pose moved it by `|y − y₀|`), and that bound with the kept gradient is returned
+    /// when it exceeds `reach` — no search, for the contact nodes far from a partner that
+    /// moves little from pose to pose (the closest-point search visits more triangles the
+    /// farther the point). Smoothed surfaces ([`SurfaceObstacle::smoothed_solid`]) answer
+    /// points farther than `reach + δ` from the control surface with `φ_control − δ`;
+    /// otherwise the exact [`SignedDistance::distance_and_gradient`]. Answers beyond the
+    /// reach are kept (at most 2²⁰ points; a full store is emptied).
     fn distance_and_gradient_within(&self, x: &Point<3>, reach: Real) -> (Real, Vector<3>) {
-        if let Some((coarse, delta)) = &self.coarse {
-            let local = self.rotation.inverse() * (x - self.translation);
-            let (_, _, d, g) = coarse.closest_local(&local);
-            if d - delta > reach {
-                return (d - delta, self.rotation * g);
+        let local = self.rotation.inverse() * (x - self.translation);
+        let key = [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()];
+        let kept = self.far.lock().unwrap_or_else(|e| e.into_inner()).get(&key).copied();
+        if let Some(far) = kept {
+            let bound = far.distance - (local - far.local).norm();
+            if bound > reach {
+                return (bound, self.rotation * far.gradient);
             }
         }
-        self.distance_and_gradient(x)
+        let (distance, gradient) = match &self.coarse {
+            Some((coarse, delta)) => {
+                let (_, _, d, g) = coarse.closest_local(&local);
+                if d - delta > reach {
+                    (d - delta, g)
+                } else {
+                    let (_, _, d, g) = self.closest_local(&local);
+                    (d, g)
+                }
+            }
+            None => {
+                let (_, _, d, g) = self.closest_local(&local);
+                (d, g)
+            }
+        };
+        if distance > reach {
+            let mut far = self.far.lock().unwrap_or_else(|e| e.into_inner());
+            if far.len() >= FAR_ANSWERS {
+                far.clear();
+            }
+            far.insert(key, FarAnswer { local, distance, gradient });
+        }
+        (distance, self.rotation * gradient)
     }
     fn validate(&self) -> Result<(), String> {
         if self.translation.iter().chain(self.rotation.matrix().iter()).all(|v| v.is_finite()) {
@@ -271,5 +318,58 @@ impl SignedDistance<3> for SurfaceObstacle {
         } else {
             Err("surface obstacle pose is not finite".into())
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bounded queries of a surface that moves a little from pose to pose (a rigid partner
+    /// over a gait cycle): within the reach they equal the exact query of a fresh obstacle
+    /// (no kept answers) bit for bit, beyond it they are lower bounds `reach < d ≤ φ` with
+    /// unit gradients, and after the first pose most far points are answered from the kept
+    /// bounds (strictly below `φ`) instead of a search.
+    #[test]
+    fn kept_far_answers_are_lower_bounds_and_near_answers_exact() {
+        let centre = Point::<3>::new(0.3, -0.2, 0.1);
+        let surface = TriangleSurface::icosphere(centre, 2.0, 3).expect("icosphere");
+        let moving = SurfaceObstacle::solid(surface.clone()).expect("solid");
+        let fresh = SurfaceObstacle::solid(surface).expect("solid");
+        let mut state: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((state >> 11) as f64 / (1u64 << 53) as f64) * 10.0 - 5.0
+        };
+        let points: Vec<Point<3>> = (0..600).map(|_| Point::<3>::new(next(), next(), next())).collect();
+        let reach = 0.5;
+        let mut moving = moving;
+        let mut fresh = fresh;
+        let mut from_kept = Vec::new();
+        for pose in 0..6 {
+            let angle = 0.01 * pose as Real;
+            let rotation = Rotation3::from_axis_angle(&Vector3::z_axis(), angle);
+            let shift = Vector::<3>::new(0.02 * pose as Real, -0.01 * pose as Real, 0.0);
+            moving.set_pose(rotation, shift);
+            fresh.set_pose(rotation, shift);
+            let (mut near, mut kept) = (0, 0);
+            for x in &points {
+                let (d, g) = fresh.distance_and_gradient(x);
+                let (db, gb) = moving.distance_and_gradient_within(x, reach);
+                assert!((gb.norm() - 1.0).abs() < 1e-12, "unit gradient");
+                if d <= reach {
+                    assert_eq!((d, g), (db, gb), "within reach at {x:?}, pose {pose}");
+                    near += 1;
+                } else {
+                    assert!(db > reach && db <= d, "{db} not in ({reach}, {d}] at pose {pose}");
+                    kept += usize::from(db < d);
+                }
+            }
+            assert!(near > 20, "{near} points within reach");
+            from_kept.push(kept);
+        }
+        assert_eq!(from_kept[0], 0, "nothing kept before the first pose");
+        assert!(from_kept[1..].iter().all(|&k| k > 300), "answered from kept bounds: {from_kept:?}");
+        assert!(moving.far.lock().expect("lock").len() <= FAR_ANSWERS);
     }
 }

@@ -561,6 +561,131 @@ impl CholeskySolver {
         Ok(x)
     }
 
+    /// `X = A⁻¹ B` on the dofs `support` only, for right-hand sides `B` with few non-zeros
+    /// (the unit vectors `e_p` of interface dofs): with `P A Pᵀ = L Lᵀ` (supernodal `L`), the
+    /// forward half `Y = L⁻¹ P B` visits only the supernodes where `Y` is non-zero — those on
+    /// the elimination-tree paths from the right-hand sides' dofs to the root — and in each
+    /// only the right-hand sides non-zero there; the backward half `Lᵀ P X = Y` visits only
+    /// the supernodes that hold a dof of `support` and their ancestors (the rows `x_s` of a
+    /// supernode `s` depend on the rows of its pattern, which lie in its ancestors). The
+    /// result equals [`Self::solve_many_in_place`] on `support` up to rounding; the work of
+    /// the forward half follows the paths instead of the factor. `out[c][k] = (A⁻¹ b_c)_{support[k]}`
+    /// for `rhs[c] = b_c` given as `(dof, value)` entries (repeated dofs add up). A simplicial
+    /// factor is solved whole.
+    ///
+    /// # Errors
+    /// No successful factorisation; a dof `≥ n`.
+    pub fn solve_sparse_on(
+        &self,
+        rhs: &[Vec<(usize, f64)>],
+        support: &[usize],
+    ) -> Result<Vec<Vec<f64>>, LinalgError> {
+        use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
+        if !self.factorized {
+            return Err(LinalgError::Sparse("solve called before a successful factorisation".into()));
+        }
+        let n = self.symbolic.nrows();
+        let k = rhs.len();
+        if let Some(&d) = rhs.iter().flatten().map(|(d, _)| d).chain(support).find(|&&d| d >= n) {
+            return Err(LinalgError::InvalidParameter(format!("dof {d} out of range (n = {n})")));
+        }
+        let SymbolicCholeskyRaw::Supernodal(sym) = self.symbolic.raw() else {
+            let mut b = faer::Mat::<f64>::zeros(n, k);
+            for (c, col) in rhs.iter().enumerate() {
+                for &(d, v) in col {
+                    b[(d, c)] += v;
+                }
+            }
+            self.solve_many_in_place(b.as_mut())?;
+            return Ok((0..k).map(|c| support.iter().map(|&d| b[(d, c)]).collect()).collect());
+        };
+        let identity: Vec<usize>;
+        let inv: &[usize] = match self.symbolic.perm() {
+            Some(perm) => perm.arrays().1,
+            None => {
+                identity = (0..n).collect();
+                &identity
+            }
+        };
+        let mut x = faer::Mat::<f64>::zeros(n, k);
+        for (c, col) in rhs.iter().enumerate() {
+            for &(d, v) in col {
+                x[(inv[d], c)] += v;
+            }
+        }
+        let llt = SupernodalLltRef::new(sym, &self.factor);
+        let ns = sym.n_supernodes();
+        let mut nonzero = Vec::with_capacity(k);
+        // forward: Y = L⁻¹ P B, supernodes and right-hand sides where Y is non-zero only
+        for s in 0..ns {
+            let node = llt.supernode(s);
+            let (start, val, pattern) = (node.start(), node.val(), node.pattern());
+            let size = val.ncols();
+            nonzero.clear();
+            nonzero.extend((0..k).filter(|&c| (start..start + size).any(|i| x[(i, c)] != 0.0)));
+            if nonzero.is_empty() {
+                continue;
+            }
+            let (top, bottom) = val.split_at_row(size);
+            let mut xs = faer::Mat::<f64>::from_fn(size, nonzero.len(), |i, j| x[(start + i, nonzero[j])]);
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(top, xs.as_mut(), Par::Seq);
+            let mut update = faer::Mat::<f64>::zeros(pattern.len(), nonzero.len());
+            faer::linalg::matmul::matmul(
+                update.as_mut(),
+                faer::Accum::Replace,
+                bottom,
+                xs.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            for (j, &c) in nonzero.iter().enumerate() {
+                for i in 0..size {
+                    x[(start + i, c)] = xs[(i, j)];
+                }
+                for (idx, &i) in pattern.iter().enumerate() {
+                    x[(i, c)] -= update[(idx, j)];
+                }
+            }
+        }
+        // the supernodes the backward half needs: those holding a dof of `support`, and
+        // their ancestors (the parent of `s` holds the first row of its pattern)
+        let mut supernode_of = vec![0usize; n];
+        for s in 0..ns {
+            let node = llt.supernode(s);
+            supernode_of[node.start()..node.start() + node.val().ncols()].fill(s);
+        }
+        let mut needed = vec![false; ns];
+        for &d in support {
+            needed[supernode_of[inv[d]]] = true;
+        }
+        for s in 0..ns {
+            if needed[s] {
+                if let Some(&first) = llt.supernode(s).pattern().first() {
+                    needed[supernode_of[first]] = true;
+                }
+            }
+        }
+        // backward: Lᵀ P X = Y on the needed supernodes
+        for s in (0..ns).rev().filter(|&s| needed[s]) {
+            let node = llt.supernode(s);
+            let (start, val, pattern) = (node.start(), node.val(), node.pattern());
+            let size = val.ncols();
+            let (top, bottom) = val.split_at_row(size);
+            let below = faer::Mat::<f64>::from_fn(pattern.len(), k, |idx, c| x[(pattern[idx], c)]);
+            let mut xs = x.as_mut().subrows_mut(start, size);
+            faer::linalg::matmul::matmul(
+                xs.rb_mut(),
+                faer::Accum::Add,
+                bottom.transpose(),
+                below.as_ref(),
+                -1.0,
+                Par::Seq,
+            );
+            faer::linalg::triangular_solve::solve_upper_triangular_in_place(top.transpose(), xs, Par::Seq);
+        }
+        Ok((0..k).map(|c| support.iter().map(|&d| x[(inv[d], c)]).collect()).collect())
+    }
+
     /// Solves `A x = b` in place for one right-hand side.
     pub fn solve_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
         let n = b.len();

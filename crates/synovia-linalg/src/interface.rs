@@ -435,6 +435,9 @@ pub(crate) fn cholesky_interface_columns(
 /// Rows with at most this many entries in the trailing block are combined from unit solves.
 const UNIT_SPLIT: usize = 3;
 
+/// Unit solves of the whole factor per call of [`CholeskySolver::solve_sparse_on`].
+const UNIT_CHUNK: usize = 32;
+
 /// The columns `cols` of `S` by whole solves (two halves in parallel), stored in `columns`;
 /// returns the number of solves.
 fn solve_columns_into(
@@ -509,28 +512,35 @@ fn whole_factor_unit_columns(
         unit_dirs.iter().map(|d| kept.get_shared(id, d).map(|(_, x)| x)).collect();
     let absent: Vec<usize> = (0..dofs.len()).filter(|&u| units[u].is_none()).collect();
     if !absent.is_empty() {
+        // sparse right-hand sides: the forward halves follow the elimination-tree paths of
+        // the dofs, the backward halves the supernodes of the support
+        let t_units = std::time::Instant::now();
         let computed = in_two_halves(&absent, true, |list| {
             let mut out = Vec::with_capacity(list.len());
-            for chunk in list.chunks(32) {
-                let k = chunk.len();
-                let mut rhs = vec![0.0; n * k];
-                for (c, &u) in chunk.iter().enumerate() {
-                    rhs[c * n + dofs[u]] = 1.0;
-                }
-                op.solve_many_in_place(&mut rhs, k)?;
-                for (c, &u) in chunk.iter().enumerate() {
-                    let x = &rhs[c * n..(c + 1) * n];
-                    out.push((u, support.iter().map(|&p| x[p]).collect::<Vec<f64>>()));
-                }
+            for chunk in list.chunks(UNIT_CHUNK) {
+                let rhs: Vec<Vec<(usize, f64)>> = chunk.iter().map(|&u| vec![(dofs[u], 1.0)]).collect();
+                let solved = op.factor().solve_sparse_on(&rhs, &support)?;
+                out.extend(chunk.iter().copied().zip(solved));
             }
             Ok(out)
         })?;
         solved += computed.len();
+        tracing::debug!(n = computed.len(), ms = t_units.elapsed().as_secs_f64() * 1e3, "unit solves");
         for (u, x) in computed {
             kept.put(id, &unit_dirs[u], &x);
             units[u] = Some(Arc::new(x));
         }
     }
+    tracing::debug!(
+        missing = missing.len(),
+        many = many.len(),
+        units = dofs.len(),
+        absent = absent.len(),
+        support = support.len(),
+        kept = kept.len(),
+        kept_mb = kept.bytes() >> 20,
+        "whole-factor unit columns"
+    );
     for &j in &few {
         // S_ij = Σ_{(q,w) ∈ c_i} w Σ_{(p,v) ∈ c_j} v x_p[q]: work per column follows the rows,
         // not the interface dofs the unit solves are kept on
@@ -735,6 +745,151 @@ mod tests {
         let plain = SparseCholesky::new(tridiagonal(20), &Ordering::Amd).expect("factor");
         assert!(plain.forward_solve(&[1.0; 20]).expect("no error").is_none());
         assert!(plain.interface_of_forward(&[1.0; 20]).is_err());
+    }
+
+    /// The 7-point Laplacian (+ I) of an `m × m × m` grid with `c` components per grid
+    /// point coupled by a small symmetric term (3 for a 3D displacement field): large enough
+    /// for faer to factorise it supernodally.
+    fn grid3(m: usize, c: usize) -> SymmetricMatrix {
+        let n = m * m * m * c;
+        let idx = |x: usize, y: usize, z: usize, d: usize| ((z * m + y) * m + x) * c + d;
+        let mut columns = vec![Vec::new(); n];
+        for z in 0..m {
+            for y in 0..m {
+                for x in 0..m {
+                    for d in 0..c {
+                        let j = idx(x, y, z, d);
+                        let col = &mut columns[j];
+                        col.extend((d..c).map(|e| idx(x, y, z, e)));
+                        if x + 1 < m {
+                            col.push(idx(x + 1, y, z, d));
+                        }
+                        if y + 1 < m {
+                            col.push(idx(x, y + 1, z, d));
+                        }
+                        if z + 1 < m {
+                            col.push(idx(x, y, z + 1, d));
+                        }
+                    }
+                }
+            }
+        }
+        let mut a = SymmetricMatrix::from_columns(n, columns).expect("pattern");
+        for z in 0..m {
+            for y in 0..m {
+                for x in 0..m {
+                    for d in 0..c {
+                        let j = idx(x, y, z, d);
+                        a.add(j, j, 7.0).expect("diagonal");
+                        for e in d + 1..c {
+                            a.add(idx(x, y, z, e), j, 0.3).expect("coupling");
+                        }
+                        if x + 1 < m {
+                            a.add(idx(x + 1, y, z, d), j, -1.0).expect("off-diagonal");
+                        }
+                        if y + 1 < m {
+                            a.add(idx(x, y + 1, z, d), j, -1.0).expect("off-diagonal");
+                        }
+                        if z + 1 < m {
+                            a.add(idx(x, y, z + 1, d), j, -1.0).expect("off-diagonal");
+                        }
+                    }
+                }
+            }
+        }
+        a
+    }
+
+    /// `true` if the factor of `op` is supernodal (the path of
+    /// [`CholeskySolver::solve_sparse_on`] that skips supernodes).
+    fn supernodal(op: &SparseCholesky) -> bool {
+        matches!(
+            op.view().factor().symbolic().raw(),
+            faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(_)
+        )
+    }
+
+    /// Sparse right-hand sides solved on a support (`solve_sparse_on`: forward half on the
+    /// elimination-tree paths, backward half on the support's supernodes) equal whole solves
+    /// there to 1e-13, on a supernodal factor (AMD and METIS-like custom orderings), for unit
+    /// vectors and rows with several entries, with a support that is a face of the grid and
+    /// one that is everything.
+    #[test]
+    fn sparse_right_hand_sides_on_a_support_equal_whole_solves() {
+        let (m, c) = (14, 3);
+        let a = grid3(m, c);
+        let n = a.n();
+        let op = SparseCholesky::new(a, &Ordering::Amd).expect("factor");
+        assert!(supernodal(&op), "the test needs a supernodal factor");
+        // the top face z = m − 1 (the "contact surface") and all dofs
+        let face: Vec<usize> = (n - m * m * c..n).collect();
+        let all: Vec<usize> = (0..n).collect();
+        let rhs: Vec<Vec<(usize, f64)>> = vec![
+            vec![(face[5], 1.0)],
+            vec![(face[100], 1.0)],
+            vec![(face[101], -0.5), (face[102], 2.0), (face[140], 0.25)],
+            vec![(n / 2, 1.0)],
+            vec![(0, 0.3), (7, 0.3), (7, 0.4)],
+        ];
+        let mut dense = faer::Mat::<f64>::zeros(n, rhs.len());
+        for (col, entries) in rhs.iter().enumerate() {
+            for &(d, v) in entries {
+                dense[(d, col)] += v;
+            }
+        }
+        op.view().factor().solve_many_in_place(dense.as_mut()).expect("solve");
+        for support in [&face, &all] {
+            let got = op.view().factor().solve_sparse_on(&rhs, support).expect("sparse solve");
+            for (col, x) in got.iter().enumerate() {
+                let scale = (0..n).fold(0.0_f64, |s, i| s.max(dense[(i, col)].abs()));
+                assert!(scale > 0.0);
+                for (k, &d) in support.iter().enumerate() {
+                    let want = dense[(d, col)];
+                    assert!((x[k] - want).abs() <= 1e-13 * scale, "x[{d}] of rhs {col}: {} vs {want}", x[k]);
+                }
+            }
+        }
+        assert!(op.view().factor().solve_sparse_on(&[vec![(n, 1.0)]], &face).is_err());
+        assert!(op.view().factor().solve_sparse_on(&rhs, &[n]).is_err());
+    }
+
+    /// The whole-factor unit columns on a supernodal factor (unit solves by
+    /// `solve_sparse_on`): rows on the nodes of a face with normals that change from call to
+    /// call give the columns of fresh whole solves to 1e-12, and reuse the kept unit solves.
+    #[test]
+    fn unit_columns_on_a_supernodal_factor_equal_whole_solves() {
+        let (m, c) = (12, 3);
+        let a = grid3(m, c);
+        let n = a.n();
+        let op = SparseCholesky::new(a, &Ordering::Amd).expect("factor");
+        assert!(supernodal(&op), "the test needs a supernodal factor");
+        let top = n / c - m * m;
+        let nodes: Vec<usize> = (0..40).map(|i| top + (i * 7) % (m * m)).collect();
+        let rows_at = |angle: f64| {
+            let mut rows = SparseRows::new(n);
+            for (i, &node) in nodes.iter().enumerate() {
+                let (s, co) = (angle + 0.05 * i as f64).sin_cos();
+                rows.push_row([(c * node, 0.3 * s), (c * node + 1, co), (c * node + 2, 0.2)]);
+            }
+            rows
+        };
+        let store = BlockSolveStore::default();
+        store.set_unit_solves(true);
+        let mut solves = Vec::new();
+        for angle in [0.1, 0.4, 0.9] {
+            let rows = rows_at(angle);
+            let (columns, solved) = all_columns(&op, &rows, &store);
+            solves.push(solved);
+            let reference = reference_columns(&op, &rows);
+            for (j, col) in columns.iter().enumerate() {
+                let col = col.as_ref().expect("column computed");
+                let diagonal = reference[j][j].abs();
+                for (i, (&x, &y)) in col.iter().zip(&reference[j]).enumerate() {
+                    assert!((x - y).abs() <= 1e-12 * diagonal, "S[{i},{j}] at {angle}: {x} vs {y}");
+                }
+            }
+        }
+        assert_eq!(solves, vec![3 * 40, 0, 0], "unit solves per call");
     }
 
     /// Rows on the trailing block that differ only by a factor (the friction rows
