@@ -30,6 +30,10 @@
 //! `μ ← μ + ρ G̃ λ̃`, and `M ← M/β` when `L` did not increase by `ρ/2 ‖G̃ λ̃‖²`. The primal
 //! solution is `u = K⁺ (f̂ − Bᵀ λ) + R α` with `α = −(G_E G_Eᵀ)⁻¹ G_E (d̃ − F λ)_E` (the
 //! equality rows hold exactly).
+//!
+//! With [`CoarseConstraint::Projector`] the coarse condition is eliminated instead of penalised:
+//! `λ = λ₀ + T x`, `T = I − U (G_E G_Eᵀ)⁻¹ G` with `U = [G_Eᵀ; 0]`, and one MPRGP/MPGP run
+//! solves `min ½ xᵀ Tᵀ F T x − xᵀ Tᵀ (d̃ − F λ₀)` s.t. `x_I ∈ Ω_I` (see its docs).
 
 use std::time::Instant;
 

@@ -13,8 +13,9 @@
 //!   the Tresca rows as disc multipliers, the natural coarse space `G = Rᵀ Bᵀ` and its
 //!   projector, SMALBE-M with MPRGP (2D) / MPGP (3D) from `synovia-uzawa` ([`dual`]), their
 //!   conjugate gradient steps preconditioned in face by the projected Dirichlet (or lumped)
-//!   preconditioner ([`Preconditioner`]); [`face_spectrum`] estimates the condition number the
-//!   inner iterations see.
+//!   preconditioner ([`Preconditioner`]); or ([`CoarseConstraint::Projector`]) the coarse
+//!   condition eliminated by an oblique projector along the equality rows and one MPRGP/MPGP
+//!   run; [`face_spectrum`] estimates the condition number the inner iterations see.
 //! * Parallel execution: rayon's threads over the subdomains of a process, and — with the
 //!   cargo feature `mpi` — MPI ranks ([`comm`]), one code: each rank factorises its own
 //!   subdomains and only interface values travel. Sums are taken in subdomain order, so the
