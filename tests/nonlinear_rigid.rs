@@ -116,6 +116,7 @@ fn linear_law_through_newton_equals_the_linear_path() -> Result<(), Error> {
         let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
         assert!(dl < 1e-8, "level {level}: pressures differ by {dl:e}");
         assert!(a.pairs[0].peak_pressure > 0.0 && b.pairs[0].contact_area > 0.0);
+        eprintln!("level {level}: linear law through Newton vs linear path: travel {travel:.1e}, displacements {du:.1e}, pressures {dl:.1e}");
     }
     Ok(())
 }
@@ -159,6 +160,7 @@ fn neo_hookean_at_a_small_load_equals_linear_and_balances() -> Result<(), Error>
     );
     let normal = (a.pairs[0].normal_force - b.pairs[0].normal_force).abs() / a.pairs[0].normal_force;
     assert!(normal < 0.01, "normal force: {} vs {}", a.pairs[0].normal_force, b.pairs[0].normal_force);
+    eprintln!("neo-Hookean vs linear at F = {force}: travel {travel:.2e}, peak pressure {peak:.2e}, normal force {normal:.2e}");
     // and the run is not the linear one: the finite-strain solution differs (a test that can fail)
     assert!(travel > 0.0);
     Ok(())
