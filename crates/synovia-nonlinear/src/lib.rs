@@ -417,9 +417,13 @@ pub struct GapControl<'a, const D: usize> {
     pub slope: Real,
     /// In: the guess of `w`; out: the `w` of the solution.
     pub w: Real,
-    /// Without a slope: the overlap beyond the first contact of the first trials (e.g. 1e-4
-    /// of the model size), doubled while the resultant stays zero.
+    /// Without a slope: the overlap beyond the first contact of the first trials, doubled while
+    /// the resultant stays zero, and the step of the finite difference that gives the first
+    /// slope (e.g. 1e-4 of the model size).
     pub overlap: Real,
+    /// The largest change of `w` in one trial (e.g. 1e-2 of the model size): the gaps are first
+    /// order in `w`, no guide far from the pose they were built at.
+    pub max_step: Real,
     /// Out: the `w` at which the last contact geometry was built (the solution's gaps are
     /// first order in `w − base`; a caller asking for the exact geometry solves again when
     /// they differ by more than its tolerance).
@@ -436,6 +440,7 @@ impl<const D: usize> std::fmt::Debug for GapControl<'_, D> {
             .field("slope", &self.slope)
             .field("w", &self.w)
             .field("overlap", &self.overlap)
+            .field("max_step", &self.max_step)
             .field("base", &self.base)
             .finish_non_exhaustive()
     }
@@ -881,6 +886,7 @@ impl<const D: usize> NonlinearContact<D> {
                 self.contact.solve_load_multipliers(load, lifts, solver, None, None, warm_trial.as_ref())?;
             g.trials += 1;
             let r = (g.resultant)(self.contact.geometry(), &solution.lambda_n);
+            tracing::debug!(w, r, target = g.target, slope = g.slope, "gap-control trial");
             if !r.is_finite() {
                 return Err(fail(w, format!("gap control: resultant {r} at w = {w}")));
             }
@@ -930,13 +936,13 @@ impl<const D: usize> NonlinearContact<D> {
                 }
                 _ => match slope {
                     Some(s) => w + (g.target - r) / s,
-                    // the secant from the first contact
-                    None => match gaps.first_contact(Real::NEG_INFINITY).filter(|t| *t < w) {
-                        Some(touch) => w + (g.target - r) * (w - touch) / r,
-                        None => return Err(fail(w, "gap control: no slope to step with".into())),
-                    },
+                    // a finite difference toward the target for the first slope
+                    None => w + g.overlap.abs().copysign(g.target - r),
                 },
             };
+            // (a finite cap: a step beyond it is cut to it)
+            let cap = g.max_step.abs();
+            let next = if cap > 0.0 && (next - w).abs() > cap { w + cap.copysign(next - w) } else { next };
             if !next.is_finite() || next == w {
                 return Err(fail(
                     w,
