@@ -144,3 +144,17 @@ fn regression_huge_dynamic_steps_is_an_error() {
         assert_eq!(e.key, "analysis.steps", "{e}");
     }
 }
+
+/// Found by this target (a 60 000-case run, killed at 6 GB): `refine = { radius = 100000,
+/// levels = 10 }` on the hemisphere refined every cell at every level, which the cell estimate
+/// (taken from `n` alone) did not see. The refinement now stops with an error at the cell limit.
+#[test]
+fn regression_refinement_of_the_whole_mesh_stops_at_the_cell_limit() {
+    fuzz_limits();
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/hertz3d_force.toml");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let bad = text.replace("radius = 2.5, levels = 10", "radius = 100000, levels = 10");
+    assert_ne!(bad, text);
+    let e = Scenario::parse(Source::new(&path, bad)).and_then(|sc| check(&sc).map(|_| ())).unwrap_err();
+    assert!(e.to_string().contains("more than the limit 500000"), "{e}");
+}

@@ -22,7 +22,7 @@
 use crate::error::MeshError;
 use crate::math::{Point, Real};
 use crate::mesh::{BoundaryKind, Mesh};
-use crate::refine::{refine_toward, SphereProjection};
+use crate::refine::{refine_toward_within, SphereProjection};
 
 /// A distribution of the nodes of one axis of a structured grid (see [`nodes_1d`]).
 ///
@@ -578,11 +578,28 @@ pub fn half_disc_refined(
     refine_radius: Real,
     levels: usize,
 ) -> Result<Mesh<2>, MeshError> {
+    half_disc_refined_within(center, radius, n, refine_center, refine_radius, levels, usize::MAX)
+}
+
+/// [`half_disc_refined`] that fails with [`MeshError::InvalidParameter`] once a level leaves
+/// more than `max_cells` cells ([`refine_toward_within`](crate::refine::refine_toward_within)).
+///
+/// # Errors
+/// As [`half_disc_refined`], and when the cell count exceeds `max_cells`.
+pub fn half_disc_refined_within(
+    center: Point<2>,
+    radius: Real,
+    n: usize,
+    refine_center: Point<2>,
+    refine_radius: Real,
+    levels: usize,
+    max_cells: usize,
+) -> Result<Mesh<2>, MeshError> {
     check_center("half_disc_refined (refine_center)", &refine_center)?;
     check_positive("half_disc_refined", "refine_radius", refine_radius)?;
     let mesh = half_disc(center, radius, n)?;
     let proj = SphereProjection::new(center, radius)?;
-    refine_toward(&mesh, |x| (x - refine_center).norm() <= refine_radius, levels, &proj)
+    refine_toward_within(&mesh, |x| (x - refine_center).norm() <= refine_radius, levels, &proj, max_cells)
 }
 
 /// [`hemisphere`] refined `levels` times toward the ball `|x − refine_center| ≤ refine_radius`
@@ -597,11 +614,28 @@ pub fn hemisphere_refined(
     refine_radius: Real,
     levels: usize,
 ) -> Result<Mesh<3>, MeshError> {
+    hemisphere_refined_within(center, radius, n, refine_center, refine_radius, levels, usize::MAX)
+}
+
+/// [`hemisphere_refined`] that fails with [`MeshError::InvalidParameter`] once a level leaves
+/// more than `max_cells` cells ([`refine_toward_within`](crate::refine::refine_toward_within)).
+///
+/// # Errors
+/// As [`hemisphere_refined`], and when the cell count exceeds `max_cells`.
+pub fn hemisphere_refined_within(
+    center: Point<3>,
+    radius: Real,
+    n: usize,
+    refine_center: Point<3>,
+    refine_radius: Real,
+    levels: usize,
+    max_cells: usize,
+) -> Result<Mesh<3>, MeshError> {
     check_center("hemisphere_refined (refine_center)", &refine_center)?;
     check_positive("hemisphere_refined", "refine_radius", refine_radius)?;
     let mesh = hemisphere(center, radius, n)?;
     let proj = SphereProjection::new(center, radius)?;
-    refine_toward(&mesh, |x| (x - refine_center).norm() <= refine_radius, levels, &proj)
+    refine_toward_within(&mesh, |x| (x - refine_center).norm() <= refine_radius, levels, &proj, max_cells)
 }
 
 fn check_layers(what: &str, radii: &[Real], n_radial: &[usize]) -> Result<Vec<Vec<Real>>, MeshError> {

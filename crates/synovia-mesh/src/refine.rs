@@ -355,15 +355,39 @@ pub fn refine_toward<const D: usize>(
     levels: usize,
     proj: &dyn BoundaryProjection<D>,
 ) -> Result<Mesh<D>, MeshError> {
+    refine_toward_within(mesh, region, levels, proj, usize::MAX)
+}
+
+/// [`refine_toward`] that stops with [`MeshError::InvalidParameter`] as soon as a level leaves
+/// more than `max_cells` cells, before refining further: the guard of a caller that cannot
+/// tell in advance how many cells a region and a number of levels make (a region that covers
+/// the whole mesh refines every cell at every level, `2^levels` times the cells).
+///
+/// # Errors
+/// As [`refine_marked`], and when the cell count exceeds `max_cells`.
+pub fn refine_toward_within<const D: usize>(
+    mesh: &Mesh<D>,
+    region: impl Fn(&Point<D>) -> bool,
+    levels: usize,
+    proj: &dyn BoundaryProjection<D>,
+    max_cells: usize,
+) -> Result<Mesh<D>, MeshError> {
     let weights = sample_weights(D);
     let mut current = mesh.clone();
-    for _ in 0..levels {
+    for level in 0..levels {
         let marked: Vec<bool> =
             (0..current.n_cells()).map(|c| cell_touches(&current, c, &weights, &region)).collect();
         if !marked.iter().any(|&m| m) {
             break;
         }
         current = refine_marked(&current, |c| marked.get(c).copied().unwrap_or(false), proj)?;
+        if current.n_cells() > max_cells {
+            return Err(MeshError::InvalidParameter(format!(
+                "refinement toward the region: {} cells after level {} of {levels}, more than the limit {max_cells}",
+                current.n_cells(),
+                level + 1
+            )));
+        }
     }
     Ok(current)
 }

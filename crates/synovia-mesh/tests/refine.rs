@@ -7,7 +7,8 @@ use std::collections::HashSet;
 use common::*;
 use synovia_mesh::generators::{box_mesh, disc, hemisphere, rectangle, Grading};
 use synovia_mesh::refine::{
-    refine_marked, refine_toward, refine_uniform, BoundaryProjection, SphereProjection, StraightMidpoint,
+    refine_marked, refine_toward, refine_toward_within, refine_uniform, BoundaryProjection, SphereProjection,
+    StraightMidpoint,
 };
 use synovia_mesh::{BoundaryKind, Mesh, MeshError, Point, Real};
 
@@ -249,5 +250,29 @@ fn sphere_projection_on_hemisphere_keeps_cap_round_and_top_flat() -> Result<(), 
     let exact = 2.0 * std::f64::consts::PI * r.powi(3) / 3.0;
     assert!(rel(fine.measure(), exact) < 0.6 * rel(coarse.measure(), exact));
     assert!(min_quality(&fine) > 0.25, "min radius ratio {}", min_quality(&fine));
+    Ok(())
+}
+
+/// `refine_toward_within` is `refine_toward` under its cell limit, and stops with an error at
+/// the first level above it (a region covering the whole mesh doubles the cells per level).
+#[test]
+fn refinement_within_a_cell_limit() -> Result<(), MeshError> {
+    let o = Point::<3>::zeros();
+    let mesh = hemisphere(o, 1.0, 2)?;
+    let proj = SphereProjection::new(o, 1.0)?;
+    let everywhere = |_: &Point<3>| true;
+    let free = refine_toward(&mesh, everywhere, 3, &proj)?;
+    let within = refine_toward_within(&mesh, everywhere, 3, &proj, free.n_cells())?;
+    assert_eq!(within.n_cells(), free.n_cells());
+    assert!(within.cells().eq(free.cells()));
+    assert!(free.n_cells() >= 4 * mesh.n_cells(), "{} from {}", free.n_cells(), mesh.n_cells());
+    match refine_toward_within(&mesh, everywhere, 3, &proj, free.n_cells() - 1) {
+        Err(MeshError::InvalidParameter(m)) => assert!(m.contains("after level 3 of 3"), "{m}"),
+        other => panic!("expected the cell limit, got {:?}", other.map(|m| m.n_cells())),
+    }
+    match refine_toward_within(&mesh, everywhere, 30, &proj, 2 * mesh.n_cells()) {
+        Err(MeshError::InvalidParameter(m)) => assert!(m.contains("more than the limit"), "{m}"),
+        other => panic!("expected the cell limit, got {:?}", other.map(|m| m.n_cells())),
+    }
     Ok(())
 }

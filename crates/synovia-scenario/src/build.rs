@@ -21,8 +21,8 @@ use synovia::material::{
     VoigtMatrix,
 };
 use synovia::mesh::generators::{
-    ball, box_mesh, disc, half_disc, half_disc_refined, hemisphere, hemisphere_refined, layered_arc_2d,
-    layered_cap_3d, rectangle, Grading,
+    ball, box_mesh, disc, half_disc, half_disc_refined_within, hemisphere, hemisphere_refined_within,
+    layered_arc_2d, layered_cap_3d, rectangle, Grading,
 };
 use synovia::mesh::math::{Point, Vector};
 use synovia::mesh::{BoundaryKind, Mesh};
@@ -809,6 +809,9 @@ fn generate<const D: usize>(
             format!("the mesh would have about {estimate:.3e} cells, more than the limit {max_cells:e}"),
         ));
     }
+    // a refinement's cell count depends on how much of the mesh its region covers (up to
+    // `2^levels` times the cells): checked level by level while refining
+    let max_cells_usize = if max_cells >= usize::MAX as f64 { usize::MAX } else { max_cells as usize };
     if let Some(r) = &m.refine {
         let levels = *r.get_ref().levels.get_ref();
         let max_levels = limits().max_refine_levels;
@@ -867,18 +870,31 @@ fn generate<const D: usize>(
                 let cp = Point::<2>::new(c[0], c[1]);
                 Box::new(match refine {
                     None => half_disc(cp, r, n).map_err(gen_err)?,
-                    Some((rc, rr, l)) => {
-                        half_disc_refined(cp, r, n, Point::<2>::new(rc[0], rc[1]), rr, l).map_err(gen_err)?
-                    }
+                    Some((rc, rr, l)) => half_disc_refined_within(
+                        cp,
+                        r,
+                        n,
+                        Point::<2>::new(rc[0], rc[1]),
+                        rr,
+                        l,
+                        max_cells_usize,
+                    )
+                    .map_err(gen_err)?,
                 })
             } else {
                 let cp = Point::<3>::new(c[0], c[1], c[2]);
                 Box::new(match refine {
                     None => hemisphere(cp, r, n).map_err(gen_err)?,
-                    Some((rc, rr, l)) => {
-                        hemisphere_refined(cp, r, n, Point::<3>::new(rc[0], rc[1], rc[2]), rr, l)
-                            .map_err(gen_err)?
-                    }
+                    Some((rc, rr, l)) => hemisphere_refined_within(
+                        cp,
+                        r,
+                        n,
+                        Point::<3>::new(rc[0], rc[1], rc[2]),
+                        rr,
+                        l,
+                        max_cells_usize,
+                    )
+                    .map_err(gen_err)?,
                 })
             }
         }
