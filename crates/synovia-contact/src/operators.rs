@@ -636,9 +636,9 @@ impl<const D: usize> ContactGeometry<D> {
             // distinct nodes of the part at the same reference position (a duplicated node,
             // e.g. an unmerged mesh seam) would give two constraints on one point
             {
-                let mut seen: std::collections::HashMap<Vec<u64>, usize> = std::collections::HashMap::new();
+                let mut seen: std::collections::HashMap<[u64; D], usize> = std::collections::HashMap::new();
                 for i in part.nodes() {
-                    let key: Vec<u64> = reference(i).iter().map(|x| (x + 0.0).to_bits()).collect();
+                    let key: [u64; D] = std::array::from_fn(|a| (reference(i)[a] + 0.0).to_bits());
                     if let Some(j) = seen.insert(key, i) {
                         return Err(invalid(format!(
                             "nodes {j} and {i} of part `{}` of body `{}` coincide at {:?} (duplicated node)",

@@ -59,11 +59,27 @@ pub struct SurfaceObstacle {
     /// Far answers of bounded queries, kept for the next ones
     /// ([`SignedDistance::distance_and_gradient_within`]); shared by clones (they hold
     /// points in the surface's own frame, valid for every pose).
-    far: Arc<Mutex<HashMap<[u64; 3], FarAnswer>>>,
+    far: Arc<Mutex<FarAnswers>>,
 }
 
-/// A bounded query's answer beyond its reach: the query point in the surface's frame, a lower
-/// bound `φ₀ > reach` of `φ` there, and the gradient's direction (surface frame).
+/// Far answers of bounded queries in a grid of cubes of side `reach / 2` (surface frame): at
+/// most [`FAR_PER_CELL`] per cube (the oldest replaced), at most [`FAR_CELLS`] cubes (a full
+/// grid is emptied); a query with another reach empties it.
+#[derive(Debug, Default)]
+struct FarAnswers {
+    reach: Real,
+    cells: HashMap<[i64; 3], Vec<FarAnswer>>,
+}
+
+impl FarAnswers {
+    fn cell(&self, y: &Vector3<Real>) -> [i64; 3] {
+        let h = 0.5 * self.reach;
+        [(y.x / h).floor() as i64, (y.y / h).floor() as i64, (y.z / h).floor() as i64]
+    }
+}
+
+/// A bounded query's answer beyond its reach: the query point in the surface's frame, `φ₀ > reach`
+/// there, and the gradient (surface frame).
 #[derive(Debug, Clone, Copy)]
 struct FarAnswer {
     local: Vector3<Real>,
@@ -71,8 +87,10 @@ struct FarAnswer {
     gradient: Vector3<Real>,
 }
 
-/// At most this many far answers are kept (about 80 bytes each); a full store is emptied.
-const FAR_ANSWERS: usize = 1 << 20;
+/// Far answers kept per cube of the grid.
+const FAR_PER_CELL: usize = 8;
+/// Cubes of the grid of far answers kept (at most 2¹⁶ × 8 answers of 80 bytes: 42 MB).
+const FAR_CELLS: usize = 1 << 16;
 
 impl SurfaceObstacle {
     /// An obstacle bounded by `surface`, which must be a consistently oriented manifold (open
@@ -268,47 +286,51 @@ impl SignedDistance<3> for SurfaceObstacle {
         let p = self.closest_point(x);
         (p.distance, p.gradient)
     }
-    /// Points that were answered beyond the reach before, at `y₀` (surface frame) with a
-    /// lower bound `φ₀ ≤ φ(y₀)`, are answered from it while it stays beyond the reach: `φ` is
-    /// 1-Lipschitz, so `φ(y) ≥ φ₀ − |y − y₀|` for the point `y` in the surface's frame now
-    /// (the pose moved it by `|y − y₀|`), and that bound with the kept gradient is returned
-    /// when it exceeds `reach` — no search, for the contact nodes far from a partner that
-    /// moves little from pose to pose (the closest-point search visits more triangles the
-    /// farther the point). Smoothed surfaces ([`SurfaceObstacle::smoothed_solid`]) answer
-    /// points farther than `reach + δ` from the control surface with `φ_control − δ`;
-    /// otherwise the exact [`SignedDistance::distance_and_gradient`]. Answers beyond the
-    /// reach are kept (at most 2²⁰ points; a full store is emptied).
+    /// Smoothed surfaces ([`SurfaceObstacle::smoothed_solid`]) answer points farther than
+    /// `reach + δ` from the control surface with `φ_control − δ`. Other surfaces keep the
+    /// exact answers beyond the reach, `(y₀, φ₀ = φ(y₀), ∇φ(y₀))` in the surface's frame (a
+    /// grid of cubes of side `reach / 2`, at most 8 per cube and 2¹⁶ cubes), and answer a
+    /// point `y` (surface frame) from those in its cube: `φ` is 1-Lipschitz, so
+    /// `φ(y) ≥ max φ₀ − |y − y₀|`, and that bound with its gradient is returned when it
+    /// exceeds `reach` — no search for the contact nodes far from a partner that moves little
+    /// from pose to pose (the closest-point search visits more triangles the farther the
+    /// point). Such answers depend on the queries before (any bound in `(reach, φ]` is one).
+    /// Otherwise the exact [`SignedDistance::distance_and_gradient`].
     fn distance_and_gradient_within(&self, x: &Point<3>, reach: Real) -> (Real, Vector<3>) {
         let local = self.rotation.inverse() * (x - self.translation);
-        let key = [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()];
-        let kept = self.far.lock().unwrap_or_else(|e| e.into_inner()).get(&key).copied();
-        if let Some(far) = kept {
-            let bound = far.distance - (local - far.local).norm();
-            if bound > reach {
-                return (bound, self.rotation * far.gradient);
+        if let Some((coarse, delta)) = &self.coarse {
+            let (_, _, d, g) = coarse.closest_local(&local);
+            if d - delta > reach {
+                return (d - delta, self.rotation * g);
             }
+            return self.distance_and_gradient(x);
         }
-        let (distance, gradient) = match &self.coarse {
-            Some((coarse, delta)) => {
-                let (_, _, d, g) = coarse.closest_local(&local);
-                if d - delta > reach {
-                    (d - delta, g)
-                } else {
-                    let (_, _, d, g) = self.closest_local(&local);
-                    (d, g)
+        let usable = reach.is_finite() && reach > 0.0;
+        if usable {
+            let far = self.far.lock().unwrap_or_else(|e| e.into_inner());
+            if far.reach == reach {
+                let best = far.cells.get(&far.cell(&local)).and_then(|kept| {
+                    kept.iter()
+                        .map(|a| (a.distance - (local - a.local).norm(), a.gradient))
+                        .max_by(|a, b| a.0.total_cmp(&b.0))
+                });
+                if let Some((bound, gradient)) = best.filter(|(b, _)| *b > reach) {
+                    return (bound, self.rotation * gradient);
                 }
             }
-            None => {
-                let (_, _, d, g) = self.closest_local(&local);
-                (d, g)
-            }
-        };
-        if distance > reach {
+        }
+        let (_, _, distance, gradient) = self.closest_local(&local);
+        if usable && distance > reach {
             let mut far = self.far.lock().unwrap_or_else(|e| e.into_inner());
-            if far.len() >= FAR_ANSWERS {
-                far.clear();
+            if far.reach != reach || far.cells.len() >= FAR_CELLS {
+                *far = FarAnswers { reach, cells: HashMap::new() };
             }
-            far.insert(key, FarAnswer { local, distance, gradient });
+            let cell = far.cell(&local);
+            let kept = far.cells.entry(cell).or_default();
+            if kept.len() >= FAR_PER_CELL {
+                kept.remove(0);
+            }
+            kept.push(FarAnswer { local, distance, gradient });
         }
         (distance, self.rotation * gradient)
     }
@@ -329,7 +351,7 @@ mod tests {
     /// over a gait cycle): within the reach they equal the exact query of a fresh obstacle
     /// (no kept answers) bit for bit, beyond it they are lower bounds `reach < d ≤ φ` with
     /// unit gradients, and after the first pose most far points are answered from the kept
-    /// bounds (strictly below `φ`) instead of a search.
+    /// answers (bounds strictly below `φ`) instead of a search; the grid stays bounded.
     #[test]
     fn kept_far_answers_are_lower_bounds_and_near_answers_exact() {
         let centre = Point::<3>::new(0.3, -0.2, 0.1);
@@ -368,8 +390,12 @@ mod tests {
             assert!(near > 20, "{near} points within reach");
             from_kept.push(kept);
         }
-        assert_eq!(from_kept[0], 0, "nothing kept before the first pose");
-        assert!(from_kept[1..].iter().all(|&k| k > 300), "answered from kept bounds: {from_kept:?}");
-        assert!(moving.far.lock().expect("lock").len() <= FAR_ANSWERS);
+        // at the first pose only from other points' answers in the same cube
+        assert!(
+            from_kept[1..].iter().all(|&k| k > 300 && k > 2 * from_kept[0]),
+            "from kept bounds: {from_kept:?}"
+        );
+        let far = moving.far.lock().expect("lock");
+        assert!(far.cells.len() <= FAR_CELLS && far.cells.values().all(|c| c.len() <= FAR_PER_CELL));
     }
 }

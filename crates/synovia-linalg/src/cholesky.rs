@@ -392,8 +392,9 @@ impl CholeskySolver {
     /// about half the cost of [`CholeskySolver::solve_in_place`]: with `P A Pᵀ = L Lᵀ` and
     /// `P b = (0, b_c)`, the forward substitution is `y = (0, L₂₂⁻¹ b_c)` (dense, size
     /// `k = |c|`), and only the backward substitution `Lᵀ P x = y` runs over the whole factor
-    /// (docs/model.md §6.4). Falls back to the full solve when there is no trailing block or `b` has
-    /// entries outside `c`.
+    /// (docs/model.md §6.4). Without a trailing block, or for a `b` with entries outside `c`, a
+    /// whole solve (for a `b` with few non-zeros, its forward half on their elimination-tree
+    /// paths only: [`CholeskySolver::solve_sparse_on`]).
     ///
     /// # Errors
     /// As [`CholeskySolver::solve_in_place`].
@@ -401,7 +402,7 @@ impl CholeskySolver {
         let n = self.symbolic.nrows();
         let (Some(block), Some(perm), true) = (self.trailing.as_ref(), self.symbolic.perm(), self.factorized)
         else {
-            return self.solve_in_place(b);
+            return self.solve_sparse_in_place(b);
         };
         if b.len() != n {
             return Err(LinalgError::Length { what: "right-hand side", expected: n, got: b.len() });
@@ -410,7 +411,7 @@ impl CholeskySolver {
         let k = block.dofs.len();
         let t0 = n - k;
         if fwd[..t0].iter().any(|&i| b[i] != 0.0) {
-            return self.solve_in_place(b);
+            return self.solve_sparse_in_place(b);
         }
         let mut z = vec![0.0; n];
         for (p, zp) in z[t0..].iter_mut().enumerate() {
@@ -424,6 +425,26 @@ impl CholeskySolver {
         self.sparse_half_solve(MatMut::from_column_major_slice_mut(&mut z, n, 1), true)?;
         for (i, bi) in b.iter_mut().enumerate() {
             *bi = z[inv[i]];
+        }
+        Ok(())
+    }
+
+    /// Solves `A x = b` in place; a `b` with at most `n / 8` non-zeros (contact forces `Cᵀ ν`
+    /// on the active nodes) through [`CholeskySolver::solve_sparse_on`], whose forward half
+    /// visits only the supernodes on the elimination-tree paths of those dofs.
+    fn solve_sparse_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
+        let n = self.symbolic.nrows();
+        let supernodal =
+            matches!(self.symbolic.raw(), faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(_));
+        let entries: Vec<(usize, f64)> =
+            b.iter().enumerate().filter(|(_, v)| **v != 0.0).map(|(i, &v)| (i, v)).collect();
+        if !supernodal || b.len() != n || entries.len() > n / 8 {
+            return self.solve_in_place(b);
+        }
+        let all: Vec<usize> = (0..n).collect();
+        let x = self.solve_sparse_on(&[entries], &all)?;
+        if let Some(x) = x.first() {
+            b.copy_from_slice(x);
         }
         Ok(())
     }
@@ -607,43 +628,54 @@ impl CholeskySolver {
                 &identity
             }
         };
-        let mut x = faer::Mat::<f64>::zeros(n, k);
+        // X in factor order, column-major (column c at x[c n..(c + 1) n])
+        let mut x = vec![0.0; n * k];
         for (c, col) in rhs.iter().enumerate() {
             for &(d, v) in col {
-                x[(inv[d], c)] += v;
+                x[c * n + inv[d]] += v;
             }
         }
         let llt = SupernodalLltRef::new(sym, &self.factor);
         let ns = sym.n_supernodes();
         let mut nonzero = Vec::with_capacity(k);
+        let (mut xs, mut update) = (Vec::new(), Vec::new());
         // forward: Y = L⁻¹ P B, supernodes and right-hand sides where Y is non-zero only
         for s in 0..ns {
             let node = llt.supernode(s);
             let (start, val, pattern) = (node.start(), node.val(), node.pattern());
             let size = val.ncols();
             nonzero.clear();
-            nonzero.extend((0..k).filter(|&c| (start..start + size).any(|i| x[(i, c)] != 0.0)));
+            nonzero
+                .extend((0..k).filter(|&c| x[c * n + start..c * n + start + size].iter().any(|&v| v != 0.0)));
             if nonzero.is_empty() {
                 continue;
             }
+            let r = nonzero.len();
             let (top, bottom) = val.split_at_row(size);
-            let mut xs = faer::Mat::<f64>::from_fn(size, nonzero.len(), |i, j| x[(start + i, nonzero[j])]);
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(top, xs.as_mut(), Par::Seq);
-            let mut update = faer::Mat::<f64>::zeros(pattern.len(), nonzero.len());
+            xs.clear();
+            for &c in &nonzero {
+                xs.extend_from_slice(&x[c * n + start..c * n + start + size]);
+            }
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+                top,
+                MatMut::from_column_major_slice_mut(&mut xs, size, r),
+                Par::Seq,
+            );
+            update.clear();
+            update.resize(pattern.len() * r, 0.0);
             faer::linalg::matmul::matmul(
-                update.as_mut(),
+                MatMut::from_column_major_slice_mut(&mut update, pattern.len(), r),
                 faer::Accum::Replace,
                 bottom,
-                xs.as_ref(),
+                faer::MatRef::from_column_major_slice(&xs, size, r),
                 1.0,
                 Par::Seq,
             );
             for (j, &c) in nonzero.iter().enumerate() {
-                for i in 0..size {
-                    x[(start + i, c)] = xs[(i, j)];
-                }
-                for (idx, &i) in pattern.iter().enumerate() {
-                    x[(i, c)] -= update[(idx, j)];
+                let col = &mut x[c * n..(c + 1) * n];
+                col[start..start + size].copy_from_slice(&xs[j * size..(j + 1) * size]);
+                for (&i, u) in pattern.iter().zip(&update[j * pattern.len()..(j + 1) * pattern.len()]) {
+                    col[i] -= u;
                 }
             }
         }
@@ -666,24 +698,40 @@ impl CholeskySolver {
             }
         }
         // backward: Lᵀ P X = Y on the needed supernodes
+        let mut below = Vec::new();
         for s in (0..ns).rev().filter(|&s| needed[s]) {
             let node = llt.supernode(s);
             let (start, val, pattern) = (node.start(), node.val(), node.pattern());
             let size = val.ncols();
             let (top, bottom) = val.split_at_row(size);
-            let below = faer::Mat::<f64>::from_fn(pattern.len(), k, |idx, c| x[(pattern[idx], c)]);
-            let mut xs = x.as_mut().subrows_mut(start, size);
+            below.clear();
+            for c in 0..k {
+                let col = &x[c * n..(c + 1) * n];
+                below.extend(pattern.iter().map(|&i| col[i]));
+            }
+            xs.clear();
+            for c in 0..k {
+                xs.extend_from_slice(&x[c * n + start..c * n + start + size]);
+            }
+            let mut top_rows = MatMut::from_column_major_slice_mut(&mut xs, size, k);
             faer::linalg::matmul::matmul(
-                xs.rb_mut(),
+                top_rows.rb_mut(),
                 faer::Accum::Add,
                 bottom.transpose(),
-                below.as_ref(),
+                faer::MatRef::from_column_major_slice(&below, pattern.len(), k),
                 -1.0,
                 Par::Seq,
             );
-            faer::linalg::triangular_solve::solve_upper_triangular_in_place(top.transpose(), xs, Par::Seq);
+            faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+                top.transpose(),
+                top_rows,
+                Par::Seq,
+            );
+            for c in 0..k {
+                x[c * n + start..c * n + start + size].copy_from_slice(&xs[c * size..(c + 1) * size]);
+            }
         }
-        Ok((0..k).map(|c| support.iter().map(|&d| x[(inv[d], c)]).collect()).collect())
+        Ok((0..k).map(|c| support.iter().map(|&d| x[c * n + inv[d]]).collect()).collect())
     }
 
     /// Solves `A x = b` in place for one right-hand side.

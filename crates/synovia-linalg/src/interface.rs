@@ -849,6 +849,18 @@ mod tests {
                 }
             }
         }
+        // a sparse right-hand side of a whole solve (contact forces `Cᵀ ν`): the same
+        for (col, entries) in rhs.iter().enumerate() {
+            let mut b = vec![0.0; n];
+            for &(d, v) in entries {
+                b[d] += v;
+            }
+            op.view().factor().solve_trailing_supported_in_place(&mut b).expect("solve");
+            let scale = (0..n).fold(0.0_f64, |s, i| s.max(dense[(i, col)].abs()));
+            for (i, x) in b.iter().enumerate() {
+                assert!((x - dense[(i, col)]).abs() <= 1e-13 * scale, "x[{i}] of rhs {col}");
+            }
+        }
         assert!(op.view().factor().solve_sparse_on(&[vec![(n, 1.0)]], &face).is_err());
         assert!(op.view().factor().solve_sparse_on(&rhs, &[n]).is_err());
     }
