@@ -1386,8 +1386,8 @@ impl<const D: usize> JointModel<D> {
     fn check_nonlinear_rigid(&self) -> Result<(), JointError> {
         if !self.rigid_ties.is_empty() {
             return Err(JointError::Invalid(
-                "rigid bodies (mixed control) are not supported with nonlinear materials or finite strain yet; \
-                 prescribe the partner's motion or use a linear material"
+                "rigid bodies (mixed control) are not supported with nonlinear materials or finite strain yet \
+                 when a part is tied to them (as contact partners they are); prescribe the part's motion or use a linear material"
                     .into(),
             ));
         }

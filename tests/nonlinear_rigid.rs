@@ -195,5 +195,17 @@ fn unsupported_rigid_cases_are_refused() -> Result<(), Error> {
     two.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
     let err = two.run_static(1.0).err().ok_or("two force-controlled coordinates accepted")?;
     assert!(matches!(err, JointError::Unsupported { .. }), "{err}");
+
+    // a part tied to a rigid body: refused as before
+    let mut tied = JointModel::<3>::new();
+    let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [4, 4, 2], [Grading::Uniform; 3])?;
+    tied.add_body("block", mesh, Arc::new(neo_hookean(E, NU)?) as Arc<dyn Material<3>>)?;
+    tied.clamp("block", "bottom")?;
+    tied.add_rigid_body(
+        RigidBody::<3>::new("plate", Point::<3>::new(0.0, 0.0, 1.0))?.force(2, Constant(-1.0))?,
+    )?;
+    tied.tie_to_rigid_body("block", "top", "plate")?;
+    let err = tied.run_static(1.0).err().ok_or("a part tied to a rigid body accepted")?;
+    assert!(matches!(err, JointError::Invalid(_)) && err.to_string().contains("tied"), "{err}");
     Ok(())
 }
