@@ -1062,7 +1062,7 @@ impl RigidDriver {
     /// iteration chooses `w` on its linearised problem so that
     ///
     /// ```text
-    /// R(w) = −σ Q_k = −σ Σ_r κ_r Λ_n,r n_r · v_k(x_r) = σ F_k   (Q_k + F_k = 0, docs/model.md (10.2)),
+    /// R(w) = −σ Q_k = −σ Σ_r κ_r Λ_n,r n_r · v_k(x_r) = σ F_k   (Q_k + F_k = 0, docs/model.md (10.3)),
     /// ```
     ///
     /// the gaps followed to first order in `w` from the pose the geometry was built at,
