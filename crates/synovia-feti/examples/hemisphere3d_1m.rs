@@ -13,7 +13,7 @@
 //!
 //! ```text
 //! cargo run --release -p synovia-feti --example hemisphere3d_1m -- [levels=19] [subdomains=N]
-//!     [tol=1e-8] [bisection] [prec=lumped|dirichlet|none] [coarse=penalty|projector] [rho=F]
+//!     [tol=1e-8] [bisection] [prec=lumped|dirichlet|none] [coarse=penalty|projector] [exp=fixed|projcg|precond] [rho=F]
 //!     [dry | direct]
 //! cargo build --release -p synovia-feti --features mpi --example hemisphere3d_1m
 //! mpirun --oversubscribe -np 2 target/release/examples/hemisphere3d_1m levels=19 mpi
@@ -39,7 +39,7 @@ use synovia_fem::assembly::{assemble_matrix, body_stiffnesses, pattern};
 use synovia_fem::element::stiffness_into;
 use synovia_fem::model::Model;
 use synovia_feti::{
-    CoarseConstraint, Communicator, Decomposition, DecompositionParams, ModelProblem, Partitioner,
+    CoarseConstraint, Communicator, Decomposition, DecompositionParams, Expansion, ModelProblem, Partitioner,
     Preconditioner, SingleProcess, TfetiParams, TfetiSolution,
 };
 use synovia_linalg::{CholeskySolver, FactorisedOperator, LinalgError, SymmetricMatrix};
@@ -92,6 +92,7 @@ struct Options {
     partitioner: Partitioner,
     preconditioner: Preconditioner,
     coarse: CoarseConstraint,
+    expansion: Expansion,
     rho: f64,
     dry: bool,
     direct: bool,
@@ -106,6 +107,7 @@ fn options() -> Res<Options> {
         partitioner: Partitioner::Metis,
         preconditioner: Preconditioner::Lumped,
         coarse: CoarseConstraint::default(),
+        expansion: Expansion::Fixed,
         rho: 1.0,
         dry: false,
         direct: false,
@@ -133,6 +135,14 @@ fn options() -> Res<Options> {
                     "penalty" => CoarseConstraint::Penalty,
                     "projector" => CoarseConstraint::Projector,
                     _ => return Err(format!("unknown coarse constraint `{v}`").into()),
+                }
+            }
+            "exp" => {
+                o.expansion = match v {
+                    "fixed" => Expansion::Fixed,
+                    "projcg" => Expansion::ProjectedCg,
+                    "precond" => Expansion::Preconditioned,
+                    _ => return Err(format!("unknown expansion step `{v}`").into()),
                 }
             }
             "dry" => o.dry = true,
@@ -216,7 +226,8 @@ fn run(o: &Options, comm: &dyn Communicator) -> Res<()> {
     let mut params = TfetiParams::default()
         .with_tolerance(o.tol)
         .with_preconditioner(o.preconditioner)
-        .with_coarse(o.coarse);
+        .with_coarse(o.coarse)
+        .with_expansion(o.expansion);
     params.rho_factor = o.rho;
     let t2 = Instant::now();
     let s0 = normal.solve(&dec, comm, &params)?;
@@ -267,13 +278,14 @@ fn run(o: &Options, comm: &dyn Communicator) -> Res<()> {
             "mu": MU, "subdomains": r.subdomains, "ranks": r.ranks,
             "threads_per_rank": rayon::current_num_threads(),
             "subdomains_per_rank": all.chunks(3).map(|c| c[1] as usize).collect::<Vec<_>>(),
-            "partitioner": format!("{:?}", o.partitioner), "preconditioner": format!("{:?}", o.preconditioner), "coarse": format!("{:?}", o.coarse),
+            "partitioner": format!("{:?}", o.partitioner), "preconditioner": format!("{:?}", o.preconditioner), "coarse": format!("{:?}", o.coarse), "expansion": format!("{:?}", o.expansion),
             "rho_factor": o.rho, "tolerance": o.tol,
             "dual": r.dual, "coarse": r.coarse_dim,
             "time_s": time_s, "model_s": model_s, "decomposition_s": decomposition_s,
             "normal_s": normal_s, "tresca_s": tresca_s, "kkt_s": kkt_s,
             "normal_outer": s0.report.outer_iterations, "normal_inner": s0.report.inner_iterations, "normal_steps_cg_exp_prop": s0.report.inner_steps,
             "tresca_outer": r.outer_iterations, "tresca_inner": r.inner_iterations, "tresca_steps_cg_exp_prop": r.inner_steps,
+            "exp_fallbacks": [s0.report.expansion_fallbacks, r.expansion_fallbacks],
             "outer_iterations": s0.report.outer_iterations + r.outer_iterations,
             "inner_iterations": s0.report.inner_iterations + r.inner_iterations,
             "f_products": s0.report.f_products + r.f_products,

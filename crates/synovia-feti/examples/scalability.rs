@@ -14,8 +14,8 @@ use synovia_contact::obstacle::SphereObstacle;
 use synovia_contact::operators::ContactPair;
 use synovia_fem::model::Model;
 use synovia_feti::{
-    CoarseConstraint, Decomposition, DecompositionParams, Gluing, ModelProblem, Partitioner, Preconditioner,
-    SingleProcess, TfetiParams,
+    CoarseConstraint, Decomposition, DecompositionParams, Expansion, Gluing, ModelProblem, Partitioner,
+    Preconditioner, SingleProcess, TfetiParams,
 };
 use synovia_material::plane_strain;
 use synovia_mesh::generators::{rectangle, Grading};
@@ -80,6 +80,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 "prec=dirichlet" => params.preconditioner = Preconditioner::Dirichlet,
                 "coarse=projector" => params.coarse = CoarseConstraint::Projector,
                 "coarse=penalty" => params.coarse = CoarseConstraint::Penalty,
+                "exp=fixed" => params.expansion = Expansion::Fixed,
+                "exp=projcg" => params.expansion = Expansion::ProjectedCg,
+                "exp=precond" => params.expansion = Expansion::Preconditioned,
                 _ => {}
             }
         }
@@ -115,10 +118,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "k": k, "gluing": format!("{gluing:?}"), "preconditioner": format!("{:?}", params.preconditioner), "coarse": format!("{:?}", params.coarse), "partitioner": format!("{partitioner:?}"), "subdomains": r.subdomains, "H_over_h": hh, "dofs": dec.n_reduced(),
             "primal": dec.n_primal(), "dual": r.dual, "coarse": r.coarse_dim,
             "frictionless": {"outer": s0.report.outer_iterations, "inner": s0.report.inner_iterations, "f_products": s0.report.f_products,
-                "per_outer": s0.report.inner_per_outer, "steps_cg_exp_prop": s0.report.inner_steps},
+                "per_outer": s0.report.inner_per_outer, "steps_cg_exp_prop": s0.report.inner_steps, "exp_fallbacks": s0.report.expansion_fallbacks},
             "spectrum": spectrum,
             "tresca": {"outer": r.outer_iterations, "inner": r.inner_iterations, "f_products": r.f_products, "prec_products": r.preconditioner_products, "face_factorisations": r.face_factorisations,
-                        "per_outer": r.inner_per_outer, "steps_cg_exp_prop": r.inner_steps,
+                        "per_outer": r.inner_per_outer, "steps_cg_exp_prop": r.inner_steps, "exp_fallbacks": r.expansion_fallbacks, "expansion": format!("{:?}", params.expansion),
                         "active": s.lambda_n.iter().filter(|&&l| l > 0.0).count(),
                         "slip": s.lambda_t.iter().filter(|l| l.abs() >= 1.0 - 1e-8).count()},
             "decompose_s": decompose_s, "tresca_setup_s": r.setup_s, "tresca_solve_s": r.solve_s,

@@ -13,8 +13,8 @@ use synovia_contact::obstacle::SphereObstacle;
 use synovia_contact::operators::ContactPair;
 use synovia_fem::model::Model;
 use synovia_feti::{
-    CoarseConstraint, Decomposition, DecompositionParams, ModelProblem, Partitioner, Preconditioner,
-    SingleProcess, TfetiParams,
+    CoarseConstraint, Decomposition, DecompositionParams, Expansion, ModelProblem, Partitioner,
+    Preconditioner, SingleProcess, TfetiParams,
 };
 use synovia_material::isotropic;
 use synovia_mesh::generators::{box_mesh, Grading};
@@ -39,6 +39,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "prec=dirichlet" => params.preconditioner = Preconditioner::Dirichlet,
             "coarse=projector" => params.coarse = CoarseConstraint::Projector,
             "coarse=penalty" => params.coarse = CoarseConstraint::Penalty,
+            "exp=fixed" => params.expansion = Expansion::Fixed,
+            "exp=projcg" => params.expansion = Expansion::ProjectedCg,
+            "exp=precond" => params.expansion = Expansion::Preconditioned,
             _ => {}
         }
     }
@@ -70,9 +73,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "partitioner": format!("{partitioner:?}"), "preconditioner": format!("{:?}", params.preconditioner), "coarse": format!("{:?}", params.coarse),
             "rho_factor": params.rho_factor, "dual": r.dual, "coarse": r.coarse_dim,
             "frictionless": {"outer": s0.report.outer_iterations, "inner": s0.report.inner_iterations,
-                             "f_products": s0.report.f_products, "steps_cg_exp_prop": s0.report.inner_steps},
+                             "f_products": s0.report.f_products, "steps_cg_exp_prop": s0.report.inner_steps, "exp_fallbacks": s0.report.expansion_fallbacks},
             "tresca": {"outer": r.outer_iterations, "inner": r.inner_iterations, "f_products": r.f_products,
-                       "prec_products": r.preconditioner_products, "face_factorisations": r.face_factorisations, "steps_cg_exp_prop": r.inner_steps,
+                       "prec_products": r.preconditioner_products, "face_factorisations": r.face_factorisations, "steps_cg_exp_prop": r.inner_steps, "exp_fallbacks": r.expansion_fallbacks, "expansion": format!("{:?}", params.expansion),
                        "active": s.lambda_n.iter().filter(|&&l| l > 0.0).count()},
             "tresca_solve_s": r.solve_s,
         });

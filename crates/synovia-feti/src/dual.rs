@@ -40,7 +40,7 @@ use std::time::Instant;
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use synovia_contact::{ContactError, FrictionConstraints, NormalConstraints};
-use synovia_uzawa::{estimate_norm, qp_until, ConvexBlock, Hessian, QpOptions};
+use synovia_uzawa::{estimate_norm, qp_until, ConvexBlock, Expansion, Hessian, QpOptions};
 
 use crate::comm::Communicator;
 use crate::decomposition::{Decomposition, Entry};
@@ -70,6 +70,10 @@ pub struct TfetiParams {
     /// How the coarse condition `G λ = e` is enforced (default [`CoarseConstraint::Penalty`]:
     /// SMALBE).
     pub coarse: CoarseConstraint,
+    /// The expansion step of the inner MPRGP/MPGP iterations (default
+    /// [`Expansion::Fixed`]: Dostál's fixed length `ᾱ = 1.9/‖H‖`; see `synovia_uzawa`'s
+    /// *Longer expansion steps*).
+    pub expansion: Expansion,
 }
 
 /// How the natural coarse condition `G λ = e` of the dual problem is enforced (module docs).
@@ -152,6 +156,7 @@ impl Default for TfetiParams {
             beta: 10.0,
             preconditioner: Preconditioner::default(),
             coarse: CoarseConstraint::default(),
+            expansion: Expansion::Fixed,
         }
     }
 }
@@ -187,6 +192,11 @@ impl TfetiParams {
         self.max_inner = max_inner;
         self
     }
+    /// Sets [`Self::expansion`].
+    pub fn with_expansion(mut self, expansion: Expansion) -> Self {
+        self.expansion = expansion;
+        self
+    }
 }
 
 /// What a TFETI solve did.
@@ -208,6 +218,9 @@ pub struct TfetiReport {
     pub inner_per_outer: Vec<usize>,
     /// Of the inner iterations: conjugate gradient, expansion and proportioning steps.
     pub inner_steps: [usize; 3],
+    /// Of the expansion steps: those whose longer candidate ([`TfetiParams::expansion`]) was
+    /// replaced by the fixed-length step.
+    pub expansion_fallbacks: usize,
     /// Products with `F` (one subdomain solve each per subdomain).
     pub f_products: usize,
     /// Applications of the preconditioner (one interior solve per subdomain each with
@@ -1019,7 +1032,8 @@ pub fn solve(
             let chopped = blocks.iter().all(|b| matches!(b, ConvexBlock::Interval { .. }));
             let mut opts = QpOptions::default()
                 .with_hessian_norm(Some(1.05 * est.max(rho)))
-                .with_precondition(params.preconditioner != Preconditioner::None);
+                .with_precondition(params.preconditioner != Preconditioner::None)
+                .with_expansion(params.expansion);
 
             let mut x = vec![0.0; m];
             let mut mu = DVector::<f64>::zeros(dual.n_coarse);
@@ -1057,6 +1071,7 @@ pub fn solve(
                 report.inner_steps[0] += rep.cg_steps;
                 report.inner_steps[1] += rep.expansion_steps;
                 report.inner_steps[2] += rep.proportioning_steps;
+                report.expansion_fallbacks += rep.expansion_fallbacks;
                 gp_last = gp_s;
                 gx_last = gx_s;
                 if !rep.converged {
@@ -1131,6 +1146,7 @@ fn solve_projected(
     let opts = QpOptions::default()
         .with_hessian_norm(Some(hnorm))
         .with_precondition(params.preconditioner != Preconditioner::None)
+        .with_expansion(params.expansion)
         .with_max_iterations(params.max_inner.max(1));
     let mut x = vec![0.0; m];
     let mut gp_last = f64::INFINITY;
@@ -1145,6 +1161,7 @@ fn solve_projected(
     report.inner_iterations = rep.iterations;
     report.inner_per_outer = vec![rep.iterations];
     report.inner_steps = [rep.cg_steps, rep.expansion_steps, rep.proportioning_steps];
+    report.expansion_fallbacks = rep.expansion_fallbacks;
     report.face_factorisations = hess.face_factorisations;
     report.gradient = gp_last / bnorm;
     let lt = dual.t(&x);

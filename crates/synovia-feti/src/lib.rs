@@ -56,6 +56,7 @@ pub use dual::{
 };
 pub use error::FetiError;
 pub use partition::Partitioner;
+pub use synovia_uzawa::Expansion;
 
 /// The contact solver `"tfeti"`: TFETI on a [`Decomposition`] of the model whose contact
 /// problems it solves, in one process (rayon threads over the subdomains).

@@ -6,7 +6,7 @@
 //! relative (max norm), and the TFETI solution must satisfy the KKT conditions.
 
 use synovia_contact::{ContactSolver, StaticContact, StaticContactResult};
-use synovia_feti::{CoarseConstraint, DecompositionParams, Tfeti, TfetiParams};
+use synovia_feti::{CoarseConstraint, DecompositionParams, Expansion, Tfeti, TfetiParams};
 use synovia_models::hertz::{hertz2d_model, hertz3d_model, Hertz2d, Hertz3d};
 use synovia_pdas::Pdas;
 
@@ -32,8 +32,9 @@ fn compare<const D: usize>(
         .expect("decomposition");
     let dec = tfeti.decomposition();
     println!(
-        "{name} ({:?}): {} subdomains, primal {}, equality rows {:?}, coarse {}",
+        "{name} ({:?}, {:?} expansion): {} subdomains, primal {}, equality rows {:?}, coarse {}",
         params.coarse,
+        params.expansion,
         dec.n_subdomains(),
         dec.n_primal(),
         dec.n_equality(),
@@ -105,4 +106,39 @@ fn tfeti_projector_equals_pdas_on_3d_hertz_with_friction() {
     pairs[0].friction = 0.3;
     let params = TfetiParams::default().with_coarse(CoarseConstraint::Projector);
     compare("hertz3d", &model, &pairs, 8, 0.002, params);
+}
+
+/// The longer expansion steps of MPRGP/MPGP (`Expansion::ProjectedCg`,
+/// `Expansion::Preconditioned`) with the projector: the same solution as PDAS in 2D and 3D,
+/// with friction (and so the same as the fixed step, both within 1e-6 of PDAS).
+#[test]
+fn tfeti_projector_with_longer_expansion_steps_equals_pdas_on_hertz() {
+    let p2 = Hertz2d { levels: 6, e2: Some(1.0), push: 0.02, ..Default::default() };
+    let (model2, mut pairs2) = hertz2d_model(&p2).expect("model");
+    pairs2[0].friction = 0.3;
+    let p3 = Hertz3d { n: 3, levels: 7, ..Default::default() };
+    let (model3, mut pairs3) = hertz3d_model(&p3).expect("model");
+    pairs3[0].friction = 0.3;
+    for expansion in [Expansion::ProjectedCg, Expansion::Preconditioned] {
+        let params =
+            TfetiParams::default().with_coarse(CoarseConstraint::Projector).with_expansion(expansion);
+        compare("hertz2d", &model2, &pairs2, 8, 0.004, params);
+        compare("hertz3d", &model3, &pairs3, 8, 0.002, params);
+    }
+}
+
+/// SMALBE (the default coarse treatment) with the projected CG expansion step: same solution.
+#[test]
+fn tfeti_smalbe_with_projected_cg_expansion_equals_pdas_on_2d_hertz() {
+    let p = Hertz2d { levels: 6, e2: Some(1.0), push: 0.02, ..Default::default() };
+    let (model, mut pairs) = hertz2d_model(&p).expect("model");
+    pairs[0].friction = 0.3;
+    compare(
+        "hertz2d",
+        &model,
+        &pairs,
+        8,
+        0.004,
+        TfetiParams::default().with_expansion(Expansion::ProjectedCg),
+    );
 }

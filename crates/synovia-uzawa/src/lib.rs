@@ -70,7 +70,8 @@ pub mod uzawa;
 
 pub use dual::DualMprgp;
 pub use qp::{
-    estimate_norm, mpgp, mprgp, qp_until, ConvexBlock, DenseHessian, Hessian, QpOptions, QpReport, StopTest,
+    estimate_norm, mpgp, mprgp, qp_until, ConvexBlock, DenseHessian, Expansion, Hessian, QpOptions, QpReport,
+    StopTest,
 };
 pub use schur::SchurOperator;
 pub use uzawa::UzawaMprgp;

@@ -51,6 +51,26 @@
 //! convergence theory is untouched, while the iteration counts on 3D Tresca problems with many
 //! slipping cells drop several-fold (e.g. from about 200 to 20).
 //!
+//! ## Longer expansion steps (option, [`Expansion`])
+//!
+//! The fixed length `ᾱ ≤ 2/‖H‖` of the expansion step is set by the largest eigenvalue of the
+//! *unpreconditioned* `H`; when the CG steps are preconditioned in face and `‖H‖` is large (a
+//! FETI dual whose coarse condition is eliminated by an oblique projector), one expansion step
+//! adds only the few blocks near their boundary to the active set, and the expansion steps grow
+//! with `‖H‖`. [`QpOptions::expansion`] offers two longer steps from the half step
+//! `x^{½} = x − α_f p` (Kružík, Horák, Čermák, Pospíšil, Pecha 2020, *Active set expansion
+//! strategies in MPRGP algorithm*; PERMON's `projcg` and `gf`/`opt` expansions):
+//!
+//! ```text
+//! ProjectedCg:     x^c = P_Ω(x − α_cg p) = P_Ω(x^{½} − (α_cg − α_f) p),   α_cg = gᵀp / pᵀHp,
+//! Preconditioned:  x^c = P_Ω(x^{½} − α_z z),   z = M_F⁻¹ φ(x^{½}),   α_z = φᵀz / zᵀHz,
+//! ```
+//!
+//! (`α_z` minimises `q` along `−z` before the projection). The candidate is kept if
+//! `q(x^c) ≤ q(x^{½})`; otherwise the fixed-length step is taken from `x^{½}` (a *fallback*,
+//! counted in [`QpReport::expansion_fallbacks`]). The cost therefore decreases monotonically,
+//! but the R-linear rate of Dostál's proof covers only the fixed step, which stays the default.
+//!
 //! `‖H‖` is estimated by a few steps of the power method (which converges from below; the
 //! estimate is enlarged by 5 %), unless given.
 
@@ -174,6 +194,25 @@ impl ConvexBlock {
     }
 }
 
+/// The step taken after an infeasible conjugate gradient step (module docs, *Longer expansion
+/// steps*).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum Expansion {
+    /// Dostál's expansion step: `x^{½} = x − α_f p`, then `x ← P_Ω(x^{½} − ᾱ φ(x^{½}))` with the
+    /// fixed length `ᾱ = step_factor/‖H‖` (default).
+    #[default]
+    Fixed,
+    /// The projected CG step `x ← P_Ω(x − α_cg p)`, kept if `q` does not exceed `q(x^{½})`,
+    /// else the fixed step (one product with `H` per step, plus one on a fallback).
+    ProjectedCg,
+    /// From `x^{½}`, the preconditioned free gradient `z = M_F⁻¹ φ` with the step `α_z = φᵀz /
+    /// zᵀHz` that minimises `q` along `−z`, projected: `x ← P_Ω(x^{½} − α_z z)`, kept if `q`
+    /// does not exceed `q(x^{½})`, else the fixed step (two products with `H` and one
+    /// application of the preconditioner per step).
+    Preconditioned,
+}
+
 /// Options of [`mprgp`] and [`mpgp`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -195,6 +234,8 @@ pub struct QpOptions {
     /// Preconditioning in face of the CG steps (default `true`): by the [`Hessian`]'s own
     /// [`Hessian::precondition_in_face`] if it has one, else Jacobi if it supplies its diagonal.
     pub precondition: bool,
+    /// The expansion step (default [`Expansion::Fixed`], Dostál's).
+    pub expansion: Expansion,
 }
 
 impl Default for QpOptions {
@@ -208,6 +249,7 @@ impl Default for QpOptions {
             hessian_norm: None,
             power_iterations: 20,
             precondition: true,
+            expansion: Expansion::Fixed,
         }
     }
 }
@@ -253,6 +295,11 @@ impl QpOptions {
         self.precondition = precondition;
         self
     }
+    /// Sets [`Self::expansion`].
+    pub fn with_expansion(mut self, expansion: Expansion) -> Self {
+        self.expansion = expansion;
+        self
+    }
 }
 
 /// What [`mprgp`] / [`mpgp`] did.
@@ -266,6 +313,10 @@ pub struct QpReport {
     pub cg_steps: usize,
     /// Expansion steps.
     pub expansion_steps: usize,
+    /// Expansion steps whose longer candidate ([`Expansion::ProjectedCg`],
+    /// [`Expansion::Preconditioned`]) raised the cost above `q(x^{½})` and was replaced by the
+    /// fixed-length step (or had no usable length).
+    pub expansion_fallbacks: usize,
     /// Proportioning steps.
     pub proportioning_steps: usize,
     /// Final `‖g^P‖`.
@@ -896,6 +947,8 @@ fn run<H: Hessian + ?Sized>(
     let nf = if prop == Proportioning::Projected { n } else { 0 };
     let (mut d, mut fr, mut fp) = (vec![0.0; nf], vec![0.0; nf], vec![0.0; nf]);
     let mut z = vec![0.0; n];
+    let ne = if opt.expansion == Expansion::Fixed { 0 } else { n };
+    let (mut xc, mut gc) = (vec![0.0; ne], vec![0.0; ne]);
     let mut steps = vec![0.0; blocks.len()];
     let (mut bb, mut rf, mut gpn) = layout.split(x, &g, abar, &mut w);
     let bnorm = norm(b);
@@ -979,11 +1032,58 @@ fn run<H: Hessian + ?Sized>(
                 }
                 layout.snap(x, &p, &steps, af);
                 layout.split(x, &g, abar, &mut w);
-                for k in 0..n {
-                    x[k] -= abar * w.phi[k];
+                // a longer candidate from x½, kept if q(x^c) ≤ q(x½)
+                let mut longer = false;
+                if opt.expansion != Expansion::Fixed {
+                    let q_half = cost(x, &g, b);
+                    let usable = match opt.expansion {
+                        Expansion::ProjectedCg => {
+                            let s = acg - af;
+                            if s.is_finite() && s > 0.0 {
+                                for k in 0..n {
+                                    xc[k] = x[k] - s * p[k];
+                                }
+                                true
+                            } else {
+                                false
+                            }
+                        }
+                        _ => {
+                            precondition(hessian, &mut general, &w, &mut z)?;
+                            hessian.apply(&z, &mut hp)?;
+                            rep.hessian_products += 1;
+                            let (gz, zhz) = (dot(&w.phi, &z), dot(&z, &hp));
+                            if gz > 0.0 && zhz > 1e-14 * hnorm * dot(&z, &z) {
+                                let a = gz / zhz;
+                                for k in 0..n {
+                                    xc[k] = x[k] - a * z[k];
+                                }
+                                true
+                            } else {
+                                false
+                            }
+                        }
+                    };
+                    if usable {
+                        layout.project(&mut xc);
+                        gradient(hessian, &xc, &mut gc, &mut rep)?;
+                        if cost(&xc, &gc, b) <= q_half {
+                            x.copy_from_slice(&xc);
+                            g.copy_from_slice(&gc);
+                            longer = true;
+                        }
+                    }
+                    if !longer {
+                        rep.expansion_fallbacks += 1;
+                    }
                 }
-                layout.project(x);
-                gradient(hessian, x, &mut g, &mut rep)?;
+                if !longer {
+                    for k in 0..n {
+                        x[k] -= abar * w.phi[k];
+                    }
+                    layout.project(x);
+                    gradient(hessian, x, &mut g, &mut rep)?;
+                }
                 (bb, rf, gpn) = layout.split(x, &g, abar, &mut w);
                 precondition(hessian, &mut general, &w, &mut z)?;
                 p.copy_from_slice(&z);

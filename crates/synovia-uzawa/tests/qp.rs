@@ -4,7 +4,7 @@
 use approx::assert_relative_eq;
 use nalgebra::{DMatrix, DVector};
 use synovia_contact::ContactError;
-use synovia_uzawa::{estimate_norm, mpgp, mprgp, ConvexBlock, DenseHessian, QpOptions};
+use synovia_uzawa::{estimate_norm, mpgp, mprgp, ConvexBlock, DenseHessian, Expansion, QpOptions};
 
 const INF: f64 = f64::INFINITY;
 
@@ -287,4 +287,151 @@ fn qp_errors() {
         }
         other => panic!("expected NoConvergence, got {other:?}"),
     }
+}
+
+/// The longer expansion steps (`Expansion::ProjectedCg`, `Expansion::Preconditioned`) reach the
+/// same solutions as Dostál's fixed step: on strictly convex random box problems (with and
+/// without Jacobi preconditioning in face) the KKT residual is below 1e-9 and `x` equals the
+/// fixed-step solution to 1e-8 (the minimiser is unique).
+#[test]
+fn longer_expansion_steps_reach_the_same_box_solutions() {
+    let mut rng = Lcg(7);
+    for &precondition in &[false, true] {
+        for trial in 0..5 {
+            let n = 30;
+            let h = random_spd(n, &mut rng);
+            let b: Vec<f64> = (0..n).map(|_| 3.0 * rng.next()).collect();
+            let l: Vec<f64> =
+                (0..n).map(|i| if i % 5 == 0 { -INF } else { -0.5 + 0.3 * rng.next() }).collect();
+            let u: Vec<f64> = (0..n).map(|i| if i % 7 == 0 { INF } else { 0.5 + 0.3 * rng.next() }).collect();
+            let base = QpOptions::default().with_tolerance(1e-12).with_precondition(precondition);
+            let mut x0 = vec![0.0; n];
+            let fixed = mprgp(&mut DenseHessian(h.clone()), &b, &l, &u, &mut x0, &base).expect("fixed");
+            for expansion in [Expansion::ProjectedCg, Expansion::Preconditioned] {
+                let mut x = vec![0.0; n];
+                let opts = base.with_expansion(expansion);
+                let rep = mprgp(&mut DenseHessian(h.clone()), &b, &l, &u, &mut x, &opts).expect("mprgp");
+                let kkt = box_kkt(&h, &b, &l, &u, &x);
+                let diff = x.iter().zip(&x0).fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()));
+                println!(
+                    "trial {trial} precondition {precondition} {expansion:?}: {} iterations ({} exp, {} fallbacks) vs fixed {} ({} exp), kkt {kkt:.2e}, |x − x_fixed| {diff:.2e}",
+                    rep.iterations, rep.expansion_steps, rep.expansion_fallbacks, fixed.iterations, fixed.expansion_steps
+                );
+                assert!(kkt < 1e-9, "trial {trial} {expansion:?}: KKT residual {kkt:e}");
+                assert!(diff < 1e-8, "trial {trial} {expansion:?}: differs from the fixed step by {diff:e}");
+            }
+        }
+    }
+}
+
+/// As above for MPGP with discs and half-lines (3D friction-like blocks): KKT of the disc
+/// constraints and equality with the fixed-step solution.
+#[test]
+fn longer_expansion_steps_reach_the_same_disc_solutions() {
+    let mut rng = Lcg(11);
+    for trial in 0..5 {
+        let (nh, nd) = (10, 10);
+        let n = nh + 2 * nd;
+        let h = random_spd(n, &mut rng);
+        let b: Vec<f64> = (0..n).map(|_| 3.0 * rng.next()).collect();
+        let mut blocks = vec![ConvexBlock::Interval { lower: 0.0, upper: INF }; nh];
+        blocks.extend(std::iter::repeat_n(ConvexBlock::Ball { dim: 2, radius: 0.8 }, nd));
+        let base = QpOptions::default().with_tolerance(1e-12);
+        let mut x0 = vec![0.0; n];
+        mpgp(&mut DenseHessian(h.clone()), &b, &blocks, &mut x0, &base).expect("fixed");
+        for expansion in [Expansion::ProjectedCg, Expansion::Preconditioned] {
+            let mut x = vec![0.0; n];
+            let rep =
+                mpgp(&mut DenseHessian(h.clone()), &b, &blocks, &mut x, &base.with_expansion(expansion))
+                    .expect("mpgp");
+            let g = gradient(&h, &x, &b);
+            let scale = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let mut worst = 0.0_f64;
+            for i in 0..nh {
+                assert!(x[i] >= 0.0);
+                worst = worst.max(if x[i] == 0.0 { (-g[i]).max(0.0) } else { g[i].abs() });
+            }
+            for c in 0..nd {
+                let (xc, gc) = (&x[nh + 2 * c..nh + 2 * c + 2], &g[nh + 2 * c..nh + 2 * c + 2]);
+                let r = (xc[0] * xc[0] + xc[1] * xc[1]).sqrt();
+                assert!(r <= 0.8 * (1.0 + 1e-14));
+                if r >= 0.8 * (1.0 - 1e-9) {
+                    let (nx, ny) = (xc[0] / r, xc[1] / r);
+                    let gn = gc[0] * nx + gc[1] * ny;
+                    let gt = -gc[0] * ny + gc[1] * nx;
+                    worst = worst.max(gt.abs()).max(gn.max(0.0));
+                } else {
+                    worst = worst.max(gc[0].abs()).max(gc[1].abs());
+                }
+            }
+            let diff = x.iter().zip(&x0).fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()));
+            println!(
+                "trial {trial} {expansion:?}: {} iterations ({} exp, {} fallbacks), kkt {:.2e}, |x − x_fixed| {diff:.2e}",
+                rep.iterations,
+                rep.expansion_steps,
+                rep.expansion_fallbacks,
+                worst / scale
+            );
+            assert!(worst / scale < 1e-9, "trial {trial} {expansion:?}: KKT residual {:e}", worst / scale);
+            assert!(diff < 1e-8, "trial {trial} {expansion:?}: differs from the fixed step by {diff:e}");
+        }
+    }
+}
+
+/// What the longer steps are for: a badly scaled obstacle problem, `H = D (L + I) D` (`L` the
+/// 1D Laplacian, `D = diag(1, 0.05, 1, 0.05, …)`, 200 unknowns) with upper bounds that most
+/// entries reach, solved with Jacobi preconditioning in face. The CG steps see the scaling; the
+/// fixed step `ᾱ = 1.9/‖H‖` moves the entries with `D_i = 0.05` by a factor 400 too little, so
+/// the fixed-step expansion adds few bounds per step. The longer steps must need fewer than
+/// half the expansion steps, and reach the same solution (KKT).
+#[test]
+fn longer_expansion_steps_need_fewer_expansion_steps_on_a_scaled_obstacle() {
+    let n = 200;
+    let d: Vec<f64> = (0..n).map(|i| if i % 2 == 0 { 1.0 } else { 0.05 }).collect();
+    let h = DMatrix::from_fn(n, n, |i, j| {
+        let a = if i == j {
+            3.0
+        } else if i.abs_diff(j) == 1 {
+            -1.0
+        } else {
+            0.0
+        };
+        d[i] * a * d[j]
+    });
+    // (L + I) y = c, c_i = 2 sin(π i/n), has y ≈ c inside; x = D⁻¹ y, bounded by 0.8 / D_i
+    let b: Vec<f64> = d
+        .iter()
+        .enumerate()
+        .map(|(i, di)| di * 2.0 * (std::f64::consts::PI * i as f64 / n as f64).sin())
+        .collect();
+    let l = vec![-INF; n];
+    let u: Vec<f64> = d.iter().map(|di| 0.8 / di).collect();
+    let mut counts = Vec::new();
+    let mut solutions = Vec::new();
+    for expansion in [Expansion::Fixed, Expansion::ProjectedCg, Expansion::Preconditioned] {
+        let mut x = vec![0.0; n];
+        let opts = QpOptions::default().with_tolerance(1e-13).with_expansion(expansion);
+        let rep = mprgp(&mut DenseHessian(h.clone()), &b, &l, &u, &mut x, &opts).expect("mprgp");
+        let active = (0..n).filter(|&i| x[i] >= u[i]).count();
+        let kkt = box_kkt(&h, &b, &l, &u, &x);
+        println!(
+            "{expansion:?}: {} iterations ({} cg, {} exp, {} prop, {} fallbacks), {} products, {active} active, kkt {kkt:.2e}",
+            rep.iterations,
+            rep.cg_steps,
+            rep.expansion_steps,
+            rep.proportioning_steps,
+            rep.expansion_fallbacks,
+            rep.hessian_products
+        );
+        assert!(active > n / 4 && active < n, "active {active}");
+        assert!(kkt < 1e-9, "{expansion:?}: KKT residual {kkt:e}");
+        counts.push(rep.expansion_steps);
+        solutions.push(x);
+    }
+    for x in &solutions[1..] {
+        let diff = x.iter().zip(&solutions[0]).fold(0.0_f64, |m, (a, c)| m.max((a - c).abs()));
+        println!("|x − x_fixed| = {diff:.2e} (max |x| = 16)");
+        assert!(diff < 1e-8, "differs from the fixed step by {diff:e}");
+    }
+    assert!(2 * counts[1] < counts[0] && 2 * counts[2] < counts[0], "expansion steps {counts:?}");
 }
