@@ -93,12 +93,13 @@ fn main() -> Result<(), KneeError> {
     let factorisations: usize = nonlinear.iter().map(|h| h.factorisations).sum();
     let solves: usize = nonlinear.iter().map(|h| h.step.solves).sum();
     let controlled = nonlinear.iter().filter(|h| h.load_controlled).count();
+    let trials: usize = nonlinear.iter().map(|h| h.load_control_trials).sum();
     let cost_ratio = nonlinear_s / linear_s;
     println!(
-        "linear {linear_s:.3} s (fastest of 3), neo-Hookean {nonlinear_s:.2} s ({cost_ratio:.1}x): {solves} Newton solves ({controlled} poses under load control inside the Newton iteration), {newton} Newton iterations, {factorisations} factorisations"
+        "linear {linear_s:.3} s (fastest of 3), neo-Hookean {nonlinear_s:.2} s ({cost_ratio:.1}x): {solves} Newton solves ({controlled} poses under load control inside the Newton iteration), {newton} Newton iterations, {factorisations} factorisations, {trials} load-control trials"
     );
     println!(
-        "{{\"problem\":\"knee2d_nonlinear\",\"poses\":{},\"peak_pressure_linear_mpa\":{:.4},\"peak_pressure_neo_hookean_mpa\":{:.4},\"min_peak_ratio\":{min_ratio:.4},\"max_peak_ratio\":{max_ratio:.4},\"max_balance_error\":{balance:.3e},\"max_kkt\":{kkt:.3e},\"max_gap_error_per_h\":{gap:.3e},\"h_mm\":{h:.4},\"max_penetration_mm\":{penetration:.3e},\"newton_solves\":{solves},\"load_controlled_poses\":{controlled},\"newton_iterations\":{newton},\"factorisations\":{factorisations},\"linear_s\":{linear_s:.3},\"nonlinear_s\":{nonlinear_s:.3},\"cost_ratio\":{cost_ratio:.2}}}",
+        "{{\"problem\":\"knee2d_nonlinear\",\"poses\":{},\"peak_pressure_linear_mpa\":{:.4},\"peak_pressure_neo_hookean_mpa\":{:.4},\"min_peak_ratio\":{min_ratio:.4},\"max_peak_ratio\":{max_ratio:.4},\"max_balance_error\":{balance:.3e},\"max_kkt\":{kkt:.3e},\"max_gap_error_per_h\":{gap:.3e},\"h_mm\":{h:.4},\"max_penetration_mm\":{penetration:.3e},\"newton_solves\":{solves},\"load_controlled_poses\":{controlled},\"newton_iterations\":{newton},\"factorisations\":{factorisations},\"load_control_trials\":{trials},\"linear_s\":{linear_s:.3},\"nonlinear_s\":{nonlinear_s:.3},\"cost_ratio\":{cost_ratio:.2}}}",
         times.len(),
         peak(&mut linear.iter().map(|s| s.peak_pressure)),
         peak(&mut nonlinear.iter().map(|h| h.step.peak_pressure)),

@@ -123,5 +123,9 @@ fn carried_state_and_load_control_give_the_same_poses() {
     // the first pose ramps with the secant iteration; every later one under load control, one solve
     assert!(!controlled[0].load_controlled && space.iter().all(|h| !h.load_controlled));
     assert!(controlled[1..].iter().all(|h| h.load_controlled && h.step.solves == 1));
+    // every Newton iteration under load control takes at least one trial of the approach; the
+    // poses without it none
+    assert!(controlled[1..].iter().all(|h| h.load_control_trials >= h.step.solver_iterations));
+    assert!(controlled[0].load_control_trials == 0 && space.iter().all(|h| h.load_control_trials == 0));
     assert!(newton(&controlled) < newton(&space));
 }

@@ -667,6 +667,10 @@ pub struct NonlinearKneeStep {
     /// The pose was solved under load control inside the Newton iteration
     /// ([`nonlinear_cycle_with`]); `false`: by the secant iteration on `δ`.
     pub load_controlled: bool,
+    /// Contact solves of the load control's secant iterations on `δ` over the pose (the
+    /// trials of [`synovia::nonlinear::LoadControl::trials`], at least one per Newton
+    /// iteration; 0 for a pose solved by the secant iteration around whole Newton solves).
+    pub load_control_trials: usize,
 }
 
 impl Knee2d {
@@ -874,6 +878,7 @@ pub fn nonlinear_cycle_with(
         // chosen per iteration on the linearised problem); the secant iteration on δ around
         // whole Newton solves when it fails, and for the first pose
         let mut controlled = None;
+        let mut trials = 0;
         if let (true, Some((slope, f_last))) = (control, last_slope) {
             let resultant = |g: &ContactGeometry<2>, l: &[Real]| traction_resultant(g, l)[1].abs();
             let mut ctl = synovia::nonlinear::LoadControl {
@@ -881,6 +886,7 @@ pub fn nonlinear_cycle_with(
                 target,
                 tolerance,
                 slope: slope * (target / f_last).cbrt(),
+                trials: 0,
             };
             // on failure the state is unchanged: the secant iteration below
             if let Ok(r) = nl.step_controlled(&model, d0, solver, &mut ctl) {
@@ -888,6 +894,7 @@ pub fn nonlinear_cycle_with(
                 extra.1 += r.report.total_iterations;
                 extra.2 += r.report.factorisations;
                 last_slope = Some((ctl.slope, target));
+                trials = ctl.trials;
                 controlled = Some((r.time, r));
             }
         }
@@ -999,6 +1006,7 @@ pub fn nonlinear_cycle_with(
             penetration: penetration.max(0.0),
             mesh_size,
             load_controlled: was_controlled,
+            load_control_trials: trials,
         });
     }
     Ok(steps)

@@ -128,7 +128,8 @@ fn a_strategy_the_solver_cannot_run_is_refused() {
     // the Combined strategy under load control
     nl.step_to(&model, 1.0, &Pdas::default()).expect("level");
     let resultant = |_: &synovia_contact::operators::ContactGeometry<2>, l: &[f64]| l.iter().sum::<f64>();
-    let mut control = LoadControl { resultant: &resultant, target: 1.0, tolerance: 1e-6, slope: 1.0 };
+    let mut control =
+        LoadControl { resultant: &resultant, target: 1.0, tolerance: 1e-6, slope: 1.0, trials: 0 };
     let err = nl.step_controlled(&model, 1.1, &Pdas::default(), &mut control).expect_err("refused");
     assert!(matches!(err, NonlinearError::InvalidParameter(ref m) if m.contains("load control")), "{err}");
 }
