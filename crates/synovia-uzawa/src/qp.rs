@@ -209,7 +209,9 @@ pub enum Expansion {
     /// From `x^{½}`, the preconditioned free gradient `z = M_F⁻¹ φ` with the step `α_z = φᵀz /
     /// zᵀHz` that minimises `q` along `−z`, projected: `x ← P_Ω(x^{½} − α_z z)`, kept if `q`
     /// does not exceed `q(x^{½})`, else the fixed step (two products with `H` and one
-    /// application of the preconditioner per step).
+    /// application of the preconditioner per step). Without preconditioning in face
+    /// (`precondition = false`, or a Hessian with neither a preconditioner nor a diagonal)
+    /// `z = φ`: the free gradient with its optimal length.
     Preconditioned,
 }
 
