@@ -773,6 +773,29 @@ impl<const D: usize> ContactGeometry<D> {
         (entries, lift)
     }
 
+    /// One row per contact node on every free dof of the node, its partner and its master
+    /// nodes (value 1): the dofs its normal and tangential rows can use whatever their
+    /// directions (a row drops the dofs its direction has no component along).
+    pub(crate) fn node_dof_rows(&self, dofs: &DofMap<D>) -> SparseRows {
+        let mut rows = SparseRows::new(dofs.n_dofs());
+        for node in &self.nodes {
+            let mut entries = Vec::with_capacity(2 * D);
+            let mut add = |body: BodyId, i: usize| {
+                let g = &dofs.groups()[dofs.group_of(body, i)];
+                entries.extend((0..g.n_dofs).map(|k| (g.first_dof + k, 1.0)));
+            };
+            add(node.node.0, node.node.1);
+            if let Some((b, j)) = node.partner {
+                add(b, j);
+            }
+            for &(b, j, _) in &node.master {
+                add(b, j);
+            }
+            rows.push_row(entries);
+        }
+        rows
+    }
+
     /// `B_hn`, `κ` and the reduced gaps `d − [u_p]_n` for the lifts `u_p` of prescribed
     /// displacements at the current time.
     pub fn normal_constraints(&self, dofs: &DofMap<D>, lifts: &[Vector<D>]) -> NormalConstraints {

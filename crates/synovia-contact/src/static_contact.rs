@@ -720,7 +720,13 @@ impl<const D: usize> StaticContact<D> {
             let band = self.screening_band?;
             let near: Vec<bool> = problem.normal.gap.iter().map(|&d| d <= band).collect();
             (!near.iter().all(|&b| b)).then(|| {
-                // the sub-problems draw on the unit solves of all candidate rows
+                // the sub-problems draw on the unit solves of all candidate rows: reserved on
+                // every dof of their nodes (a row whose normal gains a component later would
+                // otherwise grow the support and empty the kept solves)
+                let nodes = self.geometry.node_dof_rows(self.elastic.dofs());
+                problem
+                    .operator
+                    .reserve_interface(synovia_linalg::RowStack::new(&nodes, None), context.row_solves());
                 problem.operator.reserve_interface(problem.rows(), context.row_solves());
                 near
             })
