@@ -145,3 +145,39 @@ fn solver_keys_of_the_other_kind_are_refused() {
     let e = refused(&replace(&example(), "subdomains = 8", "subdomains = 0"));
     assert!(e.contains("solver.subdomains"), "{e}");
 }
+
+/// `coarse = "projector"` with the longer expansion steps (`examples/scenarios/
+/// hertz2d_tfeti_projector.toml`) gives the direct solver's displacements and forces to 1e-6,
+/// frictionless and with friction; unknown values are refused at their key.
+#[test]
+fn projector_and_longer_expansion_equal_the_direct_solver() {
+    let projector =
+        std::fs::read_to_string(workspace().join("examples/scenarios/hertz2d_tfeti_projector.toml")).unwrap();
+    assert!(
+        projector.contains("coarse = \"projector\"") && projector.contains("expansion = \"preconditioned\"")
+    );
+    for expansion in ["preconditioned", "projected_cg", "fixed"] {
+        for (case, friction) in [("frictionless", "0.0"), ("friction", "0.3")] {
+            let text = replace(&projector, "friction = 0.3", &format!("friction = {friction}"));
+            let text =
+                replace(&text, "expansion = \"preconditioned\"", &format!("expansion = \"{expansion}\""));
+            let dir = tmp(&format!("projector-{expansion}-{case}"));
+            let feti = run_into(&text, &dir.join("tfeti"));
+            run_into(&direct(&text), &dir.join("direct"));
+            assert!(feti.steps.iter().all(|s| s.solver == "tfeti" && s.kkt < 1e-8), "{:?}", feti.steps);
+            let c = compare(&dir.join("direct"), &dir.join("tfeti")).unwrap();
+            println!("projector, {expansion}, {case}: {:?}", c.differences);
+            assert_eq!((c.steps, c.files), (3, 3));
+            assert!(c.max() <= 1e-6, "{expansion}, {case}: {:?}", c.differences);
+        }
+    }
+    for (key, from, to) in [
+        ("solver.coarse", "coarse = \"projector\"", "coarse = \"schur\""),
+        ("solver.expansion", "expansion = \"preconditioned\"", "expansion = \"long\""),
+    ] {
+        let e = refused(&replace(&projector, from, to));
+        assert!(e.contains(key), "{e}");
+    }
+    let e = refused(&replace(&projector, "[solver]\nname = \"tfeti\"", "[solver]\nname = \"pdas\""));
+    assert!(e.contains("keys of `tfeti`"), "{e}");
+}

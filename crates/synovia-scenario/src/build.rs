@@ -12,7 +12,9 @@ use synovia::builder::{Analysis, BodyMaterial, JointError, JointModel, TfetiSett
 use synovia::contact_ops::operators::{ContactPair, CylinderObstacle, PlaneObstacle, SphereObstacle};
 use synovia::contact_ops::{ContactParams, ExponentialFriction};
 use synovia::fem::{ComponentMask, ElasticParams, FemError, OrderingChoice};
-use synovia::feti::{DecompositionParams, Partitioner, Preconditioner, TfetiParams};
+use synovia::feti::{
+    CoarseConstraint, DecompositionParams, Expansion, Partitioner, Preconditioner, TfetiParams,
+};
 use synovia::io::gmsh::GmshMesh;
 use synovia::io::Encoding;
 use synovia::material::{
@@ -1692,12 +1694,12 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
         "nested_iteration" => nested_iteration, "ordering" => ordering, "load_degree" => load_degree,
         "memory_limit_mb" => memory_limit_mb, "interface_block_dofs" => interface_block_dofs,
         "screening_band" => screening_band, "subdomains" => subdomains, "partitioner" => partitioner,
-        "preconditioner" => preconditioner, "rho" => rho,
+        "preconditioner" => preconditioner, "rho" => rho, "coarse" => coarse, "expansion" => expansion,
     );
     if s.name.as_ref().is_some_and(|n| n.get_ref() == TFETI) {
         return tfeti_solver(cx, joint, s, &present);
     }
-    let tfeti_keys = ["subdomains", "partitioner", "preconditioner", "rho"];
+    let tfeti_keys = ["subdomains", "partitioner", "preconditioner", "rho", "coarse", "expansion"];
     let direct: Vec<&str> = present.iter().map(|(n, _)| *n).filter(|n| !tfeti_keys.contains(n)).collect();
     let name = s.name.as_ref().map_or(synovia::solvers::DEFAULT_SOLVER, |n| n.get_ref().as_str());
     cx.only(k, &present, &direct, &format!("solver `{name}`; they are keys of `{TFETI}`"))?;
@@ -1764,8 +1766,17 @@ fn tfeti_solver<const D: usize>(
     present: &[(&str, Option<std::ops::Range<usize>>)],
 ) -> R<()> {
     let k = "solver";
-    let ok =
-        ["tolerance", "max_iterations", "load_degree", "subdomains", "partitioner", "preconditioner", "rho"];
+    let ok = [
+        "tolerance",
+        "max_iterations",
+        "load_degree",
+        "subdomains",
+        "partitioner",
+        "preconditioner",
+        "rho",
+        "coarse",
+        "expansion",
+    ];
     cx.only(k, present, &ok, &format!("solver `{TFETI}`"))?;
     let mut decomposition = DecompositionParams::default();
     let mut params = TfetiParams::default();
@@ -1795,6 +1806,33 @@ fn tfeti_solver<const D: usize>(
                     "solver.preconditioner",
                     p.span(),
                     format!("preconditioner is `dirichlet`, `lumped` or `none`, got `{other}`"),
+                ))
+            }
+        });
+    }
+    if let Some(c) = &s.coarse {
+        params = params.with_coarse(match c.get_ref().as_str() {
+            "penalty" => CoarseConstraint::Penalty,
+            "projector" => CoarseConstraint::Projector,
+            other => {
+                return Err(cx.err(
+                    "solver.coarse",
+                    c.span(),
+                    format!("coarse is `penalty` (SMALBE) or `projector`, got `{other}`"),
+                ))
+            }
+        });
+    }
+    if let Some(e) = &s.expansion {
+        params = params.with_expansion(match e.get_ref().as_str() {
+            "fixed" => Expansion::Fixed,
+            "projected_cg" => Expansion::ProjectedCg,
+            "preconditioned" => Expansion::Preconditioned,
+            other => {
+                return Err(cx.err(
+                    "solver.expansion",
+                    e.span(),
+                    format!("expansion is `fixed`, `projected_cg` or `preconditioned`, got `{other}`"),
                 ))
             }
         });

@@ -643,6 +643,12 @@ pub struct SolverSpec {
     pub preconditioner: Option<Sp<String>>,
     /// `tfeti`: the penalty `ρ` of SMALBE as a multiple of `‖PFP‖` (default 1).
     pub rho: Option<Sp<f64>>,
+    /// `tfeti`: how the coarse condition `Gλ = e` is met: `penalty` (SMALBE, default) or
+    /// `projector` (the oblique projector along the equality rows, one bound-constrained run).
+    pub coarse: Option<Sp<String>>,
+    /// `tfeti`: the expansion step of MPRGP/MPGP: `fixed` (default), `projected_cg` or
+    /// `preconditioned`.
+    pub expansion: Option<Sp<String>>,
 }
 
 /// The analysis (flat table; `type` says which keys apply).
