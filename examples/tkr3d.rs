@@ -25,12 +25,14 @@
 //! cargo run --release --example tkr3d -- --neo-hookean --poses 0,13,25,50  # linear vs neo-Hookean insert
 //! ```
 //!
-//! `--neo-hookean` runs the poses twice in one process, frictionless: the linear insert (the
-//! main job's model, each pose a static solve of the re-solve session) and the compressible
-//! neo-Hookean insert in finite strain with the same `E`, `ν` (`InsertLaw::NeoHookean`, the
-//! poses as quasi-static levels of the Newton iteration), and prints both per pose, the peak
-//! pressures compared and the cost ratio in its JSON line (docs/tkr3d.md, "Neo-Hookean
-//! insert"); it writes no files.
+//! `--neo-hookean` runs the poses twice in one process with the model's friction (μ = 0.04;
+//! `--friction 0`: frictionless): the linear insert (the main job's model and solves, the
+//! re-solve session: with friction the first pose a static solve and the others quasi-static
+//! steps, frictionless every pose a static solve) and the compressible neo-Hookean insert in
+//! finite strain with the same `E`, `ν` (`InsertLaw::NeoHookean`, the poses as quasi-static
+//! levels of the Newton iteration, Coulomb frozen to Tresca per level as the linear steps),
+//! and prints both per pose, the peak pressures compared and the cost ratio in its JSON line
+//! (docs/tkr3d.md, "Neo-Hookean insert"); it writes no files.
 
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -159,10 +161,6 @@ fn main() -> Result<(), Error> {
         return Err("--poses takes increasing percentages of the cycle in 0..=100, e.g. 13,50".into());
     }
     if std::env::args().any(|a| a == "--neo-hookean") {
-        if std::env::args().any(|a| a == "--friction") && model.friction > 0.0 {
-            return Err("--neo-hookean runs frictionless (friction against the moving femur is not in the nonlinear path yet); drop --friction".into());
-        }
-        model.friction = 0.0;
         return compare_neo_hookean(&model, &percents, start);
     }
     let joint = model.joint_model()?;
@@ -284,6 +282,7 @@ struct Figures {
     peak: f64,
     medial_peak: f64,
     lateral_peak: f64,
+    friction_force: f64,
 }
 
 impl Figures {
@@ -300,13 +299,16 @@ impl Figures {
             peak: pair.peak_pressure,
             medial_peak: side("medial"),
             lateral_peak: side("lateral"),
+            friction_force: pair.tangential_force,
         })
     }
 }
 
-/// `--neo-hookean`: the poses with the linear insert (re-solve session, static solves) and
-/// with the neo-Hookean insert in finite strain (quasi-static levels of the Newton iteration),
-/// frictionless, in one process; the per-pose figures side by side and one JSON line.
+/// `--neo-hookean`: the poses with the linear insert (re-solve session as the main job: with
+/// friction a static solve at the first pose and quasi-static steps after it, frictionless
+/// static solves) and with the neo-Hookean insert in finite strain (quasi-static levels of the
+/// Newton iteration, the same friction frozen per level), in one process; the per-pose figures
+/// side by side and one JSON line.
 fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Result<(), Error> {
     let times: Vec<f64> = percents.iter().map(|&p| f64::from(p) / 100.0).collect();
     // linear: the main job's model and solves
@@ -315,8 +317,9 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     let mut session = linear_joint.prepare()?;
     let dofs = session.elastic_info().n_dofs;
     let mut linear = Vec::with_capacity(times.len());
-    for &t in &times {
-        let report = session.solve_static(t)?;
+    for (i, &t) in times.iter().enumerate() {
+        let report =
+            if model.friction > 0.0 && i > 0 { session.step(t)? } else { session.solve_static(t)? };
         linear.push(Figures::of(session.record().ok_or("no record")?, report.kkt)?);
     }
     let linear_s = t_linear.elapsed().as_secs_f64();
@@ -353,12 +356,12 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         Ok(())
     })?;
     let nonlinear_s = t_nonlinear.elapsed().as_secs_f64();
-    println!("| cycle % | SI lin / NH (mm) | force (N) | area lin / NH (mm²) | peak p lin / NH (MPa) | Δ peak | medial peak lin / NH | lateral peak lin / NH | balance NH | KKT NH | Newton it. | solves | s |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| cycle % | SI lin / NH (mm) | force (N) | area lin / NH (mm²) | peak p lin / NH (MPa) | Δ peak | medial peak lin / NH | lateral peak lin / NH | friction lin / NH (N) | balance NH | KKT NH | Newton it. | solves | s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let rel = |a: f64, b: f64| if a > 0.0 { (b - a) / a } else { 0.0 };
     for (((p, l), n), (it, solves, s)) in percents.iter().zip(&linear).zip(&nonlinear).zip(&newton_steps) {
         println!(
-            "| {p} | {:.4} / {:.4} | {:.0} | {:.1} / {:.1} | {:.2} / {:.2} | {:+.1} % | {:.2} / {:.2} | {:.2} / {:.2} | {:.1e} | {:.1e} | {it} | {solves} | {s:.2} |",
+            "| {p} | {:.4} / {:.4} | {:.0} | {:.1} / {:.1} | {:.2} / {:.2} | {:+.1} % | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} | {:.1e} | {:.1e} | {it} | {solves} | {s:.2} |",
             l.si_mm,
             n.si_mm,
             n.force,
@@ -371,6 +374,8 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
             n.medial_peak,
             l.lateral_peak,
             n.lateral_peak,
+            l.friction_force,
+            n.friction_force,
             n.balance,
             n.kkt
         );
@@ -381,13 +386,16 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     let max = |f: &dyn Fn(&Figures) -> f64, v: &[Figures]| v.iter().map(f).fold(0.0, f64::max);
     let changes: Vec<f64> = linear.iter().zip(&nonlinear).map(|(l, n)| rel(l.peak, n.peak)).collect();
     println!(
-        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":0,\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
+        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":{},\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"friction_force_linear_n\":[{}],\"friction_force_neo_hookean_n\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
         model.mesh_file(),
         percents.iter().map(u32::to_string).collect::<Vec<_>>().join(","),
+        model.friction,
         list(&|f| f.peak, &linear),
         list(&|f| f.peak, &nonlinear),
         list(&|f| f.area, &linear),
         list(&|f| f.area, &nonlinear),
+        list(&|f| f.friction_force, &linear),
+        list(&|f| f.friction_force, &nonlinear),
         changes.iter().copied().fold(f64::INFINITY, f64::min),
         changes.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         max(&|f| f.balance, &nonlinear),

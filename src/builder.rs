@@ -1381,8 +1381,9 @@ impl<const D: usize> JointModel<D> {
     }
 
     /// What the nonlinear path (static and quasi-static) does not take of the rigid bodies:
-    /// parts tied to them, and friction against them (the slip relative to a moving partner is
-    /// not measured in the Newton iteration).
+    /// parts tied to them. (Friction against them is taken with one force-controlled
+    /// coordinate, the slip measured relative to the moving partner, docs/model.md (10.5);
+    /// [`crate::rigid`] refuses it when all their coordinates are prescribed.)
     fn check_nonlinear_rigid(&self) -> Result<(), JointError> {
         if !self.rigid_ties.is_empty() {
             return Err(JointError::Invalid(
@@ -1390,19 +1391,6 @@ impl<const D: usize> JointModel<D> {
                  when a part is tied to them (as contact partners they are); prescribe the part's motion or use a linear material"
                     .into(),
             ));
-        }
-        if let Some(pair) = self
-            .pairs
-            .iter()
-            .find(|p| p.friction > 0.0 && self.rigid_pairs.iter().any(|(name, _)| *name == p.name))
-        {
-            return Err(JointError::Unsupported {
-                solver: "nonlinear (Newton)".into(),
-                feature: format!(
-                    "friction against a rigid body with mixed control (pair `{}`, coefficient {}) with nonlinear materials or finite strain; set the pair's friction to 0",
-                    pair.name, pair.friction
-                ),
-            });
         }
         Ok(())
     }

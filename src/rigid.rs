@@ -63,7 +63,7 @@ use synovia_time::history::LoadHistory;
 
 use synovia_contact::operators::ContactGeometry;
 use synovia_contact::{ContactSolver, StaticContactResult};
-use synovia_nonlinear::{GapControl, NonlinearContact, NonlinearResult};
+use synovia_nonlinear::{GapControl, GapFriction, NonlinearContact, NonlinearResult};
 use synovia_time::quasistatic::{QuasiStaticStepper, StepperCheckpoint};
 use synovia_time::results::StepRecord;
 
@@ -1068,11 +1068,15 @@ impl RigidDriver {
     /// the gaps followed to first order in `w` from the pose the geometry was built at,
     /// `∂d_r/∂w = σ n_r · v_k(x_r)` (10.4); a solution farther than the geometry tolerance from
     /// that pose is solved again on the geometry rebuilt at it (at most 8 times). One
-    /// force-controlled coordinate, rigid bodies as contact partners, frictionless pairs.
+    /// force-controlled coordinate, rigid bodies as contact partners. Friction (docs/model.md
+    /// (10.5)): Tresca with the slip bounds of the last accepted level, the slip measured from it
+    /// relative to the partners, each posed at the trial's coordinate (`GapFriction`), and the
+    /// friction forces in `Q_k` (`Σ_c g_c κ_r Λ_t,c · T_r v_k(x_r)` added), as the linear path.
+    /// Friction against rigid bodies whose coordinates are all prescribed is refused.
     ///
     /// # Errors
-    /// [`JointError::Unsupported`] for several force-controlled coordinates; the errors of the
-    /// Newton iteration (no convergence, a force-controlled body not resisted).
+    /// [`JointError::Unsupported`] for several force-controlled coordinates, and for friction
+    /// against rigid bodies without one; the errors of the Newton iteration (no convergence, a force-controlled body not resisted).
     pub(crate) fn nonlinear_level<const D: usize>(
         &mut self,
         joint: &JointModel<D>,
@@ -1091,7 +1095,19 @@ impl RigidDriver {
         let length = joint.model_size();
         let params = joint.force_control_params();
         self.set_poses(joint);
+        let owner_of = joint.pair_rigid_owner(nl.geometry());
+        let rigid_friction = nl
+            .geometry()
+            .nodes
+            .iter()
+            .any(|n| n.friction > 0.0 && owner_of.get(n.pair).copied().flatten().is_some());
         let (level, solves) = match unknowns.as_slice() {
+            [] if rigid_friction => {
+                return Err(JointError::Unsupported {
+                    solver: "nonlinear (Newton)".into(),
+                    feature: "friction against rigid bodies whose coordinates are all prescribed, with nonlinear materials or finite strain (one force-controlled coordinate is supported)".into(),
+                })
+            }
             [] => {
                 nl.rebuild_geometry(model)?;
                 (nl.step_to(model, t, solver)?, 1)
@@ -1139,11 +1155,84 @@ impl RigidDriver {
                         .sum();
                     -sigma * generalised
                 };
+                // friction (docs/model.md (10.5)): the motion since the last accepted level of
+                // every rigid partner's material point at the nodes' deformed positions, body
+                // `b` at the trial's `w`, and the friction forces' part of the generalised force
+                let accepted = self.accepted.clone();
+                let all_q = self.q.clone();
+                let motion = |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>], w: Real| -> Vec<Vector<D>> {
+                    let Some(old) = &accepted else { return Vec::new() };
+                    let poses: Vec<(RigidPose<D>, RigidPose<D>)> = bodies
+                        .iter()
+                        .enumerate()
+                        .map(|(bi, body)| {
+                            let new = if bi == b { body.pose_of(&coordinates(sigma * w)) } else { body.pose_of(&all_q[bi]) };
+                            (body.pose_of(&old[bi]), new)
+                        })
+                        .collect();
+                    let owner = joint.pair_rigid_owner(geometry);
+                    geometry
+                        .nodes
+                        .iter()
+                        .enumerate()
+                        .map(|(r, node)| match owner.get(node.pair).copied().flatten() {
+                            Some(ob) => {
+                                // the reference position (in finite strain the geometry's
+                                // `position` is that of the deformed configuration it was
+                                // built on) moved by the last accepted displacement
+                                let x = joint
+                                    .model()
+                                    .body(node.node.0)
+                                    .ok()
+                                    .and_then(|body| body.mesh.nodes().get(node.node.1).copied())
+                                    .unwrap_or(node.position);
+                                let y = x + geometry.jump(r, previous).unwrap_or_else(Vector::<D>::zeros);
+                                let (old, new) = &poses[ob];
+                                new.position(&old.to_body(&y)) - y
+                            }
+                            None => Vector::<D>::zeros(),
+                        })
+                        .collect()
+                };
+                // the force on the body of friction cell c: g_c κ_r Σ_j Λ_t,c,j T_j (the
+                // opposite of the slave side's, synovia_time::results::pair_records)
+                let friction_resultant =
+                    |geometry: &ContactGeometry<D>, cells: &[usize], bounds: &[Real], lambda_t: &[Real]| -> Real {
+                        let q = coordinates(current.get());
+                        let comps = D - 1;
+                        let generalised: Real = cells
+                            .iter()
+                            .zip(bounds)
+                            .enumerate()
+                            .filter_map(|(c, (&r, &g))| {
+                                let node = geometry.nodes.get(r).filter(|node| owned(node.pair))?;
+                                let lt = lambda_t.get(c * comps..(c + 1) * comps)?;
+                                let v = body.velocity(&q, k, &node.position);
+                                Some(
+                                    node.tangents
+                                        .iter()
+                                        .zip(lt)
+                                        .map(|(t, l)| g * node.weight * l * t.dot(&v))
+                                        .sum::<Real>(),
+                                )
+                            })
+                            .sum();
+                        -sigma * generalised
+                    };
+                let friction = rigid_friction
+                    .then_some(GapFriction { motion: &motion, resultant: &friction_resultant });
+                // each pass commits its solution: with friction the next pass starts again from
+                // the last accepted level (the slip origin and the frozen slip bounds are that
+                // level's, not the previous pass's)
+                let start = rigid_friction.then(|| nl.checkpoint());
                 let mut w = sigma * q0[k];
                 let mut trials = 0;
                 let mut passes = 0;
                 let mut iterations = 0;
                 let level = loop {
+                    if let (Some(c), true) = (&start, passes > 0) {
+                        nl.restore(c.clone())?;
+                    }
                     let mut control = GapControl {
                         pose: &pose,
                         sensitivity: &sensitivity,
@@ -1156,6 +1245,7 @@ impl RigidDriver {
                         max_step: 1e-2 * length,
                         base: w,
                         trials: 0,
+                        friction,
                     };
                     let mut level = nl.step_gap_controlled(model, t, solver, &mut control)?;
                     trials += control.trials;

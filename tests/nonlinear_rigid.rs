@@ -7,7 +7,12 @@
 //!   gives the linear path's solution (rigid coordinates, displacements, pressures) to 1e-8;
 //! * a neo-Hookean block (finite strain) at a small load equals the linear one to 1 %;
 //! * the contact resultant equals the applied force (balance) and the KKT residual of the
-//!   contact solution is small.
+//!   contact solution is small;
+//! * with Tresca friction against the moving indenter (Coulomb frozen per level), the linear law
+//!   through the Newton path equals the linear path (travel, reactions, displacements, normal
+//!   and tangential multipliers), the Tresca conditions hold with the slip measured relative to
+//!   the indenter, and the force-controlled coordinate balances the applied force including
+//!   the friction forces.
 
 use std::sync::Arc;
 
@@ -47,6 +52,11 @@ impl Material<3> for Hidden {
 /// point `c = (0, 0, 3)`; `tx`, `ty` and the three rotations prescribed (small, so the sphere
 /// moves and tilts about a point that is not its centre), `tz` loaded by `−force · t`.
 fn model(material: Arc<dyn Material<3>>, force: f64) -> Result<JointModel<3>, Error> {
+    model_with_friction(material, force, 0.0)
+}
+
+/// [`model`] with the Coulomb coefficient `mu` on the pair with the indenter.
+fn model_with_friction(material: Arc<dyn Material<3>>, force: f64, mu: f64) -> Result<JointModel<3>, Error> {
     let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [12, 12, 6], [Grading::Uniform; 3])?;
     let mut joint = JointModel::<3>::new();
     joint.add_body("block", mesh, material)?;
@@ -61,7 +71,7 @@ fn model(material: Arc<dyn Material<3>>, force: f64) -> Result<JointModel<3>, Er
         .prescribe(5, Constant(0.02))?;
     joint.add_rigid_body(indenter)?;
     let shape = Arc::new(SphereObstacle::new(Point::<3>::new(0.15, -0.1, 1.0 + RADIUS), RADIUS, false)?);
-    joint.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+    joint.contact_rigid_body("indent", "block", "top", "indenter", shape, mu)?;
     // both paths accept a solution whose contact geometry was built within the geometry
     // tolerance of its pose (the rows' normals are those of that pose: first order in the
     // distance): a tight one, so that the two agree to 1e-8 and not to the default 1e-6
@@ -167,20 +177,21 @@ fn neo_hookean_at_a_small_load_equals_linear_and_balances() -> Result<(), Error>
 }
 
 /// What the nonlinear path does not take is refused with a typed error: friction against a
-/// rigid body, and several force-controlled coordinates.
+/// rigid body whose coordinates are all prescribed, and several force-controlled coordinates.
 #[test]
 fn unsupported_rigid_cases_are_refused() -> Result<(), Error> {
-    // friction on the rigid pair
+    // friction on a rigid pair whose coordinates are all prescribed (no force control)
     let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [4, 4, 2], [Grading::Uniform; 3])?;
     let mut with_friction = JointModel::<3>::new();
     with_friction.add_body("block", mesh, Arc::new(neo_hookean(E, NU)?) as Arc<dyn Material<3>>)?;
     with_friction.clamp("block", "bottom")?;
-    let indenter =
-        RigidBody::<3>::new("indenter", Point::<3>::new(0.0, 0.0, 3.0))?.force(2, Constant(-1.0))?;
+    let indenter = RigidBody::<3>::new("indenter", Point::<3>::new(0.0, 0.0, 3.0))?
+        .prescribe(2, FnHistory::new(|t| -0.01 * t))?;
     with_friction.add_rigid_body(indenter)?;
     let shape = Arc::new(SphereObstacle::new(Point::<3>::new(0.0, 0.0, 3.0), RADIUS, false)?);
     with_friction.contact_rigid_body("indent", "block", "top", "indenter", shape.clone(), 0.1)?;
-    let err = with_friction.run_static(1.0).err().ok_or("friction against a rigid body accepted")?;
+    let err =
+        with_friction.run_static(1.0).err().ok_or("friction against a prescribed rigid body accepted")?;
     assert!(matches!(err, JointError::Unsupported { .. }), "{err}");
     assert!(err.to_string().contains("friction"), "{err}");
 
@@ -207,5 +218,127 @@ fn unsupported_rigid_cases_are_refused() -> Result<(), Error> {
     tied.tie_to_rigid_body("block", "top", "plate")?;
     let err = tied.run_static(1.0).err().ok_or("a part tied to a rigid body accepted")?;
     assert!(matches!(err, JointError::Invalid(_)) && err.to_string().contains("tied"), "{err}");
+    Ok(())
+}
+
+/// One level's fields: displacement, `Λ_n`, friction cells with `(node, g, Λ_t)`.
+type Fields = (Vec<Vec<Vector<3>>>, Vec<f64>, Vec<(usize, f64, Vec<f64>)>);
+
+fn fields_of(view: &StepView<'_, 3>) -> Fields {
+    let r = view.result;
+    let cells = r
+        .cell_node
+        .iter()
+        .zip(&r.slip_bound)
+        .enumerate()
+        .map(|(c, (&node, &g))| (node, g, r.solution.lambda_t[2 * c..2 * c + 2].to_vec()))
+        .collect();
+    (r.displacement.clone(), r.solution.lambda_n.clone(), cells)
+}
+
+/// Tresca friction against the moving indenter: the linear law through the Newton path equals
+/// the linear path level by level; the Tresca conditions (`‖Λ_t‖ ≤ 1`, the slip relative to the
+/// indenter zero where it sticks and along `Λ_t` where it slips) and the balance of the
+/// force-controlled coordinate (friction forces included) hold.
+#[test]
+fn friction_against_the_rigid_body_equals_the_linear_path() -> Result<(), Error> {
+    let force = 20.0;
+    let mu = 0.3;
+    let times = [0.4, 0.7, 1.0];
+    let linear = model_with_friction(Arc::new(isotropic(E, NU)?), force, mu)?;
+    let routed = model_with_friction(Arc::new(Hidden(isotropic(E, NU)?)), force, mu)?;
+    assert!(routed.is_nonlinear() && !linear.is_nonlinear());
+    let mut runs = Vec::new();
+    for joint in [&linear, &routed] {
+        let mut fields: Vec<Fields> = Vec::new();
+        let mut checks = Vec::new();
+        let run = joint.run_quasistatic_with(&times, |view| {
+            let f = fields_of(view);
+            // Tresca at the friction cells, the slip relative to the indenter
+            // (`ContactGeometry::slip_origin`: the previous level's jump plus the indenter's
+            // motion since then)
+            let (mut bound, mut stick, mut slip_dir, mut slip_max) = (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
+            let (mut sticking, mut slipping) = (0usize, 0usize);
+            if let Some((previous, _, _)) = fields.last() {
+                for (r, g, lt) in &f.2 {
+                    assert!(*g > 0.0);
+                    let node = &view.geometry.nodes[*r];
+                    let du =
+                        view.geometry.jump(*r, &f.0).ok_or_else(|| JointError::Invalid("jump".into()))?
+                            - view
+                                .geometry
+                                .slip_origin(*r, previous)
+                                .ok_or_else(|| JointError::Invalid("slip origin".into()))?;
+                    let s = [node.tangents[0].dot(&du), node.tangents[1].dot(&du)];
+                    let s_norm = s[0].hypot(s[1]);
+                    let l_norm = lt[0].hypot(lt[1]);
+                    slip_max = slip_max.max(s_norm);
+                    bound = bound.max(l_norm - 1.0);
+                    if l_norm < 1.0 - 1e-6 {
+                        stick = stick.max(s_norm);
+                        sticking += 1;
+                    } else {
+                        slipping += 1;
+                        // slipping: the slip along Λ_t, ‖s‖ − s·Λ_t = 0
+                        slip_dir = slip_dir.max(s_norm - (s[0] * lt[0] + s[1] * lt[1]));
+                    }
+                }
+            }
+            checks.push((bound, stick, slip_dir, slip_max, view.result.kkt.max(), sticking, slipping));
+            fields.push(f);
+            Ok(())
+        })?;
+        runs.push((run, fields, checks));
+    }
+    let ((lin, lin_fields, _), (nl, nl_fields, nl_checks)) = (&runs[0], &runs[1]);
+    let mut tangential = 0.0_f64;
+    for (level, (a, b)) in lin.records.iter().zip(&nl.records).enumerate() {
+        let (ra, rb) = (&a.rigid[0], &b.rigid[0]);
+        let travel = (ra.dofs[2] - rb.dofs[2]).abs() / ra.dofs[2].abs();
+        assert!(travel < 1e-8, "level {level}: tz {} vs {} ({travel:e})", ra.dofs[2], rb.dofs[2]);
+        for k in 0..6 {
+            let d = (ra.reaction[k] - rb.reaction[k]).abs() / force;
+            assert!(d < 1e-8, "level {level}: reaction {k}: {:?} vs {:?}", ra.reaction, rb.reaction);
+        }
+        let (ua, la, ca) = &lin_fields[level];
+        let (ub, lb, cb) = &nl_fields[level];
+        let du = max_diff(ua, ub) / max_abs(ua);
+        assert!(du < 1e-8, "level {level}: displacements differ by {du:e}");
+        let lmax = la.iter().copied().fold(0.0, f64::max);
+        let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
+        assert!(dl < 1e-8, "level {level}: pressures differ by {dl:e}");
+        // the same friction cells, slip bounds and tangential multipliers
+        assert_eq!(ca.len(), cb.len(), "level {level}: friction cells");
+        let mut dt = 0.0_f64;
+        for ((na, ga, lta), (nb, gb, ltb)) in ca.iter().zip(cb) {
+            assert_eq!(na, nb, "level {level}");
+            assert!((ga - gb).abs() <= 1e-8 * mu * lmax, "level {level}: g {ga} vs {gb}");
+            dt = dt.max((ga * lta[0] - gb * ltb[0]).abs()).max((ga * lta[1] - gb * ltb[1]).abs());
+        }
+        let dt = dt / (mu * lmax);
+        assert!(dt < 1e-8, "level {level}: friction tractions differ by {dt:e}");
+        let (ta, tb) = (a.pairs[0].tangential_force, b.pairs[0].tangential_force);
+        let dft = (ta - tb).abs() / force;
+        assert!(dft < 1e-8, "level {level}: tangential force {ta} vs {tb}");
+        tangential = tangential.max(tb);
+        // Tresca and KKT of the Newton path's solution
+        let (bound, stick, slip_dir, slip_max, kkt, sticking, slipping) = nl_checks[level];
+        assert!(bound <= 1e-10, "level {level}: ‖Λ_t‖ − 1 = {bound:e}");
+        assert!(stick <= 1e-9 * max_abs(ub), "level {level}: slip {stick:e} at a sticking cell");
+        assert!(slip_dir <= 1e-9 * max_abs(ub), "level {level}: slip not along Λ_t ({slip_dir:e})");
+        assert!(kkt < 1e-8, "level {level}: KKT {kkt:e}");
+        // the force-controlled coordinate balances the applied force, friction included
+        let applied = force * b.time;
+        assert!(rb.balance_error < 1e-9, "level {level}: {rb:?}");
+        assert!((rb.reaction[2] - applied).abs() < 1e-9 * force, "level {level}: {rb:?}");
+        assert!((b.pairs[0].force[2] + applied).abs() < 1e-9 * force, "level {level}: {:?}", b.pairs[0]);
+        eprintln!(
+            "friction level {level}: travel {travel:.1e}, displacements {du:.1e}, pressures {dl:.1e}, friction tractions {dt:.1e}, tangential force {tb:.4} N ({dft:.1e}); Tresca: ‖Λ_t‖−1 {bound:.1e}, stick slip {stick:.1e}, slip direction {slip_dir:.1e}, slip max {slip_max:.1e} ({sticking} cells sticking, {slipping} slipping), KKT {kkt:.1e}, balance {:.1e}",
+            rb.balance_error
+        );
+    }
+    // friction acted (the tangential forces are not zero) and some cells slipped
+    assert!(tangential > 1e-3 * force, "tangential force {tangential}");
+    assert!(nl_checks.iter().any(|c| c.3 > 0.0));
     Ok(())
 }

@@ -127,8 +127,9 @@ pub enum InsertLaw {
     /// finite strain (docs/model.md §12), with the Lamé constants of the same `E`, `ν`:
     /// `μ = E / (2(1 + ν))`, `λ = E ν / ((1 + ν)(1 − 2ν))` (so linear elasticity at `e = 0`;
     /// UHMWPE: μ = 158.6 MPa, λ = 1 824 MPa). Solved by the Newton iteration of
-    /// `synovia-nonlinear`, the superior–inferior force found inside it; frictionless only
-    /// (`friction = 0`), with the other five coordinates prescribed (docs/tkr3d.md).
+    /// `synovia-nonlinear`, the superior–inferior force found inside it, with the other five
+    /// coordinates prescribed; friction as the linear insert's (Coulomb frozen to Tresca per
+    /// pose, the slip relative to the femur) or none with `friction = 0` (docs/tkr3d.md).
     NeoHookean,
 }
 

@@ -435,6 +435,31 @@ pub struct GapControl<'a, const D: usize> {
     pub base: Real,
     /// Out: contact solves (trials) of the search for `w`.
     pub trials: usize,
+    /// Tresca friction against the moving partner (`None`: frictionless pairs only).
+    pub friction: Option<GapFriction<'a, D>>,
+}
+
+/// Tresca friction against the partner of a [`GapControl`] (docs/model.md (10.5)): the slip
+/// bounds `g_c = F_c |Λ_n|` of the committed state, the slip measured from it relative to the
+/// partner, `[v_t] − ([u_t(t_{i−1})] + w_{r,t})`, with the partner's motion `w_r(w)` since the
+/// committed state at the trial's `w`, and the friction forces' part of the resultant.
+#[derive(Clone, Copy)]
+#[allow(clippy::type_complexity)]
+pub struct GapFriction<'a, const D: usize> {
+    /// `w_r(w)` per contact node of the geometry, at the nodes' positions `y_r = x_r + [u](x_r)`
+    /// of the committed displacement (the slice), for the partner at `w`
+    /// ([`ContactGeometry::set_partner_motion`]).
+    pub motion: &'a dyn Fn(&ContactGeometry<D>, &[Vec<Vector<D>>], Real) -> Vec<Vector<D>>,
+    /// The friction forces' part of the resultant, `R_t(geometry, cell_node, g, Λ_t)` over the
+    /// friction cells `c` (contact node `cell_node[c]`, slip bound `g[c]`, `Λ_t` of `D − 1`
+    /// components per cell); `R = resultant(Λ_n) + R_t`.
+    pub resultant: &'a dyn Fn(&ContactGeometry<D>, &[usize], &[Real], &[Real]) -> Real,
+}
+
+impl<const D: usize> std::fmt::Debug for GapFriction<'_, D> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GapFriction").finish_non_exhaustive()
+    }
 }
 
 impl<const D: usize> std::fmt::Debug for GapControl<'_, D> {
@@ -447,6 +472,7 @@ impl<const D: usize> std::fmt::Debug for GapControl<'_, D> {
             .field("overlap", &self.overlap)
             .field("max_step", &self.max_step)
             .field("base", &self.base)
+            .field("friction", &self.friction.is_some())
             .finish_non_exhaustive()
     }
 }
@@ -860,7 +886,10 @@ impl<const D: usize> NonlinearContact<D> {
     /// The search for `w` of one Newton iteration under [`GapControl`] (see
     /// [`Self::step_gap_controlled`]): trials on the linearised problem with the load `load`,
     /// the gaps of `gaps` at each trial's `w`; returns the `w` found and its multipliers (the
-    /// contact geometry's gaps left at that `w`).
+    /// contact geometry's gaps left at that `w`). With friction (`g.friction`, the committed
+    /// state's `slip_bound` and displacement `previous`) each trial sets the partner's motion
+    /// at its `w` (left set for the accepted one) and adds the friction forces to `R`.
+    #[allow(clippy::too_many_arguments)]
     fn search_gap_control(
         &mut self,
         g: &mut GapControl<'_, D>,
@@ -869,8 +898,19 @@ impl<const D: usize> NonlinearContact<D> {
         lifts: &[Vector<D>],
         solver: &dyn ContactSolver,
         warm: Option<&ContactSolution>,
+        slip_bound: Option<&[Real]>,
+        previous: Option<&[Vec<Vector<D>>]>,
     ) -> Result<(Real, ContactSolution), NonlinearError> {
         let rows = self.contact.geometry().len();
+        // friction against the partner: the cells of the slip bounds (nodes with g_c > 0)
+        let friction = match (g.friction, slip_bound.filter(|b| b.len() == rows), previous) {
+            (Some(f), Some(bound), Some(prev)) => {
+                let (cells, bounds): (Vec<usize>, Vec<Real>) =
+                    bound.iter().enumerate().filter(|(_, v)| **v > 0.0).map(|(r, v)| (r, *v)).unzip();
+                Some((f, bound, prev, cells, bounds))
+            }
+            _ => None,
+        };
         let inner = 0.1 * g.tolerance;
         let fail = |w: Real, reason: String| NonlinearError::NoConvergence {
             time: w,
@@ -887,10 +927,33 @@ impl<const D: usize> NonlinearContact<D> {
         let mut overlap = 0.5 * g.overlap.abs();
         for _ in 0..60 {
             self.contact.set_gaps(&gaps.at(w))?;
-            let (solution, _) =
-                self.contact.solve_load_multipliers(load, lifts, solver, None, None, warm_trial.as_ref())?;
+            let (solution, _) = match &friction {
+                Some((f, bound, prev, _, _)) => {
+                    let motion = (f.motion)(self.contact.geometry(), prev, w);
+                    self.contact.set_partner_motion(motion)?;
+                    self.contact.solve_load_multipliers(
+                        load,
+                        lifts,
+                        solver,
+                        Some(bound),
+                        Some(prev),
+                        warm_trial.as_ref(),
+                    )?
+                }
+                None => self.contact.solve_load_multipliers(
+                    load,
+                    lifts,
+                    solver,
+                    None,
+                    None,
+                    warm_trial.as_ref(),
+                )?,
+            };
             g.trials += 1;
-            let r = (g.resultant)(self.contact.geometry(), &solution.lambda_n);
+            let mut r = (g.resultant)(self.contact.geometry(), &solution.lambda_n);
+            if let Some((f, _, _, cells, bounds)) = &friction {
+                r += (f.resultant)(self.contact.geometry(), cells, bounds, &solution.lambda_t);
+            }
             tracing::debug!(w, r, target = g.target, slope = g.slope, "gap-control trial");
             if !r.is_finite() {
                 return Err(fail(w, format!("gap control: resultant {r} at w = {w}")));
@@ -1119,13 +1182,16 @@ impl<const D: usize> NonlinearContact<D> {
     /// at the pose `w` at the start of the level (and, in finite strain, on the deformed
     /// configuration between passes); `control.base` tells where. At convergence the
     /// equilibrium residual is at the Newton tolerance and `|R − target| ≤ tolerance / 10`.
-    /// Frictionless (the slip of friction against a moving partner is not measured here):
-    /// pairs with a friction coefficient are refused. No cut-back; on failure the committed
-    /// state is unchanged.
+    /// Friction (`control.friction`): Tresca with the slip bounds `g_c = F_c |Λ_n|` of the
+    /// committed state (the first level from the reference configuration is frictionless, as
+    /// [`Self::step_to`]), the slip measured from the committed state relative to the partner
+    /// posed at each trial's `w` (docs/model.md (10.5)), and the friction forces in `R`; pairs
+    /// with a friction coefficient and no `control.friction` are refused. No cut-back; on
+    /// failure the committed state is unchanged.
     ///
     /// # Errors
     /// [`NonlinearError::InvalidParameter`] for a non-finite `t`, guess, target or tolerance,
-    /// or a pair with friction; [`NonlinearError::NoConvergence`] when Newton or the search
+    /// or a pair with friction without `control.friction`; [`NonlinearError::NoConvergence`] when Newton or the search
     /// for `w` fails; model and contact errors.
     pub fn step_gap_controlled(
         &mut self,
@@ -1145,10 +1211,9 @@ impl<const D: usize> NonlinearContact<D> {
                 control.w, control.target, control.tolerance
             )));
         }
-        if self.contact.geometry().nodes.iter().any(|n| n.friction > 0.0) {
+        if control.friction.is_none() && self.contact.geometry().nodes.iter().any(|n| n.friction > 0.0) {
             return Err(NonlinearError::InvalidParameter(
-                "gap control is frictionless: the slip against a moving partner is not measured in the nonlinear solve"
-                    .into(),
+                "gap control with friction needs the partner's motion (GapControl::friction)".into(),
             ));
         }
         control.trials = 0;
@@ -1578,8 +1643,13 @@ impl<const D: usize> NonlinearContact<D> {
                     let lift_force: Vec<Real> = (0..n).map(|i| load[i] - before[i]).collect();
                     r_start = r_start.max(norm(&lift_force));
                 }
-                let (w, solution) = self.search_gap_control(g, fo, &load, &lifts, solver, warm.as_ref())?;
-                let res = self.contact.complete_load(&load, &lifts, None, None, solution)?;
+                // friction: the slip bounds and origin of the committed state (the partner's
+                // motion of the accepted trial is left set on the geometry)
+                let frozen = slip_bound.as_deref().filter(|b| g.friction.is_some() && b.len() == rows);
+                let origin = previous_disp.as_deref().filter(|_| frozen.is_some());
+                let (w, solution) =
+                    self.search_gap_control(g, fo, &load, &lifts, solver, warm.as_ref(), frozen, origin)?;
+                let res = self.contact.complete_load(&load, &lifts, frozen, origin, solution)?;
                 predictor = predictor || w != g.w;
                 g.w = w;
                 (load, res)
