@@ -806,11 +806,7 @@ impl RigidDriver {
         let model = joint.model();
         let bodies = joint.rigid_bodies();
         let values = self.set_controls(joint, t)?;
-        let unknowns: Vec<(usize, usize)> = bodies
-            .iter()
-            .enumerate()
-            .flat_map(|(bi, b)| b.force_dofs().into_iter().map(move |k| (bi, k)))
-            .collect();
+        let unknowns = force_unknowns(bodies);
         let posed_pairs = !joint.rigid_pair_bodies().is_empty();
         let checkpoint = (mode == LevelMode::Step).then(|| stepper.checkpoint());
         let cx = LevelContext { joint, t, solver, mode, checkpoint, unknowns: &unknowns };
@@ -1087,11 +1083,7 @@ impl RigidDriver {
         let model = joint.model();
         let bodies = joint.rigid_bodies();
         let values = self.set_controls(joint, t)?;
-        let unknowns: Vec<(usize, usize)> = bodies
-            .iter()
-            .enumerate()
-            .flat_map(|(bi, b)| b.force_dofs().into_iter().map(move |k| (bi, k)))
-            .collect();
+        let unknowns = force_unknowns(bodies);
         let length = joint.model_size();
         let params = joint.force_control_params();
         self.set_poses(joint);
@@ -1672,6 +1664,12 @@ impl RigidDriver {
 
 /// `scale_j`: the largest applied force of the owning body (translations), times the model
 /// size for moments, or the largest applied moment, whichever is larger.
+/// The force-controlled coordinates of the rigid bodies, `(body, dof)`, the unknowns of a
+/// level's force balance (10.3).
+fn force_unknowns<const D: usize>(bodies: &[RigidBody<D>]) -> Vec<(usize, usize)> {
+    bodies.iter().enumerate().flat_map(|(bi, b)| b.force_dofs().into_iter().map(move |k| (bi, k))).collect()
+}
+
 fn force_scales<const D: usize>(
     bodies: &[RigidBody<D>],
     values: &[Vec<Real>],
