@@ -185,6 +185,22 @@ impl Cx<'_> {
         }
     }
 
+    /// The value named by the keyword `v` among `options` (name, value); any other name is an
+    /// error at `k`: "{what} is `a`, `b` or `c`, got `x`".
+    fn keyword<T: Clone>(&self, v: &Sp<String>, k: &str, what: &str, options: &[(&str, T)]) -> R<T> {
+        let name = v.get_ref().as_str();
+        if let Some((_, t)) = options.iter().find(|(n, _)| *n == name) {
+            return Ok(t.clone());
+        }
+        let names: Vec<String> = options.iter().map(|(n, _)| format!("`{n}`")).collect();
+        let list = match names.split_last() {
+            Some((last, [])) => last.clone(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => String::new(),
+        };
+        Err(self.err(k, v.span(), format!("{what} is {list}, got `{name}`")))
+    }
+
     fn at_least(&self, v: &Sp<usize>, k: &str, min: usize) -> R<usize> {
         let x = *v.get_ref();
         if x >= min {
@@ -1733,18 +1749,12 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
     }
     let mut elastic = ElasticParams::default();
     if let Some(o) = &s.ordering {
-        elastic.ordering = match o.get_ref().as_str() {
-            "auto" => OrderingChoice::Auto,
-            "amd" => OrderingChoice::Amd,
-            "metis" => OrderingChoice::Metis,
-            other => {
-                return Err(cx.err(
-                    "solver.ordering",
-                    o.span(),
-                    format!("ordering is `auto`, `amd` or `metis`, got `{other}`"),
-                ))
-            }
-        };
+        elastic.ordering = cx.keyword(
+            o,
+            "solver.ordering",
+            "ordering",
+            &[("auto", OrderingChoice::Auto), ("amd", OrderingChoice::Amd), ("metis", OrderingChoice::Metis)],
+        )?;
     }
     if let Some(d) = &s.load_degree {
         elastic.load_degree = cx.at_least(d, "solver.load_degree", 1)?;
@@ -1784,58 +1794,44 @@ fn tfeti_solver<const D: usize>(
         decomposition = decomposition.with_subdomains(cx.at_least(n, "solver.subdomains", 1)?);
     }
     if let Some(p) = &s.partitioner {
-        decomposition = decomposition.with_partitioner(match p.get_ref().as_str() {
-            "metis" => Partitioner::Metis,
-            "bisection" => Partitioner::Bisection,
-            other => {
-                return Err(cx.err(
-                    "solver.partitioner",
-                    p.span(),
-                    format!("partitioner is `metis` or `bisection`, got `{other}`"),
-                ))
-            }
-        });
+        decomposition = decomposition.with_partitioner(cx.keyword(
+            p,
+            "solver.partitioner",
+            "partitioner",
+            &[("metis", Partitioner::Metis), ("bisection", Partitioner::Bisection)],
+        )?);
     }
     if let Some(p) = &s.preconditioner {
-        params = params.with_preconditioner(match p.get_ref().as_str() {
-            "dirichlet" => Preconditioner::Dirichlet,
-            "lumped" => Preconditioner::Lumped,
-            "none" => Preconditioner::None,
-            other => {
-                return Err(cx.err(
-                    "solver.preconditioner",
-                    p.span(),
-                    format!("preconditioner is `dirichlet`, `lumped` or `none`, got `{other}`"),
-                ))
-            }
-        });
+        params = params.with_preconditioner(cx.keyword(
+            p,
+            "solver.preconditioner",
+            "preconditioner",
+            &[
+                ("dirichlet", Preconditioner::Dirichlet),
+                ("lumped", Preconditioner::Lumped),
+                ("none", Preconditioner::None),
+            ],
+        )?);
     }
     if let Some(c) = &s.coarse {
-        params = params.with_coarse(match c.get_ref().as_str() {
-            "penalty" => CoarseConstraint::Penalty,
-            "projector" => CoarseConstraint::Projector,
-            other => {
-                return Err(cx.err(
-                    "solver.coarse",
-                    c.span(),
-                    format!("coarse is `penalty` (SMALBE) or `projector`, got `{other}`"),
-                ))
-            }
-        });
+        params = params.with_coarse(cx.keyword(
+            c,
+            "solver.coarse",
+            "coarse",
+            &[("penalty", CoarseConstraint::Penalty), ("projector", CoarseConstraint::Projector)],
+        )?);
     }
     if let Some(e) = &s.expansion {
-        params = params.with_expansion(match e.get_ref().as_str() {
-            "fixed" => Expansion::Fixed,
-            "projected_cg" => Expansion::ProjectedCg,
-            "preconditioned" => Expansion::Preconditioned,
-            other => {
-                return Err(cx.err(
-                    "solver.expansion",
-                    e.span(),
-                    format!("expansion is `fixed`, `projected_cg` or `preconditioned`, got `{other}`"),
-                ))
-            }
-        });
+        params = params.with_expansion(cx.keyword(
+            e,
+            "solver.expansion",
+            "expansion",
+            &[
+                ("fixed", Expansion::Fixed),
+                ("projected_cg", Expansion::ProjectedCg),
+                ("preconditioned", Expansion::Preconditioned),
+            ],
+        )?);
     }
     if let Some(t) = &s.tolerance {
         params = params.with_tolerance(cx.positive(t, "solver.tolerance")?);
