@@ -471,3 +471,39 @@ type = "static"
     let text = two("discretisation = \"mortar\"\nsearch_distance = -1.0");
     assert!(error_of(&text).key.contains("search_distance"), "{}", error_of(&text));
 }
+
+/// Keys that take one name among a few (`plane`, `kinematics`, `analysis.mass`,
+/// `output.encoding`): a wrong name is refused at its key with the list of the names taken.
+#[test]
+fn keyword_keys_list_their_names() {
+    let with = |from: &str, to: &str| {
+        assert!(SMALL.contains(from), "{from}");
+        SMALL.replacen(from, to, 1)
+    };
+    assert_error(
+        &with("nu = 0.3 }", "nu = 0.3, plane = \"strian\" }"),
+        "body[0].material.plane",
+        "\"strian\"",
+        "`plane` is `strain` or `stress`, got `strian`",
+    );
+    assert!(checked(&with("nu = 0.3 }", "nu = 0.3, plane = \"stress\" }")).is_ok());
+    assert_error(
+        &with("nu = 0.3 }\n", "nu = 0.3 }\nkinematics = \"large\"\n"),
+        "body[0].kinematics",
+        "\"large\"",
+        "`kinematics` is `small` or `finite`, got `large`",
+    );
+    assert_error(
+        &with("type = \"static\"\n", "type = \"dynamic\"\ndt = 0.1\nsteps = 2\nmass = \"diagonal\"\n"),
+        "analysis.mass",
+        "\"diagonal\"",
+        "mass is `consistent` or `lumped`, got `diagonal`",
+    );
+    assert_error(
+        &format!("{SMALL}[output]\nencoding = \"hdf5\"\n"),
+        "output.encoding",
+        "\"hdf5\"",
+        "encoding is `zlib`, `binary`, `base64` or `ascii`, got `hdf5`",
+    );
+    assert!(checked(&format!("{SMALL}[output]\nencoding = \"base64\"\n")).is_ok());
+}

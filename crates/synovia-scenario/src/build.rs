@@ -501,17 +501,15 @@ fn add_body<'a, const D: usize>(
     }
     if let Some(kin) = &b.kinematics {
         let kk = key(k, "kinematics");
-        let value = match kin.get_ref().as_str() {
-            "small" => synovia::fem::Kinematics::SmallStrain,
-            "finite" => synovia::fem::Kinematics::FiniteStrain,
-            other => {
-                return Err(cx.err(
-                    kk,
-                    kin.span(),
-                    format!("`kinematics` is `small` or `finite`, got `{other}`"),
-                ))
-            }
-        };
+        let value = cx.keyword(
+            kin,
+            &kk,
+            "`kinematics`",
+            &[
+                ("small", synovia::fem::Kinematics::SmallStrain),
+                ("finite", synovia::fem::Kinematics::FiniteStrain),
+            ],
+        )?;
         joint.set_kinematics(id, value).map_err(|e| cx.err(kk, kin.span(), e.to_string()))?;
     }
     if let Some(v) = &b.initial_velocity {
@@ -1050,13 +1048,7 @@ fn material<const D: usize>(
                 if D != 2 {
                     return Err(cx.err(pk, p.span(), "`plane` applies to 2D scenarios only"));
                 }
-                match p.get_ref().as_str() {
-                    "strain" => Ok(false),
-                    "stress" => Ok(true),
-                    other => {
-                        Err(cx.err(pk, p.span(), format!("`plane` is `strain` or `stress`, got `{other}`")))
-                    }
-                }
+                cx.keyword(p, &pk, "`plane`", &[("strain", false), ("stress", true)])
             }
         }
     };
@@ -1979,17 +1971,12 @@ fn quasi_and_dynamic_params<const D: usize>(
         d.t0 = cx.finite(v, "analysis.t0")?;
     }
     if let Some(v) = &s.mass {
-        d.mass = match v.get_ref().as_str() {
-            "consistent" => MassKind::Consistent,
-            "lumped" => MassKind::Lumped,
-            other => {
-                return Err(cx.err(
-                    "analysis.mass",
-                    v.span(),
-                    format!("mass is `consistent` or `lumped`, got `{other}`"),
-                ))
-            }
-        };
+        d.mass = cx.keyword(
+            v,
+            "analysis.mass",
+            "mass",
+            &[("consistent", MassKind::Consistent), ("lumped", MassKind::Lumped)],
+        )?;
     }
     if let Some(v) = &s.coulomb_iterations {
         d.coulomb_iterations = *v.get_ref();
@@ -2018,18 +2005,17 @@ fn output(cx: &Cx<'_>, o: Option<&Sp<OutputSpec>>) -> R<OutputPlan> {
         plan.stress = *v.get_ref();
     }
     if let Some(e) = &s.encoding {
-        plan.encoding = match e.get_ref().as_str() {
-            "zlib" => Encoding::Zlib,
-            "binary" | "base64" => Encoding::Base64,
-            "ascii" => Encoding::Ascii,
-            other => {
-                return Err(cx.err(
-                    "output.encoding",
-                    e.span(),
-                    format!("encoding is `zlib`, `binary` or `ascii`, got `{other}`"),
-                ))
-            }
-        };
+        plan.encoding = cx.keyword(
+            e,
+            "output.encoding",
+            "encoding",
+            &[
+                ("zlib", Encoding::Zlib),
+                ("binary", Encoding::Base64),
+                ("base64", Encoding::Base64),
+                ("ascii", Encoding::Ascii),
+            ],
+        )?;
     }
     Ok(plan)
 }
