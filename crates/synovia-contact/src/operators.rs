@@ -604,71 +604,97 @@ impl<const D: usize> ContactGeometry<D> {
                 None => body.mesh.nodes().to_vec(),
             })
             .collect();
+        let mut parts = Vec::with_capacity(pairs.len());
+        for pair in pairs {
+            parts.push(PartData::new(model, pair, &posed[pair.body.0])?);
+        }
+        Self::build_from(model, pairs, &posed, &mut parts, displacement, total_form, previous)
+    }
+
+    /// [`ContactGeometry::new`] with what does not depend on the partners' poses — the
+    /// reference positions, and per pair the weights, normals, shortest edge and duplicate
+    /// check of its part and the adjacency of its rows — taken from `cache` when it still
+    /// fits the model (same node positions, same part facets) and kept there otherwise: a
+    /// rebuild at a new pose of a rigid partner then only asks the discretisations for their
+    /// rows. Equal to [`ContactGeometry::new`].
+    ///
+    /// # Errors
+    /// As [`ContactGeometry::new`].
+    pub fn new_cached(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        cache: &mut GeometryCache<D>,
+    ) -> Result<Self, ContactError> {
+        let bodies = model.bodies();
+        let fits = cache.positions.len() == bodies.len()
+            && cache.positions.iter().zip(bodies).all(|(p, b)| p.as_slice() == b.mesh.nodes());
+        if !fits {
+            *cache = GeometryCache {
+                positions: bodies.iter().map(|b| b.mesh.nodes().to_vec()).collect(),
+                parts: Vec::new(),
+            };
+        }
+        // taken out while the geometry is built (put back on success)
+        let mut kept = std::mem::take(&mut cache.parts);
+        let mut parts = Vec::with_capacity(pairs.len());
+        for pair in pairs {
+            check_friction(pair)?;
+            let body = model.body(pair.body)?;
+            let part = body.mesh.boundary_part(&pair.part)?;
+            let found = kept.iter().position(|d| {
+                d.body == pair.body && d.part == pair.part && d.facets.iter().eq(part.facets().flatten())
+            });
+            parts.push(match found {
+                Some(i) => kept.swap_remove(i),
+                None => PartData::new(model, pair, &cache.positions[pair.body.0])?,
+            });
+        }
+        let geometry = Self::build_from(model, pairs, &cache.positions, &mut parts, None, true, None)?;
+        // the parts of these pairs, and at most as many others (pairs that alternate)
+        kept.truncate(parts.len());
+        parts.extend(kept);
+        cache.parts = parts;
+        Ok(geometry)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn build_from(
+        model: &Model<D>,
+        pairs: &[ContactPair<D>],
+        posed: &[Vec<Point<D>>],
+        parts: &mut [PartData<D>],
+        displacement: Option<&[Vec<Vector<D>>]>,
+        total_form: bool,
+        previous: Option<&ContactGeometry<D>>,
+    ) -> Result<Self, ContactError> {
         let mut nodes = Vec::new();
         let mut ranges = Vec::new();
         let mut adjacency: Vec<Vec<usize>> = Vec::new();
-        for (pi, pair) in pairs.iter().enumerate() {
+        for (pi, (pair, data)) in pairs.iter().zip(parts.iter_mut()).enumerate() {
+            check_friction(pair)?;
             let invalid = |reason: String| ContactError::InvalidPair { pair: pair.name.clone(), reason };
-            if !(pair.friction.is_finite() && pair.friction >= 0.0) {
-                return Err(invalid(format!(
-                    "friction coefficient {} must be finite and ≥ 0",
-                    pair.friction
-                )));
-            }
-            let body = model.body(pair.body)?;
-            let part = body.mesh.boundary_part(&pair.part)?;
             let pos_k = &posed[pair.body.0];
             let start = nodes.len();
-            // lumped weights and nodal normals of part k
-            let mut weight = std::collections::HashMap::new();
-            let mut min_edge = Real::INFINITY;
-            for f in part.facets() {
-                let m = area_normal(pos_k, f).norm() / D as Real;
-                for (a, &i) in f.iter().enumerate() {
-                    *weight.entry(i).or_insert(0.0) += m;
-                    for &j in &f[..a] {
-                        min_edge = min_edge.min((body.mesh.node(i) - body.mesh.node(j)).norm());
-                    }
-                }
-            }
-            let normals = nodal_normals_at(pos_k, part.facets());
-            let reference = |i: usize| *body.mesh.node(i);
-            // distinct nodes of the part at the same reference position (a duplicated node,
-            // e.g. an unmerged mesh seam) would give two constraints on one point
-            {
-                let mut seen: std::collections::HashMap<[u64; D], usize> = std::collections::HashMap::new();
-                for i in part.nodes() {
-                    let key: [u64; D] = std::array::from_fn(|a| (reference(i)[a] + 0.0).to_bits());
-                    if let Some(j) = seen.insert(key, i) {
-                        return Err(invalid(format!(
-                            "nodes {j} and {i} of part `{}` of body `{}` coincide at {:?} (duplicated node)",
-                            pair.part,
-                            body.name,
-                            reference(i).as_slice()
-                        )));
-                    }
-                }
-            }
             let context = PairContext {
                 model,
                 name: &pair.name,
                 body: pair.body,
                 part: &pair.part,
-                positions: &posed,
+                positions: posed,
                 posed: displacement.is_some(),
-                normals: &normals,
-                weights: &weight,
-                min_edge,
+                normals: &data.normals,
+                weights: &data.weights,
+                min_edge: data.min_edge,
             };
             let rows = match previous.and_then(|g| g.pair_nodes(&pair.name)) {
                 Some(old) => pair.discretisation.update(&context, old)?,
                 None => pair.discretisation.rows(&context)?,
             };
-            let on_part: std::collections::HashSet<usize> = normals.iter().map(|(i, _)| *i).collect();
-            let mut seen = std::collections::HashSet::new();
+            let mut seen = vec![false; data.on_part.len()];
+            nodes.reserve(rows.len());
             for row in rows {
-                check_row(model, &on_part, &row).map_err(&invalid)?;
-                if !seen.insert(row.node) {
+                check_row(model, &data.on_part, &row).map_err(&invalid)?;
+                if std::mem::replace(&mut seen[row.node], true) {
                     return Err(invalid(format!("two rows for node {} of part `{}`", row.node, pair.part)));
                 }
                 let mut node = ContactNode {
@@ -692,26 +718,18 @@ impl<const D: usize> ContactGeometry<D> {
             if nodes.len() == start {
                 return Err(invalid("the contact part has no nodes".into()));
             }
-            // adjacency of the new rows through the facets of part k
-            let row_of: std::collections::HashMap<usize, usize> =
-                (start..nodes.len()).map(|r| (nodes[r].node.1, r)).collect();
-            adjacency.resize(nodes.len(), Vec::new());
-            for f in part.facets() {
-                for &a in f {
-                    for &b in f {
-                        if let (Some(&ra), Some(&rb)) = (row_of.get(&a), row_of.get(&b)) {
-                            if ra != rb {
-                                adjacency[ra].push(rb);
-                            }
-                        }
-                    }
-                }
+            // adjacency of the new rows through the facets of part k (kept for the same rows)
+            let same_rows = data
+                .adjacency
+                .as_ref()
+                .is_some_and(|(kept, _)| kept.iter().eq(nodes[start..].iter().map(|n| &n.node.1)));
+            if !same_rows {
+                data.adjacency = Some(data.row_adjacency(&nodes[start..]));
+            }
+            if let Some((_, local)) = &data.adjacency {
+                adjacency.extend(local.iter().map(|a| a.iter().map(|&r| r + start).collect::<Vec<usize>>()));
             }
             ranges.push((pair.name.clone(), start..nodes.len()));
-        }
-        for a in adjacency.iter_mut() {
-            a.sort_unstable();
-            a.dedup();
         }
         Ok(Self {
             pairs: ranges,
@@ -910,12 +928,146 @@ impl<const D: usize> ContactGeometry<D> {
 
 /// `Err` unless `row` is a valid contact row: its node on the slave part, the other side's
 /// nodes in the model, a finite unit normal, finite weights and gap.
-fn check_row<const D: usize>(
-    model: &Model<D>,
-    on_part: &std::collections::HashSet<usize>,
-    row: &ContactRow<D>,
-) -> Result<(), String> {
-    if !on_part.contains(&row.node) {
+/// What [`ContactGeometry::new_cached`] keeps between rebuilds on the reference meshes (a
+/// rigid partner that moves from pose to pose, e.g. a navigation session): the reference node
+/// positions of every body and, per pair, the data of its part that do not depend on the
+/// partner's pose (lumped weights, nodal normals, shortest edge, the duplicate check, the
+/// adjacency of its rows). Checked against the model at every rebuild (positions and part
+/// facets compared entry by entry) and rebuilt when they differ; holds the data of at most
+/// twice as many parts as the last rebuild's pairs.
+#[derive(Debug, Clone, Default)]
+pub struct GeometryCache<const D: usize> {
+    positions: Vec<Vec<Point<D>>>,
+    parts: Vec<PartData<D>>,
+}
+
+impl<const D: usize> GeometryCache<D> {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Number of pair parts whose data are kept.
+    pub fn len(&self) -> usize {
+        self.parts.len()
+    }
+    /// `true` if no part's data are kept.
+    pub fn is_empty(&self) -> bool {
+        self.parts.is_empty()
+    }
+}
+
+/// The data of a pair's slave part at given positions that every discretisation shares
+/// ([`PairContext`]): lumped weights, nodal normals, the shortest facet edge (reference mesh),
+/// the part's nodes, and the adjacency of the pair's rows (for the rows' node order it was
+/// built for).
+#[derive(Debug, Clone)]
+struct PartData<const D: usize> {
+    body: BodyId,
+    part: String,
+    /// The part's facets, flattened (to check that a kept entry still fits the mesh).
+    facets: Vec<usize>,
+    weights: std::collections::HashMap<usize, Real>,
+    min_edge: Real,
+    normals: Vec<(usize, Vector<D>)>,
+    /// By node of the body: whether it is on the part.
+    on_part: Vec<bool>,
+    /// The row nodes (in row order) and each row's neighbours (row indices of the pair,
+    /// sorted): rows sharing a facet of the part.
+    adjacency: Option<(Vec<usize>, Vec<Vec<usize>>)>,
+}
+
+fn check_friction<const D: usize>(pair: &ContactPair<D>) -> Result<(), ContactError> {
+    if pair.friction.is_finite() && pair.friction >= 0.0 {
+        return Ok(());
+    }
+    Err(ContactError::InvalidPair {
+        pair: pair.name.clone(),
+        reason: format!("friction coefficient {} must be finite and ≥ 0", pair.friction),
+    })
+}
+
+impl<const D: usize> PartData<D> {
+    /// The data of `pair`'s part at the positions `pos_k` of its body's nodes.
+    fn new(model: &Model<D>, pair: &ContactPair<D>, pos_k: &[Point<D>]) -> Result<Self, ContactError> {
+        check_friction(pair)?;
+        let invalid = |reason: String| ContactError::InvalidPair { pair: pair.name.clone(), reason };
+        let body = model.body(pair.body)?;
+        let part = body.mesh.boundary_part(&pair.part)?;
+        // lumped weights and nodal normals of part k
+        let mut weights = std::collections::HashMap::new();
+        let mut min_edge = Real::INFINITY;
+        for f in part.facets() {
+            let m = area_normal(pos_k, f).norm() / D as Real;
+            for (a, &i) in f.iter().enumerate() {
+                *weights.entry(i).or_insert(0.0) += m;
+                for &j in &f[..a] {
+                    min_edge = min_edge.min((body.mesh.node(i) - body.mesh.node(j)).norm());
+                }
+            }
+        }
+        let normals = nodal_normals_at(pos_k, part.facets());
+        let reference = |i: usize| *body.mesh.node(i);
+        // distinct nodes of the part at the same reference position (a duplicated node,
+        // e.g. an unmerged mesh seam) would give two constraints on one point
+        {
+            let mut seen: std::collections::HashMap<[u64; D], usize> = std::collections::HashMap::new();
+            for i in part.nodes() {
+                let key: [u64; D] = std::array::from_fn(|a| (reference(i)[a] + 0.0).to_bits());
+                if let Some(j) = seen.insert(key, i) {
+                    return Err(invalid(format!(
+                        "nodes {j} and {i} of part `{}` of body `{}` coincide at {:?} (duplicated node)",
+                        pair.part,
+                        body.name,
+                        reference(i).as_slice()
+                    )));
+                }
+            }
+        }
+        let mut on_part = vec![false; body.mesh.n_nodes()];
+        for &(i, _) in &normals {
+            if let Some(o) = on_part.get_mut(i) {
+                *o = true;
+            }
+        }
+        Ok(Self {
+            body: pair.body,
+            part: pair.part.clone(),
+            facets: part.facets().flatten().copied().collect(),
+            weights,
+            min_edge,
+            normals,
+            on_part,
+            adjacency: None,
+        })
+    }
+
+    /// The adjacency of rows on the nodes of `rows` (in order) through the part's facets.
+    fn row_adjacency(&self, rows: &[ContactNode<D>]) -> (Vec<usize>, Vec<Vec<usize>>) {
+        let mut row_of = vec![usize::MAX; self.on_part.len()];
+        for (r, node) in rows.iter().enumerate() {
+            row_of[node.node.1] = r;
+        }
+        let mut adjacency = vec![Vec::new(); rows.len()];
+        for f in self.facets.chunks_exact(D.max(1)) {
+            for &a in f {
+                for &b in f {
+                    let (ra, rb) = (row_of[a], row_of[b]);
+                    if ra != usize::MAX && rb != usize::MAX && ra != rb {
+                        adjacency[ra].push(rb);
+                    }
+                }
+            }
+        }
+        for a in adjacency.iter_mut() {
+            a.sort_unstable();
+            a.dedup();
+        }
+        (rows.iter().map(|n| n.node.1).collect(), adjacency)
+    }
+}
+
+fn check_row<const D: usize>(model: &Model<D>, on_part: &[bool], row: &ContactRow<D>) -> Result<(), String> {
+    if !on_part.get(row.node).copied().unwrap_or(false) {
         return Err(format!("row for node {}, which is not on the contact part", row.node));
     }
     let exists = |b: BodyId, j: usize| model.bodies().get(b.0).is_some_and(|body| j < body.mesh.n_nodes());
@@ -958,5 +1110,72 @@ fn check_pose<const D: usize>(model: &Model<D>, displacement: &[Vec<Vector<D>>])
             "the displacement of the pose does not fit the model (one finite vector per node of every body)"
                 .into(),
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::Mutex;
+    use synovia_mesh::generators::{box_mesh, Grading};
+
+    /// A unit box whose top is the contact part of a rigid sphere obstacle centred at
+    /// `centre` (shared: the partner moves), with a search distance; and a node-to-segment
+    /// pair of its right side against a wall (a pair whose rows do not move).
+    fn boxed(n: usize, centre: Arc<Mutex<Point<3>>>) -> (Model<3>, Vec<ContactPair<3>>) {
+        let mesh = box_mesh([0.0; 3], [1.0; 3], [n, n, n], [Grading::Uniform; 3]).expect("mesh");
+        let mut model = Model::<3>::new();
+        let material = synovia_material::isotropic(1.0, 0.3).expect("material");
+        let material = Arc::new(material);
+        let b = model.add_body("box", mesh, material.clone()).expect("body");
+        let wall =
+            box_mesh([1.01, 0.0, 0.0], [2.0, 1.0, 1.0], [2, 3, 3], [Grading::Uniform; 3]).expect("mesh");
+        let w = model.add_body("wall", wall, material).expect("body");
+        let sphere = FnObstacle::new(move |x: &Point<3>| {
+            let c = *centre.lock().expect("centre");
+            let d = x - c;
+            let len = d.norm();
+            (len - 1.0, d / len)
+        });
+        let pairs = vec![
+            ContactPair::rigid("top", b, "top", Arc::new(sphere)).with_search_distance(0.05),
+            ContactPair::node_to_segment("sides", b, "right", w, "left").with_friction(0.2),
+        ];
+        (model, pairs)
+    }
+
+    /// Rebuilds at poses of a moving partner with the kept pose-independent data equal fresh
+    /// builds exactly (nodes, normals, gaps, weights, adjacency); a model with another mesh
+    /// refreshes the cache instead of using it.
+    #[test]
+    fn cached_rebuilds_equal_fresh_builds() {
+        let centre = Arc::new(Mutex::new(Point::<3>::new(0.5, 0.5, 2.02)));
+        let (model, pairs) = boxed(4, centre.clone());
+        let mut cache = GeometryCache::new();
+        assert!(cache.is_empty());
+        for pose in 0..5 {
+            let s = pose as Real;
+            *centre.lock().expect("centre") = Point::<3>::new(0.4 + 0.05 * s, 0.5 - 0.03 * s, 2.0 - 0.01 * s);
+            let fresh = ContactGeometry::new(&model, &pairs).expect("fresh");
+            let cached = ContactGeometry::new_cached(&model, &pairs, &mut cache).expect("cached");
+            assert_eq!(cached, fresh, "pose {pose}");
+            assert_eq!(cache.len(), 2);
+            // the far rows keep the body's normal, the near ones the sphere's: rows changed
+            assert!(fresh.nodes.iter().any(|n| n.gap <= 0.05) && fresh.nodes.iter().any(|n| n.gap > 0.05));
+        }
+        // another mesh (finer): the kept data do not fit it
+        let (finer, finer_pairs) = boxed(5, centre.clone());
+        let fresh = ContactGeometry::new(&finer, &finer_pairs).expect("fresh");
+        let cached = ContactGeometry::new_cached(&finer, &finer_pairs, &mut cache).expect("cached");
+        assert_eq!(cached, fresh);
+        assert_eq!(cache.len(), 2);
+        // an invalid pair is an error with or without the cache
+        let mut bad = pairs.clone();
+        bad[1].friction = -1.0;
+        assert!(ContactGeometry::new_cached(&model, &bad, &mut cache).is_err());
+        assert!(ContactGeometry::new(&model, &bad).is_err());
+        // and the cache still serves the valid pairs afterwards
+        let cached = ContactGeometry::new_cached(&model, &pairs, &mut cache).expect("cached");
+        assert_eq!(cached, ContactGeometry::new(&model, &pairs).expect("fresh"));
     }
 }

@@ -13,7 +13,7 @@ use synovia_mesh::math::{Real, Vector};
 use crate::context::SolveContext;
 use crate::error::ContactError;
 use crate::kkt::{check_kkt, inf_norm, KktReport};
-use crate::operators::{BodyPlacement, ContactGeometry, ContactPair};
+use crate::operators::{BodyPlacement, ContactGeometry, ContactPair, GeometryCache};
 use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints};
 use crate::solver::{ContactSolution, ContactSolver, SolverReport};
 use synovia_linalg::SparseRows;
@@ -41,6 +41,8 @@ pub struct StaticContact<const D: usize> {
     /// Built on a caller's matrix ([`StaticContact::with_system_matrix`]): the loads come from
     /// the caller ([`StaticContact::solve_load`]), not from the model.
     caller_matrix: bool,
+    /// The pose-independent geometry data kept by [`StaticContact::rebuild_geometry`].
+    geometry_cache: GeometryCache<D>,
 }
 
 /// The result of one static contact solve.
@@ -100,6 +102,7 @@ impl<const D: usize> StaticContact<D> {
             screening_band: None,
             context: SolveContext::new(),
             caller_matrix: false,
+            geometry_cache: GeometryCache::default(),
         })
     }
 
@@ -182,6 +185,7 @@ impl<const D: usize> StaticContact<D> {
             screening_band: None,
             context: SolveContext::new(),
             caller_matrix: true,
+            geometry_cache: GeometryCache::default(),
         })
     }
 
@@ -349,8 +353,10 @@ impl<const D: usize> StaticContact<D> {
 
     /// Rebuilds the contact geometry of `pairs` on the reference meshes
     /// ([`ContactGeometry::new`]), keeping the factorisation of `A`: for contact partners that
-    /// moved (a posed rigid body's shape reads its pose when the geometry is built). Returns
-    /// the previous geometry. The kept Schur columns are dropped (the rows changed); from the
+    /// moved (a posed rigid body's shape reads its pose when the geometry is built). What does
+    /// not depend on the partners' poses (weights, normals and adjacency of the parts) is kept
+    /// between rebuilds ([`ContactGeometry::new_cached`], checked against `model` each time),
+    /// so a rebuild costs the discretisations' rows. Returns the previous geometry. The kept Schur columns are dropped (the rows changed); from the
     /// first rebuild on, the columns of single-node rows come from kept unit solves
     /// ([`SolveContext::clear_moved_rows`]), so a node's rows cost no solve at later poses.
     ///
@@ -362,7 +368,7 @@ impl<const D: usize> StaticContact<D> {
         model: &Model<D>,
         pairs: &[ContactPair<D>],
     ) -> Result<ContactGeometry<D>, ContactError> {
-        let geometry = ContactGeometry::new(model, pairs)?;
+        let geometry = ContactGeometry::new_cached(model, pairs, &mut self.geometry_cache)?;
         self.context.clear_moved_rows();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
