@@ -144,20 +144,39 @@ pub fn assemble_matrix_with<const D: usize>(
     blocks: usize,
     kernel: impl Fn(usize, usize, &SimplexGeometry<D>, &mut [Real]) + Sync,
 ) -> Result<(), FemError> {
+    assemble_matrix_of(model, dofs, matrix, blocks, &[], kernel)
+}
+
+/// [`assemble_matrix_with`] over the cells of the bodies `b` with `skip.get(b) != Some(&true)`
+/// only (the others contribute nothing).
+pub(crate) fn assemble_matrix_of<const D: usize>(
+    model: &Model<D>,
+    dofs: &DofMap<D>,
+    matrix: &mut SymmetricMatrix,
+    blocks: usize,
+    skip: &[bool],
+    kernel: impl Fn(usize, usize, &SimplexGeometry<D>, &mut [Real]) + Sync,
+) -> Result<(), FemError> {
     if matrix.n() != dofs.n_dofs() {
         return Err(FemError::Length { what: "matrix", expected: dofs.n_dofs(), got: matrix.n() });
     }
     if D > 3 {
         return Err(FemError::InvalidParameter(format!("assembly of dimension {D}")));
     }
-    let n_cells: usize = model.bodies().iter().map(|b| b.mesh.n_cells()).sum();
+    let n_cells: usize = model
+        .bodies()
+        .iter()
+        .enumerate()
+        .filter(|(b, _)| skip.get(*b) != Some(&true))
+        .map(|(_, b)| b.mesh.n_cells())
+        .sum();
     let n = matrix.n();
     let nnz = matrix.nnz();
     let blocks = blocks.min(n).max(1);
     let spans: Vec<(usize, usize)> = dofs.groups().iter().map(|g| (g.first_dof, g.n_dofs)).collect();
     if blocks == 1 || n_cells < PARALLEL_MIN_CELLS {
         matrix.zero();
-        return assemble_columns(model, dofs, &spans, 0..n, true, matrix, &kernel).map_err(|e| e.2);
+        return assemble_columns(model, dofs, &spans, 0..n, true, skip, matrix, &kernel).map_err(|e| e.2);
     }
     // column bounds with about nnz / blocks stored entries per block
     let cp = matrix.pattern().col_ptr();
@@ -178,7 +197,7 @@ pub fn assemble_matrix_with<const D: usize>(
         .map(|(k, w)| {
             let mut block =
                 ColumnBlock { matrix: shared, offset: cp[w[0]], values: vec![0.0; cp[w[1]] - cp[w[0]]] };
-            assemble_columns(model, dofs, &spans, w[0]..w[1], k == 0, &mut block, &kernel)?;
+            assemble_columns(model, dofs, &spans, w[0]..w[1], k == 0, skip, &mut block, &kernel)?;
             Ok(block.values)
         })
         .collect();
@@ -276,12 +295,14 @@ fn cell_geometry_of<const D: usize>(
 /// Adds `P_Tᵀ K_T P_T` of every cell with a dof in `cols` to the entries of the columns `cols`
 /// of `target` (lower triangle). `spans[g]` = (first dof, number of dofs) of group `g`. Cells
 /// without any dof are only checked for degeneracy, and only if `dofless_cells`. Errors carry the (body, cell) where they happened.
+#[allow(clippy::too_many_arguments)]
 fn assemble_columns<const D: usize, S: Scatter>(
     model: &Model<D>,
     dofs: &DofMap<D>,
     spans: &[(usize, usize)],
     cols: std::ops::Range<usize>,
     dofless_cells: bool,
+    skip: &[bool],
     target: &mut S,
     kernel: &impl Fn(usize, usize, &SimplexGeometry<D>, &mut [Real]),
 ) -> Result<(), (usize, usize, FemError)> {
@@ -289,6 +310,9 @@ fn assemble_columns<const D: usize, S: Scatter>(
     let mut ke = vec![0.0; n * n];
     let groups = dofs.groups();
     for (bi, body) in model.bodies().iter().enumerate() {
+        if skip.get(bi) == Some(&true) {
+            continue;
+        }
         for c in 0..body.mesh.n_cells() {
             let cell = body.mesh.cell(c);
             let mut gid = [0usize; 4];

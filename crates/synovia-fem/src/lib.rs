@@ -20,6 +20,7 @@ pub mod dofs;
 pub mod elastic;
 pub mod element;
 pub mod error;
+pub mod linear_bodies;
 pub mod model;
 pub mod nonlinear;
 pub mod post;

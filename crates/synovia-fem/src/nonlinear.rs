@@ -36,7 +36,6 @@ use synovia_linalg::SymmetricMatrix;
 use synovia_material::{Material, VoigtVector};
 use synovia_mesh::math::{det, Real, Tensor, Vector};
 
-use crate::assembly::assemble_matrix;
 use crate::dofs::DofMap;
 use crate::element::{voigt_strain, SimplexGeometry};
 use crate::error::FemError;
@@ -238,7 +237,7 @@ fn cell_tangent<const D: usize>(
     result.map(|_| ())
 }
 
-fn check_kinematics<const D: usize>(
+pub(crate) fn check_kinematics<const D: usize>(
     model: &Model<D>,
     kinematics: &[Kinematics],
     displacement: &[Vec<Vector<D>>],
@@ -292,12 +291,25 @@ pub fn internal_force<const D: usize>(
     kinematics: &[Kinematics],
     displacement: &[Vec<Vector<D>>],
 ) -> Result<(Vec<Real>, Real), FemError> {
+    internal_force_of(model, dofs, kinematics, displacement, &[])
+}
+
+/// [`internal_force`] of the bodies `b` with `skip.get(b) != Some(&true)` only (the element
+/// loop, in parallel chunks of the cells of those bodies, in (body, cell) order).
+pub(crate) fn internal_force_of<const D: usize>(
+    model: &Model<D>,
+    dofs: &DofMap<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+    skip: &[bool],
+) -> Result<(Vec<Real>, Real), FemError> {
     use rayon::prelude::*;
     check_kinematics(model, kinematics, displacement)?;
     let cells: Vec<(usize, usize)> = model
         .bodies()
         .iter()
         .enumerate()
+        .filter(|(b, _)| skip.get(*b) != Some(&true))
         .flat_map(|(b, body)| (0..body.mesh.n_cells()).map(move |c| (b, c)))
         .collect();
     // the element forces of `cells` added into `out`, their energies summed
@@ -355,7 +367,7 @@ pub const INTERNAL_FORCE_CHUNK: usize = 2048;
 /// strain it is the stiffness `K̃` of the linear solve.
 ///
 /// # Errors
-/// As [`internal_force`], and the errors of [`assemble_matrix`].
+/// As [`internal_force`], and the errors of [`crate::assembly::assemble_matrix`].
 pub fn assemble_tangent<const D: usize>(
     model: &Model<D>,
     dofs: &DofMap<D>,
@@ -363,9 +375,22 @@ pub fn assemble_tangent<const D: usize>(
     displacement: &[Vec<Vector<D>>],
     matrix: &mut SymmetricMatrix,
 ) -> Result<(), FemError> {
+    assemble_tangent_of(model, dofs, kinematics, displacement, matrix, &[])
+}
+
+/// [`assemble_tangent`] over the cells of the bodies `b` with `skip.get(b) != Some(&true)` only.
+pub(crate) fn assemble_tangent_of<const D: usize>(
+    model: &Model<D>,
+    dofs: &DofMap<D>,
+    kinematics: &[Kinematics],
+    displacement: &[Vec<Vector<D>>],
+    matrix: &mut SymmetricMatrix,
+    skip: &[bool],
+) -> Result<(), FemError> {
     check_kinematics(model, kinematics, displacement)?;
     let first_failure = std::sync::Mutex::new(None::<(usize, usize, ElementFailure)>);
-    assemble_matrix(model, dofs, matrix, |b, c, geo, out| {
+    let blocks = rayon::current_num_threads();
+    crate::assembly::assemble_matrix_of(model, dofs, matrix, blocks, skip, |b, c, geo, out| {
         if let Err(e) = cell_tangent(model, kinematics, displacement, b, c, geo, out) {
             if let Ok(mut f) = first_failure.lock() {
                 if f.as_ref().is_none_or(|x| (x.0, x.1) > (b, c)) {

@@ -62,7 +62,8 @@ use std::time::Instant;
 use synovia_contact::operators::{ContactGeometry, ContactPair};
 use synovia_contact::{ContactError, ContactSolution, ContactSolver, StaticContact, StaticContactResult};
 use synovia_fem::assembly::add_loads;
-use synovia_fem::nonlinear::{assemble_tangent, internal_force, subtract_tangent_lift};
+use synovia_fem::linear_bodies::LinearBodies;
+use synovia_fem::nonlinear::{assemble_tangent, subtract_tangent_lift};
 use synovia_fem::{DofMap, ElasticParams, FemError, Kinematics, Model};
 use synovia_mesh::math::{Real, Vector};
 
@@ -138,6 +139,12 @@ pub struct NewtonParams {
     /// How the contact's active sets are iterated against the material's Newton iteration
     /// (default [`ActiveSetStrategy::Nested`]).
     pub active_sets: ActiveSetStrategy,
+    /// The internal force and tangent of the linear bodies (small strain, a material with a
+    /// constant stiffness) as the product `K_b u_b` with their stiffness and its constant part
+    /// `Σ_b Pᵀ K_b P` of the tangent, kept from level to level and rebuilt when a body's mesh
+    /// moves ([`synovia_fem::linear_bodies::LinearBodies`]), instead of the element loop
+    /// (default `true`; the same force and tangent to rounding).
+    pub linear_bodies_by_stiffness: bool,
 }
 
 /// How the active sets of the contact conditions (contact/no contact, stick/slip) are found
@@ -214,6 +221,7 @@ impl Default for NewtonParams {
             geometry_aitken: false,
             geometry_pass_tolerance: None,
             active_sets: ActiveSetStrategy::Nested,
+            linear_bodies_by_stiffness: true,
         }
     }
 }
@@ -283,6 +291,11 @@ impl NewtonParams {
     /// Sets [`Self::max_cutbacks`].
     pub fn with_max_cutbacks(mut self, max_cutbacks: usize) -> Self {
         self.max_cutbacks = max_cutbacks;
+        self
+    }
+    /// Sets [`Self::linear_bodies_by_stiffness`].
+    pub fn with_linear_bodies_by_stiffness(mut self, on: bool) -> Self {
+        self.linear_bodies_by_stiffness = on;
         self
     }
 
@@ -535,6 +548,9 @@ pub struct NonlinearContact<const D: usize> {
     /// The constant matrix `B` of [`Self::with_constant_matrix`] (on the tangent's pattern),
     /// added to every tangent; `B ũ` is added to the internal force.
     constant: Option<synovia_linalg::SymmetricMatrix>,
+    /// The stiffness of the linear bodies ([`NewtonParams::linear_bodies_by_stiffness`]),
+    /// refreshed at the start of each level.
+    linear_bodies: LinearBodies<D>,
 }
 
 /// The extra terms of one level of [`NonlinearContact::step_with_terms`] (docs/model.md
@@ -698,6 +714,7 @@ impl<const D: usize> NonlinearContact<D> {
             },
             tangent_kept: false,
             constant,
+            linear_bodies: LinearBodies::none(),
         })
     }
 
@@ -874,7 +891,8 @@ impl<const D: usize> NonlinearContact<D> {
         displacement: &[Vec<Vector<D>>],
         reduced: &[Real],
     ) -> Result<(Vec<Real>, Real), FemError> {
-        let (mut f, energy) = internal_force(model, &self.dofs, &self.kinematics, displacement)?;
+        let (mut f, energy) =
+            self.linear_bodies.internal_force(model, &self.dofs, &self.kinematics, displacement)?;
         if let Some(b) = &self.constant {
             let mut bu = vec![0.0; f.len()];
             b.mul_vec(reduced, &mut bu);
@@ -1358,6 +1376,13 @@ impl<const D: usize> NonlinearContact<D> {
         let solver: &dyn ContactSolver = step_solver.as_deref().unwrap_or(solver);
         let mut t = t;
         let n = self.dofs.n_dofs();
+        if self.params.linear_bodies_by_stiffness {
+            self.linear_bodies.refresh(model, &self.kinematics)?;
+            let template = self.contact.elastic().stiffness();
+            self.linear_bodies.refresh_tangent(model, &self.dofs, &self.kinematics, template)?;
+        } else {
+            self.linear_bodies = LinearBodies::none();
+        }
         let finite_geometry =
             self.finite_strain() && self.params.geometry_update != GeometryUpdate::Reference;
         // gap control: the partner posed at the guess and, in small strain, the geometry built
@@ -1506,6 +1531,7 @@ impl<const D: usize> NonlinearContact<D> {
             let kin = &self.kinematics;
             let at = &disp;
             let constant = self.constant.as_ref();
+            let linear = &self.linear_bodies;
             let reuse = self.params.tangent_reuse.is_some() && self.tangent_kept;
             // K_T away from equilibrium (strong compression, the geometric stiffness of
             // compressive stresses) may be indefinite: then K_T + γ D (D = diag K_T, γ = 1e-4,
@@ -1514,7 +1540,7 @@ impl<const D: usize> NonlinearContact<D> {
             if !reuse {
                 loop {
                     let result = self.contact.refactorise(|dofs, m| {
-                        assemble_tangent(model, dofs, kin, at, m)?;
+                        linear.assemble_tangent(model, dofs, kin, at, m)?;
                         if let Some(b) = constant {
                             m.add_scaled(1.0, b)?;
                         }
