@@ -426,6 +426,44 @@ impl<const D: usize> StaticContact<D> {
         Ok(())
     }
 
+    /// The strain energy `W = Σ_T |T| Φ(ε(u))` of `result`, a solution of this problem
+    /// ([`synovia_fem::post::total_strain_energy`] of its nodal displacements). When the
+    /// displacements are those of the reduced solution alone (no prescribed displacement is
+    /// non-zero: `u = N Ũ`) and `A` is the assembled stiffness (no stabilisation of floating
+    /// bodies, not a caller's matrix), `W = ½ Ũᵀ A Ũ` — `A = Σ_T |T| Nᵀ Bᵀ C B N` with the
+    /// linear materials' `C` and `Φ = ½ εᵀ C ε` — one product with `A` instead of the element
+    /// loop (equal to rounding); otherwise the element loop.
+    ///
+    /// # Errors
+    /// [`ContactError::Fem`] for displacements that do not fit the model.
+    pub fn strain_energy(
+        &self,
+        model: &Model<D>,
+        result: &StaticContactResult<D>,
+    ) -> Result<Real, ContactError> {
+        match self.reduced_strain_energy(result) {
+            Some(w) => Ok(w),
+            None => Ok(synovia_fem::post::total_strain_energy(model, &result.displacement)?),
+        }
+    }
+
+    /// `½ Ũᵀ A Ũ` of [`StaticContact::strain_energy`] when it is the strain energy of
+    /// `result`, else `None`.
+    pub(crate) fn reduced_strain_energy(&self, result: &StaticContactResult<D>) -> Option<Real> {
+        let dofs = self.elastic.dofs();
+        let u = &result.solution.u;
+        if self.caller_matrix || self.elastic.stabilisation().is_some() || u.len() != dofs.n_dofs() {
+            return None;
+        }
+        // without lifts the nodal displacements are N Ũ entry by entry
+        let zero = vec![Vector::<D>::zeros(); dofs.groups().len()];
+        if dofs.expand(u, &zero).ok()? != result.displacement {
+            return None;
+        }
+        let w = 0.5 * self.elastic.system_matrix().quadratic_form(u);
+        w.is_finite().then_some(w)
+    }
+
     /// `(reused, solved)`: solves whose `A⁻¹ F` came from the recycled load subspace and
     /// those that needed a solve with the factor ([`SolveContext::recycled_counts`]).
     pub fn load_solves(&self) -> (usize, usize) {

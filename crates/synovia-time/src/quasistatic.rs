@@ -410,9 +410,10 @@ impl<const D: usize> QuasiStaticStepper<D> {
         self.level(model, t, solver, Some(warm))
     }
 
-    /// Whether the records of the following levels carry the strain energy (default `true`).
-    /// Computing it is an element loop per level, as costly as a contact solve on a large
-    /// model; trial solves whose records are discarded (force control, docs/model.md §10)
+    /// Whether the records of the following levels carry the strain energy (default `true`;
+    /// [`StaticContact::strain_energy`]: `½ Uᵀ A U` when no prescribed displacement is
+    /// non-zero, else an element loop per level, as costly as a contact solve on a large
+    /// model); trial solves whose records are discarded (force control, docs/model.md §10)
     /// switch it off and compute it once for the accepted level. Off, a record's
     /// `strain_energy` is `0`.
     pub fn set_record_strain_energy(&mut self, on: bool) {
@@ -557,7 +558,12 @@ impl<const D: usize> QuasiStaticStepper<D> {
             friction_dissipation(geometry, &result, previous.map(|p| p.displacement.as_slice()))?;
         let cumulative = base + dissipation;
         let strain_energy = if self.record_strain_energy {
-            synovia_fem::post::total_strain_energy(model, &result.displacement)?
+            // ½ Uᵀ A U when no prescribed displacement is non-zero, else the element loop
+            self.contact.strain_energy(model, &result).map_err(|source| TimeError::Contact {
+                step,
+                time: t,
+                source,
+            })?
         } else {
             0.0
         };

@@ -51,6 +51,7 @@ impl<const D: usize> ContactDiscretisation<D> for RigidObstacle<D> {
         let pos_k = cx.positions(cx.body()).ok_or_else(|| cx.invalid("unknown body"))?;
         // the obstacle queries (closest points on a surface) are independent per node
         // (beyond the search distance only "farther than it" matters: a bounded query)
+        let span = tracing::debug_span!("obstacle_queries").entered();
         let queries: Vec<(Real, Vector<D>)> = cx
             .normals()
             .par_iter()
@@ -59,6 +60,7 @@ impl<const D: usize> ContactDiscretisation<D> for RigidObstacle<D> {
                 None => self.obstacle.distance_and_gradient(&pos_k[i]),
             })
             .collect();
+        drop(span);
         let mut rows = Vec::with_capacity(cx.normals().len());
         for (&(i, nk), &(phi, grad)) in cx.normals().iter().zip(&queries) {
             let gl = grad.norm();
