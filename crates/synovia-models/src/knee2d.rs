@@ -1170,7 +1170,7 @@ pub struct SmoothNodeToSegment {
 impl SmoothNodeToSegment {
     /// The master point `(ξ, x(ξ), n(ξ))` of `x` on the segment `a → b` with unit nodal normals
     /// `na`, `nb` (see the type docs), if the normal field passes through `x` over the segment.
-    fn project(
+    pub(crate) fn project(
         x: &Point<2>,
         (xa, xb): (&Point<2>, &Point<2>),
         (na, nb): (&Vector<2>, &Vector<2>),

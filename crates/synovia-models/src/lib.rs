@@ -22,5 +22,6 @@
 pub mod hertz;
 pub mod hip3d;
 pub mod knee2d;
+pub mod smooth_gap;
 pub mod tkr3d;
 pub mod verification;
