@@ -344,6 +344,14 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     if let Some(v) = std::env::args().skip_while(|a| a != "--tangent-reuse").nth(1) {
         newton = newton.with_tangent_reuse(Some(v.parse()?));
     }
+    // `--nh-aitken on|off`: Aitken's relaxation of the geometry passes (default off)
+    if let Some(v) = std::env::args().skip_while(|a| a != "--nh-aitken").nth(1) {
+        newton = newton.with_geometry_aitken(match v.as_str() {
+            "on" => true,
+            "off" => false,
+            _ => return Err("--nh-aitken takes on or off".into()),
+        });
+    }
     nh_joint.newton_params(newton);
     let mut nonlinear = Vec::with_capacity(times.len());
     let mut newton_steps = Vec::with_capacity(times.len());
