@@ -74,7 +74,8 @@ pub struct JointSession<'a, const D: usize> {
     joint: &'a JointModel<D>,
     solver: Box<dyn ContactSolver>,
     engine: Engine<D>,
-    geometry: ContactGeometry<D>,
+    /// The contact nodes of a session without contact pairs (none); with pairs the stepper's.
+    no_geometry: ContactGeometry<D>,
     record: Option<StepRecord>,
     report: Option<SolveReport>,
     setup_s: f64,
@@ -92,7 +93,7 @@ impl<const D: usize> std::fmt::Debug for JointSession<'_, D> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("JointSession")
             .field("solver", &self.solver.name())
-            .field("contact_nodes", &self.geometry.len())
+            .field("contact_nodes", &self.geometry().len())
             .field("report", &self.report)
             .finish_non_exhaustive()
     }
@@ -126,15 +127,11 @@ impl<'a, const D: usize> JointSession<'a, D> {
             }
             Engine::Contact(Box::new(stepper))
         };
-        let geometry = match &engine {
-            Engine::Contact(s) => s.geometry().clone(),
-            Engine::Elastic { .. } => ContactGeometry::default(),
-        };
         Ok(Self {
             joint,
             solver,
             engine,
-            geometry,
+            no_geometry: ContactGeometry::default(),
             record: None,
             report: None,
             setup_s: start.elapsed().as_secs_f64(),
@@ -169,7 +166,6 @@ impl<'a, const D: usize> JointSession<'a, D> {
                     LevelMode::Restart { warm: true },
                 )?;
                 let report = contact_report(&record, &result, warm);
-                self.geometry = stepper.geometry().clone();
                 Ok(self.commit(record, report))
             }
             Engine::Contact(stepper) => {
@@ -205,7 +201,6 @@ impl<'a, const D: usize> JointSession<'a, D> {
                 let (record, result) =
                     self.rigid.level(self.joint, stepper, t, self.solver.as_ref(), mode)?;
                 let report = contact_report(&record, &result, warm);
-                self.geometry = stepper.geometry().clone();
                 Ok(self.commit(record, report))
             }
             Engine::Contact(stepper) => {
@@ -274,12 +269,6 @@ impl<'a, const D: usize> JointSession<'a, D> {
     }
 
     fn commit(&mut self, record: StepRecord, report: SolveReport) -> SolveReport {
-        if let Engine::Contact(stepper) = &self.engine {
-            // with re-pairing the geometry may change from level to level
-            if stepper.geometry().len() != self.geometry.len() {
-                self.geometry = stepper.geometry().clone();
-            }
-        }
         self.record = Some(record);
         self.report = Some(report);
         report
@@ -310,9 +299,15 @@ impl<'a, const D: usize> JointSession<'a, D> {
     pub fn model(&self) -> &Model<D> {
         self.joint.model()
     }
-    /// The contact nodes (empty without contact pairs).
+    /// The contact nodes (empty without contact pairs): those of the last solve, rebuilt at
+    /// every pose of a posed rigid partner — after a solve that failed, those of the pose it
+    /// failed at (the nodes are the same at every pose, their normals and gaps are the pose's),
+    /// while [`JointSession::result`] keeps the last solution.
     pub fn geometry(&self) -> &ContactGeometry<D> {
-        &self.geometry
+        match &self.engine {
+            Engine::Contact(stepper) => stepper.geometry(),
+            Engine::Elastic { .. } => &self.no_geometry,
+        }
     }
     /// The contact solver's name.
     pub fn solver_name(&self) -> &str {
