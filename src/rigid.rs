@@ -802,6 +802,54 @@ impl LinearGaps {
     }
 }
 
+/// The motion since the last accepted level (coordinates `accepted`) of every rigid partner's
+/// material point at the contact nodes of `geometry`, the partners at the coordinates `q`
+/// (docs/model.md (10.5)):
+///
+/// ```text
+/// w_r = P(q)(P(q_{i−1})⁻¹(y_r)) − y_r,    y_r = X_r + [u_{i−1}](X_r),
+/// ```
+///
+/// `X_r` the node's reference position (in finite strain the geometry's `position` is that of
+/// the deformed configuration it was built on) and `[u_{i−1}]` the jump of the last accepted
+/// displacement `previous`. Zero at nodes of pairs without a rigid body; empty (no motion)
+/// without an accepted level.
+fn partner_motion<const D: usize>(
+    joint: &JointModel<D>,
+    accepted: Option<&[Vec<Real>]>,
+    q: &[Vec<Real>],
+    geometry: &ContactGeometry<D>,
+    previous: &[Vec<Vector<D>>],
+) -> Vec<Vector<D>> {
+    let Some(old) = accepted else { return Vec::new() };
+    let poses: Vec<(RigidPose<D>, RigidPose<D>)> = joint
+        .rigid_bodies()
+        .iter()
+        .zip(old.iter().zip(q))
+        .map(|(body, (qo, qn))| (body.pose_of(qo), body.pose_of(qn)))
+        .collect();
+    let owner = joint.pair_rigid_owner(geometry);
+    geometry
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(r, node)| match owner.get(node.pair).copied().flatten() {
+            Some(ob) => {
+                let x = joint
+                    .model()
+                    .body(node.node.0)
+                    .ok()
+                    .and_then(|body| body.mesh.nodes().get(node.node.1).copied())
+                    .unwrap_or(node.position);
+                let y = x + geometry.jump(r, previous).unwrap_or_else(Vector::<D>::zeros);
+                let (old, new) = &poses[ob];
+                new.position(&old.to_body(&y)) - y
+            }
+            None => Vector::<D>::zeros(),
+        })
+        .collect()
+}
+
 /// A force system: its resultant and its moment about the origin (3 components each).
 type ForceSystem = ([Real; 3], [Real; 3]);
 
@@ -1098,11 +1146,13 @@ impl RigidDriver {
     /// (10.5)): Tresca with the slip bounds of the last accepted level, the slip measured from it
     /// relative to the partners, each posed at the trial's coordinate (`GapFriction`), and the
     /// friction forces in `Q_k` (`Σ_c g_c κ_r Λ_t,c · T_r v_k(x_r)` added), as the linear path.
-    /// Friction against rigid bodies whose coordinates are all prescribed is refused.
+    /// Friction against rigid bodies whose coordinates are all prescribed: the same slip origin,
+    /// the partners' motion `w_r = P(q)(P(q_{i−1})⁻¹(y_r)) − y_r` from the last accepted
+    /// coordinates to the prescribed ones ([`NonlinearContact::step_with_partner_motion`], no
+    /// search, no cut-back).
     ///
     /// # Errors
-    /// [`JointError::Unsupported`] for several force-controlled coordinates, and for friction
-    /// against rigid bodies without one; the errors of the Newton iteration (no convergence, a force-controlled body not resisted).
+    /// [`JointError::Unsupported`] for several force-controlled coordinates; the errors of the Newton iteration (no convergence, a force-controlled body not resisted).
     pub(crate) fn nonlinear_level<const D: usize>(
         &mut self,
         joint: &JointModel<D>,
@@ -1125,10 +1175,11 @@ impl RigidDriver {
             .any(|n| n.friction > 0.0 && owner_of.get(n.pair).copied().flatten().is_some());
         let (level, solves) = match unknowns.as_slice() {
             [] if rigid_friction => {
-                return Err(JointError::Unsupported {
-                    solver: "nonlinear (Newton)".into(),
-                    feature: "friction against rigid bodies whose coordinates are all prescribed, with nonlinear materials or finite strain (one force-controlled coordinate is supported)".into(),
-                })
+                // friction against partners whose coordinates are all prescribed (docs/model.md
+                // (10.5)): the slip measured relative to each partner's motion since the last
+                // accepted level, nothing to search for
+                let motion = self.partner_motion_fn(joint);
+                (nl.step_with_partner_motion(model, t, solver, &motion)?, 1)
             }
             [] => {
                 nl.rebuild_geometry(model)?;
@@ -1183,38 +1234,9 @@ impl RigidDriver {
                 let accepted = self.accepted.clone();
                 let all_q = self.q.clone();
                 let motion = |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>], w: Real| -> Vec<Vector<D>> {
-                    let Some(old) = &accepted else { return Vec::new() };
-                    let poses: Vec<(RigidPose<D>, RigidPose<D>)> = bodies
-                        .iter()
-                        .enumerate()
-                        .map(|(bi, body)| {
-                            let new = if bi == b { body.pose_of(&coordinates(sigma * w)) } else { body.pose_of(&all_q[bi]) };
-                            (body.pose_of(&old[bi]), new)
-                        })
-                        .collect();
-                    let owner = joint.pair_rigid_owner(geometry);
-                    geometry
-                        .nodes
-                        .iter()
-                        .enumerate()
-                        .map(|(r, node)| match owner.get(node.pair).copied().flatten() {
-                            Some(ob) => {
-                                // the reference position (in finite strain the geometry's
-                                // `position` is that of the deformed configuration it was
-                                // built on) moved by the last accepted displacement
-                                let x = joint
-                                    .model()
-                                    .body(node.node.0)
-                                    .ok()
-                                    .and_then(|body| body.mesh.nodes().get(node.node.1).copied())
-                                    .unwrap_or(node.position);
-                                let y = x + geometry.jump(r, previous).unwrap_or_else(Vector::<D>::zeros);
-                                let (old, new) = &poses[ob];
-                                new.position(&old.to_body(&y)) - y
-                            }
-                            None => Vector::<D>::zeros(),
-                        })
-                        .collect()
+                    let mut q = all_q.clone();
+                    q[b] = coordinates(sigma * w);
+                    partner_motion(joint, accepted.as_deref(), &q, geometry, previous)
                 };
                 // the force on the body of friction cell c: g_c κ_r Σ_j Λ_t,c,j T_j (the
                 // opposite of the slave side's, synovia_time::results::pair_records)
@@ -1326,6 +1348,18 @@ impl RigidDriver {
         let record = self.finish(joint, geometry, record, &level.contact, &values, t, solves)?;
         self.accepted = Some(self.q.clone());
         Ok((record, level))
+    }
+
+    /// [`partner_motion`] from the last accepted level to the current coordinates (every
+    /// coordinate prescribed), for [`NonlinearContact::step_with_partner_motion`].
+    #[allow(clippy::type_complexity)]
+    fn partner_motion_fn<'a, const D: usize>(
+        &self,
+        joint: &'a JointModel<D>,
+    ) -> impl Fn(&ContactGeometry<D>, &[Vec<Vector<D>>]) -> Vec<Vector<D>> + 'a {
+        let accepted = self.accepted.clone();
+        let q = self.q.clone();
+        move |geometry, previous| partner_motion(joint, accepted.as_deref(), &q, geometry, previous)
     }
 
     /// The rigid bodies posed at the force-controlled coordinates `z`, the contact geometry

@@ -1238,6 +1238,60 @@ impl<const D: usize> NonlinearContact<D> {
         self.whole_level(model, t, solver, None, None, Some(control))
     }
 
+    /// Solves the level `t` from the committed state with contact partners that moved by a
+    /// prescribed motion since it (rigid bodies whose coordinates are all prescribed, already
+    /// posed at `t`): Newton's method as in [`Self::step_gap_controlled`] with nothing to search
+    /// for, the contact geometry built at the current poses (in finite strain on the deformed
+    /// configuration between passes), and Tresca friction with the slip bounds
+    /// `g_c = F_c |Λ_n|` of the committed state and the slip measured relative to the partners
+    /// (docs/model.md (10.5)),
+    ///
+    /// ```text
+    /// s_c = T_cᵀ ([u](x_c) − [u_{i−1}](x_c) − w_c),   w_c = motion(geometry, u_{i−1})_c,
+    /// ```
+    ///
+    /// `w_c` the motion of the partner's material point at the node's position
+    /// `y_c = x_c + [u_{i−1}](x_c)` since the committed state, evaluated on every geometry the
+    /// iteration builds ([`ContactGeometry::set_partner_motion`]). The first level from the
+    /// reference configuration is frictionless (as [`Self::step_to`]). No cut-back (a sub-level
+    /// would need the partners' poses between the committed state and `t`): on failure the
+    /// committed state is unchanged.
+    ///
+    /// # Errors
+    /// As [`Self::step_gap_controlled`].
+    #[allow(clippy::type_complexity)]
+    pub fn step_with_partner_motion(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        motion: &dyn Fn(&ContactGeometry<D>, &[Vec<Vector<D>>]) -> Vec<Vector<D>>,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
+        // a gap control whose resultant is its target at any `w`: the search accepts the first
+        // trial, the partners stay where they are posed
+        let pose = |_: Real| {};
+        let sensitivity = |geometry: &ContactGeometry<D>| vec![0.0; geometry.len()];
+        let resultant = |_: &ContactGeometry<D>, _: &[Real]| 0.0;
+        let moved =
+            |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>], _: Real| motion(geometry, previous);
+        let friction_resultant = |_: &ContactGeometry<D>, _: &[usize], _: &[Real], _: &[Real]| 0.0;
+        let mut control = GapControl {
+            pose: &pose,
+            sensitivity: &sensitivity,
+            resultant: &resultant,
+            target: 0.0,
+            tolerance: 1.0,
+            slope: 0.0,
+            w: 0.0,
+            overlap: 0.0,
+            max_step: 0.0,
+            base: 0.0,
+            trials: 0,
+            friction: Some(GapFriction { motion: &moved, resultant: &friction_resultant }),
+        };
+        self.step_gap_controlled(model, t, solver, &mut control)
+    }
+
     /// Solves one level `t` with extra terms from the committed state (docs/model.md (12.1)):
     ///
     /// ```text
