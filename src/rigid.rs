@@ -1149,10 +1149,15 @@ impl RigidDriver {
     /// Friction against rigid bodies whose coordinates are all prescribed: the same slip origin,
     /// the partners' motion `w_r = P(q)(P(q_{i−1})⁻¹(y_r)) − y_r` from the last accepted
     /// coordinates to the prescribed ones ([`NonlinearContact::step_with_partner_motion`], no
-    /// search, no cut-back).
+    /// search, no cut-back). Several force-controlled coordinates: the translation with the
+    /// largest applied force inside the iteration, the others by a quasi-Newton iteration around
+    /// whole Newton levels ([`Self::several_level`]).
     ///
     /// # Errors
-    /// [`JointError::Unsupported`] for several force-controlled coordinates; the errors of the Newton iteration (no convergence, a force-controlled body not resisted).
+    /// [`JointError::Unsupported`] for several force-controlled coordinates none of which is a
+    /// translation with a non-zero applied force; [`JointError::Invalid`] for a force-controlled
+    /// coordinate that nothing resists, or no balance within `max_solves` Newton levels; the
+    /// errors of the Newton iteration (no convergence, a force-controlled body not resisted).
     pub(crate) fn nonlinear_level<const D: usize>(
         &mut self,
         joint: &JointModel<D>,
@@ -1165,7 +1170,6 @@ impl RigidDriver {
         let values = self.set_controls(joint, t)?;
         let unknowns = force_unknowns(bodies);
         let length = joint.model_size();
-        let params = joint.force_control_params();
         self.set_poses(joint);
         let owner_of = joint.pair_rigid_owner(nl.geometry());
         let rigid_friction = nl
@@ -1186,146 +1190,10 @@ impl RigidDriver {
                 (nl.step_to(model, t, solver)?, 1)
             }
             &[(b, k)] => {
-                let f = values[b][k];
-                let sigma = if f < 0.0 { -1.0 } else { 1.0 };
                 let scale = force_scales(bodies, &values, &unknowns, length)[0];
-                let body = &bodies[b];
-                let q0 = self.q[b].clone();
-                let current = std::cell::Cell::new(q0[k]);
-                let coordinates = |z: Real| {
-                    let mut q = q0.clone();
-                    q[k] = z;
-                    q
-                };
-                let pose = |w: Real| {
-                    current.set(sigma * w);
-                    body.pose.set(body.pose_of(&coordinates(sigma * w)));
-                };
-                let owner = joint.pair_rigid_owner(nl.geometry());
-                let owned = |pair: usize| owner.get(pair).copied().flatten() == Some(b);
-                let sensitivity = |geometry: &ContactGeometry<D>| -> Vec<Real> {
-                    let q = coordinates(current.get());
-                    geometry
-                        .nodes
-                        .iter()
-                        .map(|node| {
-                            if owned(node.pair) {
-                                sigma * node.normal.dot(&body.velocity(&q, k, &node.position))
-                            } else {
-                                0.0
-                            }
-                        })
-                        .collect()
-                };
-                let resultant = |geometry: &ContactGeometry<D>, lambda_n: &[Real]| -> Real {
-                    let q = coordinates(current.get());
-                    let generalised: Real = geometry
-                        .nodes
-                        .iter()
-                        .zip(lambda_n)
-                        .filter(|(node, _)| owned(node.pair))
-                        .map(|(node, l)| node.weight * l * node.normal.dot(&body.velocity(&q, k, &node.position)))
-                        .sum();
-                    -sigma * generalised
-                };
-                // friction (docs/model.md (10.5)): the motion since the last accepted level of
-                // every rigid partner's material point at the nodes' deformed positions, body
-                // `b` at the trial's `w`, and the friction forces' part of the generalised force
-                let accepted = self.accepted.clone();
-                let all_q = self.q.clone();
-                let motion = |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>], w: Real| -> Vec<Vector<D>> {
-                    let mut q = all_q.clone();
-                    q[b] = coordinates(sigma * w);
-                    partner_motion(joint, accepted.as_deref(), &q, geometry, previous)
-                };
-                // the force on the body of friction cell c: g_c κ_r Σ_j Λ_t,c,j T_j (the
-                // opposite of the slave side's, synovia_time::results::pair_records)
-                let friction_resultant =
-                    |geometry: &ContactGeometry<D>, cells: &[usize], bounds: &[Real], lambda_t: &[Real]| -> Real {
-                        let q = coordinates(current.get());
-                        let comps = D - 1;
-                        let generalised: Real = cells
-                            .iter()
-                            .zip(bounds)
-                            .enumerate()
-                            .filter_map(|(c, (&r, &g))| {
-                                let node = geometry.nodes.get(r).filter(|node| owned(node.pair))?;
-                                let lt = lambda_t.get(c * comps..(c + 1) * comps)?;
-                                let v = body.velocity(&q, k, &node.position);
-                                Some(
-                                    node.tangents
-                                        .iter()
-                                        .zip(lt)
-                                        .map(|(t, l)| g * node.weight * l * t.dot(&v))
-                                        .sum::<Real>(),
-                                )
-                            })
-                            .sum();
-                        -sigma * generalised
-                    };
-                let friction = rigid_friction
-                    .then_some(GapFriction { motion: &motion, resultant: &friction_resultant });
-                // each pass commits its solution: with friction the next pass starts again from
-                // the last accepted level (the slip origin and the frozen slip bounds are that
-                // level's, not the previous pass's)
-                let start = rigid_friction.then(|| nl.checkpoint());
-                let mut w = sigma * q0[k];
-                let mut trials = 0;
-                let mut passes = 0;
-                let mut iterations = 0;
-                let level = loop {
-                    if let (Some(c), true) = (&start, passes > 0) {
-                        nl.restore(c.clone())?;
-                    }
-                    let mut control = GapControl {
-                        pose: &pose,
-                        sensitivity: &sensitivity,
-                        resultant: &resultant,
-                        target: sigma * f,
-                        tolerance: params.tolerance * scale,
-                        slope: self.slope.unwrap_or(0.0),
-                        w,
-                        overlap: 1e-4 * length,
-                        max_step: 1e-2 * length,
-                        base: w,
-                        trials: 0,
-                        friction,
-                    };
-                    let mut level = nl.step_gap_controlled(model, t, solver, &mut control)?;
-                    trials += control.trials;
-                    iterations += level.report.total_iterations;
-                    level.report.total_iterations = iterations;
-                    passes += 1;
-                    if control.slope > 0.0 && control.slope.is_finite() {
-                        self.slope = Some(control.slope);
-                    }
-                    w = control.w;
-                    let moved = (w - control.base).abs() * if k < D { 1.0 } else { length };
-                    tracing::debug!(t, passes, w, base = control.base, trials = control.trials, "gap-controlled level");
-                    if moved <= params.geometry_tolerance * length {
-                        break level;
-                    }
-                    if passes >= 8 {
-                        return Err(JointError::Invalid(format!(
-                            "t = {t}: the force-controlled `{}`.{} moved by {moved:e} from the pose of its contact geometry after {passes} rebuilds (tolerance {:e})",
-                            body.name,
-                            dof_names(D)[k],
-                            params.geometry_tolerance * length
-                        )));
-                    }
-                };
-                self.q[b][k] = sigma * w;
-                (level, trials)
+                self.gap_level(joint, nl, t, solver, &values, (b, k), scale, rigid_friction)?
             }
-            _ => {
-                return Err(JointError::Unsupported {
-                    solver: "nonlinear (Newton)".into(),
-                    feature: format!(
-                        "{} force-controlled degrees of freedom of rigid bodies with nonlinear materials or finite strain (one is supported; prescribe the others)",
-                        unknowns.len()
-                    ),
-                })
-            }
+            _ => self.several_level(joint, nl, t, solver, &values, &unknowns, rigid_friction)?,
         };
         self.set_poses(joint);
         for (bi, body) in bodies.iter().enumerate() {
@@ -1360,6 +1228,335 @@ impl RigidDriver {
         let accepted = self.accepted.clone();
         let q = self.q.clone();
         move |geometry, previous| partner_motion(joint, accepted.as_deref(), &q, geometry, previous)
+    }
+
+    /// One Newton level with the force-controlled coordinate `(b, k)` found inside the
+    /// iteration ([`NonlinearContact::step_gap_controlled`], see [`Self::nonlinear_level`]),
+    /// every other coordinate at its value in `self.q`; commits the level and sets
+    /// `self.q[b][k]`. Returns the level and the number of trials of the search.
+    #[allow(clippy::too_many_arguments)]
+    fn gap_level<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        nl: &mut NonlinearContact<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        values: &[Vec<Real>],
+        (b, k): (usize, usize),
+        scale: Real,
+        rigid_friction: bool,
+    ) -> Result<(NonlinearResult<D>, usize), JointError> {
+        let model = joint.model();
+        let bodies = joint.rigid_bodies();
+        let length = joint.model_size();
+        let params = joint.force_control_params();
+        let f = values[b][k];
+        let sigma = if f < 0.0 { -1.0 } else { 1.0 };
+        let body = &bodies[b];
+        let q0 = self.q[b].clone();
+        let current = std::cell::Cell::new(q0[k]);
+        let coordinates = |z: Real| {
+            let mut q = q0.clone();
+            q[k] = z;
+            q
+        };
+        let pose = |w: Real| {
+            current.set(sigma * w);
+            body.pose.set(body.pose_of(&coordinates(sigma * w)));
+        };
+        let owner = joint.pair_rigid_owner(nl.geometry());
+        let owned = |pair: usize| owner.get(pair).copied().flatten() == Some(b);
+        let sensitivity = |geometry: &ContactGeometry<D>| -> Vec<Real> {
+            let q = coordinates(current.get());
+            geometry
+                .nodes
+                .iter()
+                .map(|node| {
+                    if owned(node.pair) {
+                        sigma * node.normal.dot(&body.velocity(&q, k, &node.position))
+                    } else {
+                        0.0
+                    }
+                })
+                .collect()
+        };
+        let resultant = |geometry: &ContactGeometry<D>, lambda_n: &[Real]| -> Real {
+            let q = coordinates(current.get());
+            let generalised: Real = geometry
+                .nodes
+                .iter()
+                .zip(lambda_n)
+                .filter(|(node, _)| owned(node.pair))
+                .map(|(node, l)| node.weight * l * node.normal.dot(&body.velocity(&q, k, &node.position)))
+                .sum();
+            -sigma * generalised
+        };
+        // friction (docs/model.md (10.5)): the motion since the last accepted level of
+        // every rigid partner's material point at the nodes' deformed positions, body
+        // `b` at the trial's `w`, and the friction forces' part of the generalised force
+        let accepted = self.accepted.clone();
+        let all_q = self.q.clone();
+        let motion =
+            |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>], w: Real| -> Vec<Vector<D>> {
+                let mut q = all_q.clone();
+                q[b] = coordinates(sigma * w);
+                partner_motion(joint, accepted.as_deref(), &q, geometry, previous)
+            };
+        // the force on the body of friction cell c: g_c κ_r Σ_j Λ_t,c,j T_j (the
+        // opposite of the slave side's, synovia_time::results::pair_records)
+        let friction_resultant =
+            |geometry: &ContactGeometry<D>, cells: &[usize], bounds: &[Real], lambda_t: &[Real]| -> Real {
+                let q = coordinates(current.get());
+                let comps = D - 1;
+                let generalised: Real = cells
+                    .iter()
+                    .zip(bounds)
+                    .enumerate()
+                    .filter_map(|(c, (&r, &g))| {
+                        let node = geometry.nodes.get(r).filter(|node| owned(node.pair))?;
+                        let lt = lambda_t.get(c * comps..(c + 1) * comps)?;
+                        let v = body.velocity(&q, k, &node.position);
+                        Some(
+                            node.tangents
+                                .iter()
+                                .zip(lt)
+                                .map(|(t, l)| g * node.weight * l * t.dot(&v))
+                                .sum::<Real>(),
+                        )
+                    })
+                    .sum();
+                -sigma * generalised
+            };
+        let friction =
+            rigid_friction.then_some(GapFriction { motion: &motion, resultant: &friction_resultant });
+        // each pass commits its solution: with friction the next pass starts again from
+        // the last accepted level (the slip origin and the frozen slip bounds are that
+        // level's, not the previous pass's)
+        let start = rigid_friction.then(|| nl.checkpoint());
+        let mut w = sigma * q0[k];
+        let mut trials = 0;
+        let mut passes = 0;
+        let mut iterations = 0;
+        let level = loop {
+            if let (Some(c), true) = (&start, passes > 0) {
+                nl.restore(c.clone())?;
+            }
+            let mut control = GapControl {
+                pose: &pose,
+                sensitivity: &sensitivity,
+                resultant: &resultant,
+                target: sigma * f,
+                tolerance: params.tolerance * scale,
+                slope: self.slope.unwrap_or(0.0),
+                w,
+                overlap: 1e-4 * length,
+                max_step: 1e-2 * length,
+                base: w,
+                trials: 0,
+                friction,
+            };
+            let mut level = nl.step_gap_controlled(model, t, solver, &mut control)?;
+            trials += control.trials;
+            iterations += level.report.total_iterations;
+            level.report.total_iterations = iterations;
+            passes += 1;
+            if control.slope > 0.0 && control.slope.is_finite() {
+                self.slope = Some(control.slope);
+            }
+            w = control.w;
+            let moved = (w - control.base).abs() * if k < D { 1.0 } else { length };
+            tracing::debug!(
+                t,
+                passes,
+                w,
+                base = control.base,
+                trials = control.trials,
+                "gap-controlled level"
+            );
+            if moved <= params.geometry_tolerance * length {
+                break level;
+            }
+            if passes >= 8 {
+                return Err(JointError::Invalid(format!(
+                    "t = {t}: the force-controlled `{}`.{} moved by {moved:e} from the pose of its contact geometry after {passes} rebuilds (tolerance {:e})",
+                    body.name,
+                    dof_names(D)[k],
+                    params.geometry_tolerance * length
+                )));
+            }
+        };
+        self.q[b][k] = sigma * w;
+        Ok((level, trials))
+    }
+
+    /// A Newton level with several force-controlled coordinates (docs/model.md §12): the
+    /// translation with the largest applied force, `p`, is found inside the Newton iteration
+    /// ([`Self::gap_level`]), the others, `z`, by a quasi-Newton iteration around it on their
+    /// balance
+    ///
+    /// ```text
+    /// r_j(z) = Q_j(z) + F_j = 0,     z ← z − J⁻¹ r,
+    /// ```
+    ///
+    /// each evaluation of `r` a whole Newton level from the level's start (a checkpoint
+    /// restored), `p` balanced in it; `J` by finite differences (a step of 1e-6 of the model size,
+    /// or 1e-6 rad), carried between levels and updated by Broyden's formula, computed afresh
+    /// when a step did not reduce the largest relative error fourfold (as the linear path,
+    /// docs/model.md (10.3)); steps capped at 2 % of the model size or 0.02 rad and halved (up
+    /// to 3 times) until the scaled norm `‖r/scale‖` decreases. Accepted when
+    /// `|r_j| ≤ tolerance × scale_j` ([`ForceControlParams`]). Returns the accepted level (its
+    /// iterations and contact solves summed over the evaluations) and the contact solves.
+    #[allow(clippy::too_many_arguments)]
+    fn several_level<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        nl: &mut NonlinearContact<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        values: &[Vec<Real>],
+        unknowns: &[(usize, usize)],
+        rigid_friction: bool,
+    ) -> Result<(NonlinearResult<D>, usize), JointError> {
+        let bodies = joint.rigid_bodies();
+        let length = joint.model_size();
+        let params = joint.force_control_params();
+        let scales = force_scales(bodies, values, unknowns, length);
+        let Some(p) = unknowns
+            .iter()
+            .enumerate()
+            .filter(|(_, &(b, k))| k < D && values[b][k] != 0.0)
+            .max_by(|(_, &(b1, k1)), (_, &(b2, k2))| values[b1][k1].abs().total_cmp(&values[b2][k2].abs()))
+            .map(|(i, _)| i)
+        else {
+            return Err(JointError::Unsupported {
+                solver: "nonlinear (Newton)".into(),
+                feature: format!(
+                    "{} force-controlled degrees of freedom of rigid bodies with nonlinear materials or finite strain, none of them a translation with a non-zero applied force at t = {t} (the Newton path finds one such translation inside the iteration and the others around it)",
+                    unknowns.len()
+                ),
+            });
+        };
+        let extras: Vec<(usize, usize)> =
+            unknowns.iter().enumerate().filter(|(i, _)| *i != p).map(|(_, u)| *u).collect();
+        let extra_scales: Vec<Real> =
+            scales.iter().enumerate().filter(|(i, _)| *i != p).map(|(_, s)| *s).collect();
+        let target: Vec<Real> = extras.iter().map(|&(b, k)| values[b][k]).collect();
+        let m = extras.len();
+        let start = nl.checkpoint();
+        let mut first = true;
+        let evaluations = std::cell::Cell::new(0usize);
+        let solves = std::cell::Cell::new(0usize);
+        let iterations = std::cell::Cell::new(0usize);
+        // r(z): a whole Newton level from the level's start with the extra coordinates at `z`
+        let mut evaluate = |this: &mut Self,
+                            nl: &mut NonlinearContact<D>,
+                            z: &[Real]|
+         -> Result<(NonlinearResult<D>, Vec<Real>, Real), JointError> {
+            if !std::mem::take(&mut first) {
+                nl.restore(start.clone())?;
+            }
+            for (&(b, k), &zj) in extras.iter().zip(z) {
+                this.q[b][k] = zj;
+            }
+            this.set_poses(joint);
+            let (level, trials) =
+                this.gap_level(joint, nl, t, solver, values, unknowns[p], scales[p], rigid_friction)?;
+            evaluations.set(evaluations.get() + 1);
+            solves.set(solves.get() + trials);
+            iterations.set(iterations.get() + level.report.total_iterations);
+            this.set_poses(joint);
+            let geometry = nl.geometry();
+            let record = StepRecord {
+                time: t,
+                pairs: synovia_time::results::pair_records(geometry, &level.contact),
+                ..Default::default()
+            };
+            let reactions = this.reactions(joint, geometry, &record, &level.contact, t)?;
+            let r: Vec<Real> = extras.iter().zip(&target).map(|(&(b, k), f)| reactions[b][k] + f).collect();
+            let error = r.iter().zip(&extra_scales).map(|(ri, s)| ri.abs() / s).fold(0.0, Real::max);
+            tracing::debug!(t, ?z, ?r, error, "force control around the Newton level");
+            Ok((level, r, error))
+        };
+        let mut z: Vec<Real> = extras.iter().map(|&(b, k)| self.q[b][k]).collect();
+        let (mut level, mut r, mut error) = evaluate(self, nl, &z)?;
+        let mut jac = self.jacobian.clone().filter(|j| j.nrows() == m);
+        let mut fresh = false;
+        let mut previous: Option<(Vec<Real>, Vec<Real>, Real)> = None;
+        while error > params.tolerance {
+            if evaluations.get() >= params.max_solves {
+                let names: Vec<String> = extras
+                    .iter()
+                    .map(|&(b, k)| format!("`{}`.{}", bodies[b].name, dof_names(D)[k]))
+                    .collect();
+                return Err(JointError::Invalid(format!(
+                    "t = {t}: the force-controlled degrees of freedom {} did not reach equilibrium in {} Newton levels (relative balance error {error:.3e}, tolerance {:.1e})",
+                    names.join(", "),
+                    evaluations.get(),
+                    params.tolerance
+                )));
+            }
+            match (&mut jac, &previous) {
+                (Some(_), Some((_, _, ep))) if (error > 0.25 * ep || params.fresh_jacobian) && !fresh => {
+                    jac = None
+                }
+                (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
+                _ => {}
+            }
+            fresh = false;
+            if jac.is_none() {
+                let mut j = nalgebra::DMatrix::<Real>::zeros(m, m);
+                for col in 0..m {
+                    let h = if extras[col].1 < D { 1e-6 * length } else { 1e-6 };
+                    let mut zh = z.clone();
+                    zh[col] += h;
+                    let (_, rh, _) = evaluate(self, nl, &zh)?;
+                    for row in 0..m {
+                        j[(row, col)] = (rh[row] - r[row]) / h;
+                    }
+                    // a coordinate whose motion changes no balance beyond rounding is not
+                    // resisted (e.g. a rotation of a sphere about its centre)
+                    if (0..m).all(|row| (rh[row] - r[row]).abs() <= 1e-9 * extra_scales[row]) {
+                        return Err(self.unresisted(joint, &extras[col..=col]));
+                    }
+                }
+                jac = Some(j);
+                fresh = true;
+            }
+            let Some(dz) = jac.as_ref().and_then(|j| newton_step(j, &r)) else {
+                return Err(self.unresisted(joint, &extras));
+            };
+            let mut next: Vec<Real> = z.iter().zip(&dz).map(|(a, d)| a + d).collect();
+            limit_step::<D>(&mut next, &z, &extras, length);
+            // backtracking on the scaled norm of r (the residual is piecewise affine: a cell
+            // that changes between sticking and slipping, a node that closes or opens, bends
+            // it, and a full step across such a kink may overshoot)
+            let merit =
+                |r: &[Real]| r.iter().zip(&extra_scales).map(|(ri, s)| (ri / s).powi(2)).sum::<Real>().sqrt();
+            let m0 = merit(&r);
+            let z0 = z.clone();
+            previous = Some((z0.clone(), r.clone(), error));
+            let mut alpha = 1.0;
+            loop {
+                z = z0.iter().zip(&next).map(|(a, b)| a + alpha * (b - a)).collect();
+                (level, r, error) = evaluate(self, nl, &z)?;
+                if error <= params.tolerance || merit(&r) <= (1.0 - 1e-4 * alpha) * m0 || alpha <= 0.125 {
+                    break;
+                }
+                alpha *= 0.5;
+            }
+        }
+        self.jacobian = jac;
+        level.report.total_iterations = iterations.get();
+        level.report.sublevels = evaluations.get();
+        tracing::debug!(
+            t,
+            evaluations = evaluations.get(),
+            iterations = iterations.get(),
+            solves = solves.get(),
+            error,
+            "several force-controlled coordinates"
+        );
+        Ok((level, solves.get()))
     }
 
     /// The rigid bodies posed at the force-controlled coordinates `z`, the contact geometry
