@@ -1010,16 +1010,7 @@ impl RigidDriver {
                         continue;
                     }
                 }
-                // a Jacobian that did not reduce the error fourfold is refreshed (the residual
-                // is piecewise affine: a contact region that lifts off or closes changes its
-                // slope); otherwise it is updated by Broyden's formula
-                match (&mut jac, &previous) {
-                    (Some(_), Some((_, _, ep))) if (error > 0.25 * ep || params.fresh_jacobian) && !fresh => {
-                        jac = None
-                    }
-                    (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
-                    _ => {}
-                }
+                update_jacobian(&mut jac, previous.as_ref(), (&z, &r, error), params.fresh_jacobian, fresh);
                 fresh = false;
                 if jac.is_none() {
                     match self.fd_jacobian(
@@ -1495,13 +1486,7 @@ impl RigidDriver {
                     params.tolerance
                 )));
             }
-            match (&mut jac, &previous) {
-                (Some(_), Some((_, _, ep))) if (error > 0.25 * ep || params.fresh_jacobian) && !fresh => {
-                    jac = None
-                }
-                (Some(j), Some((zp, rp, _))) => broyden(j, &z, &r, zp, rp),
-                _ => {}
-            }
+            update_jacobian(&mut jac, previous.as_ref(), (&z, &r, error), params.fresh_jacobian, fresh);
             fresh = false;
             if jac.is_none() {
                 let mut j = nalgebra::DMatrix::<Real>::zeros(m, m);
@@ -1968,6 +1953,27 @@ fn newton_step(j: &nalgebra::DMatrix<Real>, r: &[Real]) -> Option<Vec<Real>> {
 }
 
 /// Broyden's update `J += (Δr − J Δz) Δzᵀ / (Δzᵀ Δz)`.
+/// The Jacobian of the quasi-Newton iteration over the force-controlled coordinates after the
+/// iterate `(z, r, error)`: dropped (to be taken again by finite differences) when the last
+/// step did not reduce the error fourfold or `always_fresh` asks for it — unless it was just
+/// taken (`fresh`) — since the residual is piecewise affine (a contact region that lifts off
+/// or closes changes its slope); otherwise updated by Broyden's formula from the previous
+/// iterate `(z_p, r_p, error_p)`.
+#[allow(clippy::type_complexity)]
+fn update_jacobian(
+    jac: &mut Option<nalgebra::DMatrix<Real>>,
+    previous: Option<&(Vec<Real>, Vec<Real>, Real)>,
+    (z, r, error): (&[Real], &[Real], Real),
+    always_fresh: bool,
+    fresh: bool,
+) {
+    match (jac.as_mut(), previous) {
+        (Some(_), Some((_, _, ep))) if (error > 0.25 * ep || always_fresh) && !fresh => *jac = None,
+        (Some(j), Some((zp, rp, _))) => broyden(j, z, r, zp, rp),
+        _ => {}
+    }
+}
+
 fn broyden(j: &mut nalgebra::DMatrix<Real>, z: &[Real], r: &[Real], zp: &[Real], rp: &[Real]) {
     let dz = nalgebra::DVector::from_iterator(z.len(), z.iter().zip(zp).map(|(a, b)| a - b));
     let dr = nalgebra::DVector::from_iterator(r.len(), r.iter().zip(rp).map(|(a, b)| a - b));
