@@ -1475,13 +1475,9 @@ impl RigidDriver {
         let mut previous: Option<(Vec<Real>, Vec<Real>, Real)> = None;
         while error > params.tolerance {
             if evaluations.get() >= params.max_solves {
-                let names: Vec<String> = extras
-                    .iter()
-                    .map(|&(b, k)| format!("`{}`.{}", bodies[b].name, dof_names(D)[k]))
-                    .collect();
                 return Err(JointError::Invalid(format!(
                     "t = {t}: the force-controlled degrees of freedom {} did not reach equilibrium in {} Newton levels (relative balance error {error:.3e}, tolerance {:.1e})",
-                    names.join(", "),
+                    dof_list(bodies, &extras),
                     evaluations.get(),
                     params.tolerance
                 )));
@@ -1877,13 +1873,9 @@ impl RigidDriver {
     }
 
     fn unresisted<const D: usize>(&self, joint: &JointModel<D>, unknowns: &[(usize, usize)]) -> JointError {
-        let names: Vec<String> = unknowns
-            .iter()
-            .map(|&(b, k)| format!("`{}`.{}", joint.rigid_bodies()[b].name, dof_names(D)[k]))
-            .collect();
         JointError::Invalid(format!(
             "force-controlled degree(s) of freedom {} are not resisted: no contact pair of the rigid body closes a gap when it moves along the applied force, and no tied part holds it (add a contact pair or a tie, or prescribe the degree of freedom)",
-            names.join(", ")
+            dof_list(joint.rigid_bodies(), unknowns)
         ))
     }
 
@@ -1895,27 +1887,30 @@ impl RigidDriver {
         solves: usize,
         t: Real,
     ) -> JointError {
-        let names: Vec<String> = unknowns
-            .iter()
-            .map(|&(b, k)| format!("`{}`.{}", joint.rigid_bodies()[b].name, dof_names(D)[k]))
-            .collect();
         JointError::Invalid(format!(
             "t = {t}: the force-controlled degrees of freedom {} did not reach equilibrium in {solves} contact solves (best relative balance error {:.3e}, tolerance {:.1e})",
-            names.join(", "),
+            dof_list(joint.rigid_bodies(), unknowns),
             best.as_ref().map_or(Real::INFINITY, |(e, _)| *e),
             joint.force_control_params().tolerance
         ))
     }
 }
 
-/// `scale_j`: the largest applied force of the owning body (translations), times the model
-/// size for moments, or the largest applied moment, whichever is larger.
+/// The coordinates `(body, dof)` named for a message: "`femur`.ty, `femur`.rx".
+fn dof_list<const D: usize>(bodies: &[RigidBody<D>], unknowns: &[(usize, usize)]) -> String {
+    let names: Vec<String> =
+        unknowns.iter().map(|&(b, k)| format!("`{}`.{}", bodies[b].name, dof_names(D)[k])).collect();
+    names.join(", ")
+}
+
 /// The force-controlled coordinates of the rigid bodies, `(body, dof)`, the unknowns of a
 /// level's force balance (10.3).
 fn force_unknowns<const D: usize>(bodies: &[RigidBody<D>]) -> Vec<(usize, usize)> {
     bodies.iter().enumerate().flat_map(|(bi, b)| b.force_dofs().into_iter().map(move |k| (bi, k))).collect()
 }
 
+/// `scale_j`: the largest applied force of the owning body (translations), times the model
+/// size for moments, or the largest applied moment, whichever is larger.
 fn force_scales<const D: usize>(
     bodies: &[RigidBody<D>],
     values: &[Vec<Real>],
