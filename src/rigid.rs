@@ -1393,8 +1393,10 @@ impl RigidDriver {
     /// restored), `p` balanced in it; `J` by finite differences (a step of 1e-6 of the model size,
     /// or 1e-6 rad), carried between levels and updated by Broyden's formula, computed afresh
     /// when a step did not reduce the largest relative error fourfold (as the linear path,
-    /// docs/model.md (10.3)); steps capped at 2 % of the model size or 0.02 rad and halved (up
-    /// to 3 times) until the scaled norm `‖r/scale‖` decreases. Accepted when
+    /// docs/model.md (10.3)); each step the linear path's line search on the potential
+    /// (`LineSearch`): along the modified Newton direction `d`, `z(α) = z + α d` (α from the
+    /// step caps, 2 % of the model size or 0.02 rad) until `φ(α) = −r(z(α))·d` has dropped to a
+    /// tenth of `|φ(0)|` (regula falsi once it changed sign) or the error fourfold. Accepted when
     /// `|r_j| ≤ tolerance × scale_j` ([`ForceControlParams`]). Returns the accepted level (its
     /// iterations and contact solves summed over the evaluations) and the contact solves.
     #[allow(clippy::too_many_arguments)]
@@ -1450,6 +1452,7 @@ impl RigidDriver {
                 this.q[b][k] = zj;
             }
             this.set_poses(joint);
+            tracing::debug!(t, ?z, "force control around the Newton level: evaluation");
             let (level, trials) =
                 this.gap_level(joint, nl, t, solver, values, unknowns[p], scales[p], rigid_friction)?;
             evaluations.set(evaluations.get() + 1);
@@ -1503,27 +1506,30 @@ impl RigidDriver {
                 jac = Some(j);
                 fresh = true;
             }
-            let Some(dz) = jac.as_ref().and_then(|j| newton_step(j, &r)) else {
+            // the linear path's line search on the potential (`LineSearch`, docs/model.md
+            // (10.3)): the modified Newton direction, then `α` along it until `φ = −r·d` has
+            // dropped to a tenth (bracketed by regula falsi once it changed sign) or the error
+            // fourfold. (The scaled norm of `r` is no merit here: with the femur of tkr3d on
+            // two condyles the moment saturates at ± the load times the half distance between
+            // them once one lifts off, balance lies in a window of ≈ 1e-3 rad, and steps halved
+            // from the 0.02 rad cap jumped between the two saturated sides, 40 Newton levels
+            // at pose 0.)
+            let Some(mut ls) =
+                jac.as_ref().and_then(|j| LineSearch::start::<D>(j, &z, &r, error, &extras, length))
+            else {
                 return Err(self.unresisted(joint, &extras));
             };
-            let mut next: Vec<Real> = z.iter().zip(&dz).map(|(a, d)| a + d).collect();
-            limit_step::<D>(&mut next, &z, &extras, length);
-            // backtracking on the scaled norm of r (the residual is piecewise affine: a cell
-            // that changes between sticking and slipping, a node that closes or opens, bends
-            // it, and a full step across such a kink may overshoot)
-            let merit =
-                |r: &[Real]| r.iter().zip(&extra_scales).map(|(ri, s)| (ri / s).powi(2)).sum::<Real>().sqrt();
-            let m0 = merit(&r);
-            let z0 = z.clone();
-            previous = Some((z0.clone(), r.clone(), error));
-            let mut alpha = 1.0;
+            tracing::debug!(t, ?ls.direction, ls.alpha, "force control around the Newton level: line search");
+            previous = Some((z.clone(), r.clone(), error));
             loop {
-                z = z0.iter().zip(&next).map(|(a, b)| a + alpha * (b - a)).collect();
+                z = ls.at(ls.alpha);
                 (level, r, error) = evaluate(self, nl, &z)?;
-                if error <= params.tolerance || merit(&r) <= (1.0 - 1e-4 * alpha) * m0 || alpha <= 0.125 {
+                if error <= params.tolerance || evaluations.get() >= params.max_solves {
                     break;
                 }
-                alpha *= 0.5;
+                if ls.next_alpha(-dot(&r, &ls.direction), error).is_none() {
+                    break;
+                }
             }
         }
         self.jacobian = jac;
