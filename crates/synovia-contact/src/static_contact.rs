@@ -720,6 +720,7 @@ impl<const D: usize> StaticContact<D> {
     /// `A⁻¹ F` through the context's recycled load solves (recycled when `F` is a combination
     /// of loads solved before, [`synovia_linalg::recycling`]); `None` for a semi-coercive
     /// model, whose proximal iteration changes the load every iteration.
+    #[tracing::instrument(level = "debug", skip_all)]
     fn recycled_load_solution(
         &self,
         operator: &CholeskyOperator<'_>,

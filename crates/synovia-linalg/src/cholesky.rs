@@ -64,19 +64,93 @@ pub struct TrailingBlock {
 impl TrailingBlock {
     /// Solves `(A⁻¹)_cc`-products in place: `X ← L₂₂⁻ᵀ L₂₂⁻¹ X` for the `k × r` block `x`
     /// (rows in the order of [`Self::dofs`]).
+    ///
+    /// The forward half starts at the first non-zero row `f` of `X`: with `X = [0; X₂]`
+    /// (`X₂` from row `f`), `L₂₂⁻¹ X = [0; L_ff⁻¹ X₂]` for the trailing `(k − f) × (k − f)`
+    /// block `L_ff` of `L₂₂`, so `(k − f)²` instead of `k²` work per column (the backward
+    /// half `L₂₂⁻ᵀ` runs over all rows). Right-hand sides sorted by their first non-zero row
+    /// and solved in groups ([`Self::solve_sparse_columns`]) make use of it.
     pub fn solve_in_place(&self, mut x: MatMut<'_, f64>) {
-        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-            self.factor.as_ref(),
-            x.rb_mut(),
-            Par::Seq,
-        );
+        let k = x.nrows();
+        let first = (0..k).find(|&i| (0..x.ncols()).any(|c| x[(i, c)] != 0.0)).unwrap_or(k);
+        if first < k {
+            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+                self.factor.as_ref().submatrix(first, first, k - first, k - first),
+                x.rb_mut().subrows_mut(first, k - first),
+                Par::Seq,
+            );
+        }
         faer::linalg::triangular_solve::solve_upper_triangular_in_place(
             self.factor.as_ref().transpose(),
             x.rb_mut(),
             Par::Seq,
         );
     }
+
+    /// `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` for sparse right-hand sides `c_j` given as `(position, value)`
+    /// lists in the positions of [`Self::dofs`] (repeated positions add up), returned densely
+    /// in the order of `rhs`. The right-hand sides are sorted by their first position and
+    /// solved in groups of [`SPARSE_GROUP`] ([`Self::solve_in_place`] starts each group's
+    /// forward half at its first non-zero row), the groups alternating between two threads
+    /// when `threads` is set and there are at least two groups.
+    ///
+    /// # Errors
+    /// [`LinalgError::InvalidParameter`] for a position `≥ k`.
+    pub fn solve_sparse_columns(
+        &self,
+        rhs: &[Vec<(usize, f64)>],
+        threads: bool,
+    ) -> Result<Vec<Vec<f64>>, LinalgError> {
+        let k = self.dofs.len();
+        if let Some(&(p, _)) = rhs.iter().flatten().find(|&&(p, _)| p >= k) {
+            return Err(LinalgError::InvalidParameter(format!(
+                "position {p} outside the trailing block of {k} dofs"
+            )));
+        }
+        let mut order: Vec<usize> = (0..rhs.len()).collect();
+        let first = |j: usize| rhs[j].iter().map(|&(p, _)| p).min().unwrap_or(k);
+        order.sort_by_key(|&j| (first(j), j));
+        let groups: Vec<&[usize]> = order.chunks(SPARSE_GROUP).collect();
+        let solve_group = |group: &[usize]| -> Vec<(usize, Vec<f64>)> {
+            let mut x = faer::Mat::<f64>::zeros(k, group.len());
+            for (c, &j) in group.iter().enumerate() {
+                for &(p, v) in &rhs[j] {
+                    x[(p, c)] += v;
+                }
+            }
+            self.solve_in_place(x.as_mut());
+            group.iter().enumerate().map(|(c, &j)| (j, x.col(c).iter().copied().collect())).collect()
+        };
+        let solve_share = |share: usize, of: usize| -> Vec<(usize, Vec<f64>)> {
+            groups.iter().skip(share).step_by(of).flat_map(|g| solve_group(g)).collect()
+        };
+        let solved: Vec<(usize, Vec<f64>)> = if threads && groups.len() >= 2 {
+            std::thread::scope(|scope| {
+                let other = scope.spawn(|| solve_share(1, 2));
+                let mut mine = solve_share(0, 2);
+                // a panic of the other half is re-raised here (no user input can cause one)
+                match other.join() {
+                    Ok(theirs) => mine.extend(theirs),
+                    Err(e) => std::panic::resume_unwind(e),
+                }
+                mine
+            })
+        } else {
+            solve_share(0, 1)
+        };
+        let mut out = vec![Vec::new(); rhs.len()];
+        for (j, x) in solved {
+            out[j] = x;
+        }
+        Ok(out)
+    }
 }
+
+/// Right-hand sides per group of [`TrailingBlock::solve_sparse_columns`]: each group streams
+/// `L₂₂` twice (288 MB at `k = 6000`), so groups much smaller than this are bound by memory
+/// (measured on a 6000 × 6000 block with 1 093 unit right-hand sides: 1.14 s in groups of 48,
+/// 0.62 s in groups of 192, 1.30 s in one call without the sorted forward start).
+pub const SPARSE_GROUP: usize = 192;
 
 /// Timings of the stages of a factorisation, in seconds.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

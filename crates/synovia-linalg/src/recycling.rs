@@ -13,12 +13,15 @@
 //!
 //! the recycled solution `Z c` (O(m n) work for `m` directions, no solve with the factor) is
 //! used when that bound is at most `τ ‖F‖` (`τ = 10⁻¹²`, the backward error of a direct solve
-//! of these systems is 10⁻¹⁵–10⁻¹³). Otherwise the load is solved with the factor and, if
-//! `r` is a new direction, `q = r/‖r‖`, `z = (A⁻¹ F − Z c)/‖r‖` are appended (after a second
-//! Gram–Schmidt pass) with `ρ = ‖A z − q‖` measured by one product with `A` — a direction
-//! derived from a small `‖r‖` loses digits to cancellation, and `ρ` says how many: above
-//! `10⁻¹³` the direction gets one step of iterative refinement (one more solve, once per
-//! direction), and the bound decides with the measured `ρ` in any case.
+//! of these systems is 10⁻¹⁵–10⁻¹³). Otherwise, if `r` is a new direction (`‖r‖ ≥ 10⁻¹⁰ ‖F‖`)
+//! and the basis is not empty, the direction itself is solved (after a second Gram–Schmidt
+//! pass): `q = r/‖r‖`, `z = A⁻¹ q`, `ρ = ‖A z − q‖` measured by one product with `A`, and
+//! `A⁻¹ F = Z c + ‖r‖ z` (the bound above with `ρ`, else a direct solve of `F`) — one solve,
+//! where `z = (A⁻¹ F − Z c)/‖r‖` from a solve of `F` would lose digits to cancellation for a
+//! small `‖r‖` (e.g. a small tangential shift added to a normal load) and need a second,
+//! refining one. The first direction is `q = F/‖F‖`, `z = A⁻¹ F/‖F‖` from the solve of `F`.
+//! A direction whose `ρ` exceeds `10⁻¹³` gets one step of iterative refinement (one more
+//! solve), and the bound decides with the measured `ρ` in any case.
 
 use crate::error::LinalgError;
 use crate::operator::FactorisedOperator;
@@ -108,10 +111,8 @@ impl LoadSubspace {
             self.reused += 1;
             return Ok(x);
         }
-        let mut x = load.to_vec();
-        operator.solve_in_place(&mut x)?;
         self.solved += 1;
-        if self.capacity > 0 && rnorm >= NEW_DIRECTION * norm {
+        if self.capacity > 0 && rnorm >= NEW_DIRECTION * norm && !self.basis.is_empty() {
             if self.basis.len() == self.capacity {
                 // make room first, so that the new load lies in the span it leaves
                 self.basis.remove(0);
@@ -124,22 +125,39 @@ impl LoadSubspace {
             // second Gram–Schmidt pass ("twice is enough") for an orthonormal basis
             self.orthogonalise(&mut coeffs, &mut residual);
             rnorm = dot(&residual, &residual).sqrt();
-            let mut z = x.clone();
-            for (c, zj) in coeffs.iter().zip(&self.solutions) {
-                axpy(-c, zj, &mut z);
-            }
+            // the new direction q = r/‖r‖ is solved itself, z = A⁻¹ q: no cancellation (as
+            // in z = (A⁻¹ F − Z c)/‖r‖ for a small ‖r‖, which needed a refinement step, i.e.
+            // a second solve), and A⁻¹ F = Z c + ‖r‖ z within the residual bound
             let inv = 1.0 / rnorm;
             residual.iter_mut().for_each(|v| *v *= inv);
-            z.iter_mut().for_each(|v| *v *= inv);
+            let (z, rho) = self.solve_direction(operator, &residual)?;
+            self.basis.push(residual);
+            self.solutions.push(z);
+            self.residuals.push(rho);
+            coeffs.push(rnorm);
+            let bound = coeffs.iter().zip(&self.residuals).map(|(c, r)| c.abs() * r).sum::<f64>();
+            if bound <= RECYCLED_RESIDUAL * norm {
+                let mut x = vec![0.0; n];
+                for (c, z) in coeffs.iter().zip(&self.solutions) {
+                    axpy(*c, z, &mut x);
+                }
+                return Ok(x);
+            }
+            let mut x = load.to_vec();
+            operator.solve_in_place(&mut x)?;
+            return Ok(x);
+        }
+        let mut x = load.to_vec();
+        operator.solve_in_place(&mut x)?;
+        if self.capacity > 0 && rnorm >= NEW_DIRECTION * norm {
+            // the first direction: q = F/‖F‖, z = A⁻¹ q from the solve of F
+            let inv = 1.0 / rnorm;
+            residual.iter_mut().for_each(|v| *v *= inv);
+            let mut z: Vec<f64> = x.iter().map(|v| v * inv).collect();
             let mut az = operator.apply(&z);
             let mut rho = residual_norm(&az, &residual);
             if rho > REFINE_ABOVE {
-                // cancellation in z (a small ‖r‖): one step of iterative refinement,
-                // z ← z + A⁻¹ (q − A z), one more solve for this direction only
-                let mut correction: Vec<f64> = residual.iter().zip(&az).map(|(q, a)| q - a).collect();
-                operator.solve_in_place(&mut correction)?;
-                z.iter_mut().zip(&correction).for_each(|(z, c)| *z += c);
-                az = operator.apply(&z);
+                refine(operator, &residual, &mut z, &mut az)?;
                 rho = residual_norm(&az, &residual);
             }
             self.basis.push(residual);
@@ -147,6 +165,24 @@ impl LoadSubspace {
             self.residuals.push(rho);
         }
         Ok(x)
+    }
+
+    /// `z = A⁻¹ q` for a unit direction `q` and its residual `ρ = ‖A z − q‖` (one product with
+    /// `A`), with one step of iterative refinement when `ρ` exceeds [`REFINE_ABOVE`].
+    fn solve_direction(
+        &self,
+        operator: &dyn FactorisedOperator,
+        q: &[f64],
+    ) -> Result<(Vec<f64>, f64), LinalgError> {
+        let mut z = q.to_vec();
+        operator.solve_in_place(&mut z)?;
+        let mut az = operator.apply(&z);
+        let mut rho = residual_norm(&az, q);
+        if rho > REFINE_ABOVE {
+            refine(operator, q, &mut z, &mut az)?;
+            rho = residual_norm(&az, q);
+        }
+        Ok((z, rho))
     }
 
     /// One modified Gram–Schmidt pass of `residual` against the basis, accumulating the
@@ -161,6 +197,21 @@ impl LoadSubspace {
 }
 
 /// `‖a − q‖₂`.
+/// One step of iterative refinement of `z ≈ A⁻¹ q` with `az = A z`: `z ← z + A⁻¹ (q − A z)`
+/// (one solve), `az` updated.
+fn refine(
+    operator: &dyn FactorisedOperator,
+    q: &[f64],
+    z: &mut [f64],
+    az: &mut Vec<f64>,
+) -> Result<(), LinalgError> {
+    let mut correction: Vec<f64> = q.iter().zip(az.iter()).map(|(q, a)| q - a).collect();
+    operator.solve_in_place(&mut correction)?;
+    z.iter_mut().zip(&correction).for_each(|(z, c)| *z += c);
+    *az = operator.apply(z);
+    Ok(())
+}
+
 fn residual_norm(a: &[f64], q: &[f64]) -> f64 {
     a.iter().zip(q).map(|(a, q)| (a - q) * (a - q)).sum::<f64>().sqrt()
 }
@@ -171,4 +222,95 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
 
 fn axpy(a: f64, x: &[f64], y: &mut [f64]) {
     y.iter_mut().zip(x).for_each(|(y, x)| *y += a * x);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Ordering, SparseCholesky, SymmetricMatrix};
+    use std::sync::atomic::{AtomicUsize, Ordering as AtomicOrdering};
+
+    /// A factorised operator that counts its solves.
+    #[derive(Debug)]
+    struct Counting {
+        op: SparseCholesky,
+        solves: AtomicUsize,
+    }
+
+    impl FactorisedOperator for Counting {
+        fn n(&self) -> usize {
+            self.op.n()
+        }
+        fn apply(&self, x: &[f64]) -> Vec<f64> {
+            self.op.apply(x)
+        }
+        fn diagonal(&self) -> Vec<f64> {
+            self.op.diagonal()
+        }
+        fn key(&self) -> u64 {
+            self.op.key()
+        }
+        fn solve_in_place(&self, b: &mut [f64]) -> Result<(), LinalgError> {
+            self.solves.fetch_add(1, AtomicOrdering::Relaxed);
+            self.op.solve_in_place(b)
+        }
+    }
+
+    /// `tridiag(−1, 2 + 10⁻³, −1)` of size `n` (condition number ≈ 4·10³).
+    fn matrix(n: usize) -> SymmetricMatrix {
+        let columns = (0..n).map(|j| if j + 1 < n { vec![j, j + 1] } else { vec![j] }).collect();
+        let mut a = SymmetricMatrix::from_columns(n, columns).expect("pattern");
+        for j in 0..n {
+            a.add(j, j, 2.001).expect("diagonal");
+            if j + 1 < n {
+                a.add(j + 1, j, -1.0).expect("off-diagonal");
+            }
+        }
+        a
+    }
+
+    /// A load that adds a small new direction to a solved one (`F₂ = F₁ + 10⁻⁶ G`, as a small
+    /// tangential shift added to a normal load) takes one solve, the direction's own, and
+    /// `A⁻¹ F₂` has a relative residual `‖A x − F₂‖ / ‖F₂‖ ≤ 10⁻¹²` and equals the direct
+    /// solve to 1e-12; the direction is kept, so `F₁ + 3·10⁻⁶ G` is recycled without a solve.
+    #[test]
+    fn a_small_new_direction_takes_one_solve() {
+        let n = 400;
+        let op = Counting {
+            op: SparseCholesky::new(matrix(n), &Ordering::Amd).expect("factor"),
+            solves: AtomicUsize::new(0),
+        };
+        let f1: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64 * 0.01).sin()).collect();
+        let g: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+        let load = |e: f64| -> Vec<f64> { f1.iter().zip(&g).map(|(a, b)| a + e * b).collect() };
+        let direct = |f: &[f64]| {
+            let mut x = f.to_vec();
+            op.op.solve_in_place(&mut x).expect("solve");
+            x
+        };
+        let check = |x: &[f64], f: &[f64]| {
+            let ax = op.op.apply(x);
+            let res = ax.iter().zip(f).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
+            assert!(res <= 1e-12 * dot(f, f).sqrt(), "relative residual {:e}", res / dot(f, f).sqrt());
+            let want = direct(f);
+            let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let err = x.iter().zip(&want).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs())) / scale;
+            assert!(err < 1e-12, "differs from the direct solve by {err:e}");
+        };
+        let mut sub = LoadSubspace::new(4);
+        let x1 = sub.solve(&op, &f1).expect("first");
+        check(&x1, &f1);
+        let before = op.solves.load(AtomicOrdering::Relaxed);
+        let f2 = load(1e-6);
+        let x2 = sub.solve(&op, &f2).expect("second");
+        assert_eq!(op.solves.load(AtomicOrdering::Relaxed) - before, 1, "one solve for the new direction");
+        check(&x2, &f2);
+        assert_eq!((sub.len(), sub.counts()), (2, (0, 2)));
+        let before = op.solves.load(AtomicOrdering::Relaxed);
+        let f3 = load(3e-6);
+        let x3 = sub.solve(&op, &f3).expect("recycled");
+        assert_eq!(op.solves.load(AtomicOrdering::Relaxed), before, "recycled");
+        assert_eq!(sub.counts(), (1, 2));
+        check(&x3, &f3);
+    }
 }
