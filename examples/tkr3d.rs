@@ -279,6 +279,11 @@ fn main() -> Result<(), Error> {
 #[derive(Debug, Clone, Copy)]
 struct Figures {
     si_mm: f64,
+    /// The medial–lateral translation (mm) and the ab/adduction angle (rad) of the femur.
+    ml_mm: f64,
+    adduction: f64,
+    medial_force: f64,
+    lateral_force: f64,
     balance: f64,
     kkt: f64,
     force: f64,
@@ -294,8 +299,14 @@ impl Figures {
         let pair = record.pairs.first().ok_or("no pair")?;
         let rigid = record.rigid.first().ok_or("no rigid body")?;
         let side = |name: &str| pair.sides.iter().find(|s| s.name == name).map_or(0.0, |s| s.peak_pressure);
+        let side_force =
+            |name: &str| pair.sides.iter().find(|s| s.name == name).map_or(0.0, |s| s.normal_force);
         Ok(Self {
             si_mm: rigid.dofs[1],
+            ml_mm: rigid.dofs[2],
+            adduction: rigid.dofs[3],
+            medial_force: side_force("medial"),
+            lateral_force: side_force("lateral"),
             balance: rigid.balance_error,
             kkt,
             force: pair.normal_force,
@@ -368,15 +379,23 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         Ok(())
     })?;
     let nonlinear_s = t_nonlinear.elapsed().as_secs_f64();
-    println!("| cycle % | SI lin / NH (mm) | force (N) | area lin / NH (mm²) | peak p lin / NH (MPa) | Δ peak | medial peak lin / NH | lateral peak lin / NH | friction lin / NH (N) | balance NH | KKT NH | Newton it. | solves | s |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| cycle % | SI lin / NH (mm) | ML lin / NH (mm) | adduction lin / NH (mrad) | force (N) | medial force lin / NH (N) | lateral force lin / NH (N) | area lin / NH (mm²) | peak p lin / NH (MPa) | Δ peak | medial peak lin / NH | lateral peak lin / NH | friction lin / NH (N) | balance NH | KKT NH | Newton it. | solves | s |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let rel = |a: f64, b: f64| if a > 0.0 { (b - a) / a } else { 0.0 };
     for (((p, l), n), (it, solves, s)) in percents.iter().zip(&linear).zip(&nonlinear).zip(&newton_steps) {
         println!(
-            "| {p} | {:.4} / {:.4} | {:.0} | {:.1} / {:.1} | {:.2} / {:.2} | {:+.1} % | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} | {:.1e} | {:.1e} | {it} | {solves} | {s:.2} |",
+            "| {p} | {:.4} / {:.4} | {:.4} / {:.4} | {:.4} / {:.4} | {:.0} | {:.1} / {:.1} | {:.1} / {:.1} | {:.1} / {:.1} | {:.2} / {:.2} | {:+.1} % | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} / {:.2} | {:.1e} | {:.1e} | {it} | {solves} | {s:.2} |",
             l.si_mm,
             n.si_mm,
+            l.ml_mm,
+            n.ml_mm,
+            1e3 * l.adduction,
+            1e3 * n.adduction,
             n.force,
+            l.medial_force,
+            n.medial_force,
+            l.lateral_force,
+            n.lateral_force,
             l.area,
             n.area,
             l.peak,
@@ -395,10 +414,13 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     let list = |f: &dyn Fn(&Figures) -> f64, v: &[Figures]| {
         v.iter().map(|x| format!("{:.3}", f(x))).collect::<Vec<_>>().join(",")
     };
+    let list4 = |f: &dyn Fn(&Figures) -> f64, v: &[Figures]| {
+        v.iter().map(|x| format!("{:.4}", f(x))).collect::<Vec<_>>().join(",")
+    };
     let max = |f: &dyn Fn(&Figures) -> f64, v: &[Figures]| v.iter().map(f).fold(0.0, f64::max);
     let changes: Vec<f64> = linear.iter().zip(&nonlinear).map(|(l, n)| rel(l.peak, n.peak)).collect();
     println!(
-        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":{},\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"friction_force_linear_n\":[{}],\"friction_force_neo_hookean_n\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
+        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":{},\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"friction_force_linear_n\":[{}],\"friction_force_neo_hookean_n\":[{}],\"medial_force_linear_n\":[{}],\"medial_force_neo_hookean_n\":[{}],\"lateral_force_linear_n\":[{}],\"lateral_force_neo_hookean_n\":[{}],\"ml_linear_mm\":[{}],\"ml_neo_hookean_mm\":[{}],\"adduction_linear_mrad\":[{}],\"adduction_neo_hookean_mrad\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
         model.mesh_file(),
         percents.iter().map(u32::to_string).collect::<Vec<_>>().join(","),
         model.friction,
@@ -408,6 +430,14 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         list(&|f| f.area, &nonlinear),
         list(&|f| f.friction_force, &linear),
         list(&|f| f.friction_force, &nonlinear),
+        list(&|f| f.medial_force, &linear),
+        list(&|f| f.medial_force, &nonlinear),
+        list(&|f| f.lateral_force, &linear),
+        list(&|f| f.lateral_force, &nonlinear),
+        list4(&|f| f.ml_mm, &linear),
+        list4(&|f| f.ml_mm, &nonlinear),
+        list4(&|f| 1e3 * f.adduction, &linear),
+        list4(&|f| 1e3 * f.adduction, &nonlinear),
         changes.iter().copied().fold(f64::INFINITY, f64::min),
         changes.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         max(&|f| f.balance, &nonlinear),
