@@ -364,6 +364,18 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         });
     }
     nh_joint.newton_params(newton);
+    // `--nh-jacobian fresh|broyden`: the Jacobian of the outer iteration over several
+    // force-controlled coordinates in the neo-Hookean run (default: the model's, fresh for the
+    // freed variants)
+    if let Some(v) = std::env::args().skip_while(|a| a != "--nh-jacobian").nth(1) {
+        let mut control = nh_joint.force_control_params();
+        control.fresh_jacobian = match v.as_str() {
+            "fresh" => true,
+            "broyden" => false,
+            _ => return Err("--nh-jacobian takes fresh or broyden".into()),
+        };
+        nh_joint.force_control(control);
+    }
     let mut nonlinear = Vec::with_capacity(times.len());
     let mut newton_steps = Vec::with_capacity(times.len());
     nh_joint.run_quasistatic_with(&times, |view| {
