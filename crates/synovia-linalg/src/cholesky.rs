@@ -59,32 +59,65 @@ pub struct TrailingBlock {
     pub position: Vec<usize>,
     /// `L₂₂` (dense, lower triangular, `k × k`).
     pub factor: faer::Mat<f64>,
+    /// The diagonal blocks of `L₂₂` with nothing below them (consecutive ranges covering
+    /// `0..k`, [`diagonal_blocks`]): `L₂₂ = diag(L₁, L₂, …)`, e.g. one block per body of an
+    /// interface between bodies that only contact couples. One block `0..k` is always correct.
+    pub blocks: Vec<std::ops::Range<usize>>,
+}
+
+/// The finest partition of `0..k` into consecutive ranges `a..b` with `l[(i, j)] = 0` for all
+/// `j < b ≤ i` (nothing below a range's diagonal block), for a lower-triangular `k × k` `l`:
+/// column `j` reaches down to its last non-zero row, and a block ends where no column so far
+/// reaches past it.
+pub fn diagonal_blocks(l: faer::MatRef<'_, f64>) -> Vec<std::ops::Range<usize>> {
+    let k = l.nrows().min(l.ncols());
+    let mut blocks = Vec::new();
+    let (mut start, mut reach) = (0, 0);
+    for j in 0..k {
+        let last = (j..k).rev().find(|&i| l[(i, j)] != 0.0).unwrap_or(j);
+        reach = reach.max(last);
+        if reach == j {
+            blocks.push(start..j + 1);
+            start = j + 1;
+        }
+    }
+    blocks
 }
 
 impl TrailingBlock {
     /// Solves `(A⁻¹)_cc`-products in place: `X ← L₂₂⁻ᵀ L₂₂⁻¹ X` for the `k × r` block `x`
     /// (rows in the order of [`Self::dofs`]).
     ///
-    /// The forward half starts at the first non-zero row `f` of `X`: with `X = [0; X₂]`
-    /// (`X₂` from row `f`), `L₂₂⁻¹ X = [0; L_ff⁻¹ X₂]` for the trailing `(k − f) × (k − f)`
-    /// block `L_ff` of `L₂₂`, so `(k − f)²` instead of `k²` work per column (the backward
-    /// half `L₂₂⁻ᵀ` runs over all rows). Right-hand sides sorted by their first non-zero row
-    /// and solved in groups ([`Self::solve_sparse_columns`]) make use of it.
+    /// Each diagonal block `L_b` of [`Self::blocks`] is solved on its own rows
+    /// (`L₂₂ = diag(L_b)`, so `L₂₂⁻ᵀ L₂₂⁻¹ X = [L_b⁻ᵀ L_b⁻¹ X_b]_b`), and a block whose rows of
+    /// `X` are zero is skipped. Within a block the forward half starts at its first non-zero
+    /// row `f`: with `X_b = [0; X₂]` (`X₂` from row `f`), `L_b⁻¹ X_b = [0; L_ff⁻¹ X₂]` for the
+    /// trailing block `L_ff` of `L_b`, so `(k_b − f)²` instead of `k_b²` work per column (the
+    /// backward half `L_b⁻ᵀ` runs over all of the block's rows). Right-hand sides sorted by
+    /// their first non-zero row and solved in groups ([`Self::solve_sparse_columns`]) make use
+    /// of it.
     pub fn solve_in_place(&self, mut x: MatMut<'_, f64>) {
         let k = x.nrows();
-        let first = (0..k).find(|&i| (0..x.ncols()).any(|c| x[(i, c)] != 0.0)).unwrap_or(k);
-        if first < k {
+        let whole = std::iter::once(0..k);
+        let blocks: Vec<std::ops::Range<usize>> = if self.blocks.last().is_some_and(|b| b.end == k) {
+            self.blocks.clone()
+        } else {
+            whole.collect()
+        };
+        for block in &blocks {
+            let (a, size) = (block.start, block.len());
+            let Some(first) = (0..size).find(|&i| (0..x.ncols()).any(|c| x[(a + i, c)] != 0.0)) else {
+                continue;
+            };
+            let l = self.factor.as_ref().submatrix(a, a, size, size);
+            let mut xb = x.rb_mut().subrows_mut(a, size);
             faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                self.factor.as_ref().submatrix(first, first, k - first, k - first),
-                x.rb_mut().subrows_mut(first, k - first),
+                l.submatrix(first, first, size - first, size - first),
+                xb.rb_mut().subrows_mut(first, size - first),
                 Par::Seq,
             );
+            faer::linalg::triangular_solve::solve_upper_triangular_in_place(l.transpose(), xb, Par::Seq);
         }
-        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-            self.factor.as_ref().transpose(),
-            x.rb_mut(),
-            Par::Seq,
-        );
     }
 
     /// `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` for sparse right-hand sides `c_j` given as `(position, value)`
@@ -458,7 +491,8 @@ impl CholeskySolver {
         for (p, &d) in dofs.iter().enumerate() {
             position[d] = p;
         }
-        Ok(TrailingBlock { dofs: dofs.to_vec(), position, factor: l22 })
+        let blocks = diagonal_blocks(l22.as_ref());
+        Ok(TrailingBlock { dofs: dofs.to_vec(), position, factor: l22, blocks })
     }
 
     /// Solves `A x = b` in place for a right-hand side that vanishes outside the trailing

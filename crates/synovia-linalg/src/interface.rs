@@ -1127,4 +1127,75 @@ mod tests {
         }
         assert!(block.solve_sparse_columns(&[vec![(k, 1.0)]], false).is_err());
     }
+
+    /// Two grids that nothing couples (two bodies touching only through contact), trailing
+    /// dofs from both: `L₂₂` splits into one diagonal block per grid
+    /// ([`crate::cholesky::diagonal_blocks`]), and right-hand sides on one grid or on both,
+    /// solved block by block, equal `A⁻¹ c` of whole solves to 1e-12 (zero on a grid they do
+    /// not touch).
+    #[test]
+    fn block_diagonal_trailing_factor_is_solved_per_block() {
+        let (g, m) = (grid(20), 400);
+        let n = 2 * m;
+        let pattern = g.pattern();
+        let (cp, ri) = (pattern.col_ptr(), pattern.row_idx());
+        let mut columns = vec![Vec::new(); n];
+        for j in 0..m {
+            for &i in &ri[cp[j]..cp[j + 1]] {
+                columns[j].push(i);
+                columns[j + m].push(i + m);
+            }
+        }
+        let mut a = SymmetricMatrix::from_columns(n, columns).expect("pattern");
+        for j in 0..m {
+            for &i in &ri[cp[j]..cp[j + 1]] {
+                let v = g.get(i, j);
+                a.add(i, j, v).expect("entry");
+                a.add(i + m, j + m, (1.0 + 0.5 * (i % 3) as f64 / 3.0) * v).expect("entry");
+            }
+        }
+        // the last row of each grid, interleaved
+        let last: Vec<usize> = (0..20).flat_map(|c| [m - 20 + c, n - 20 + c]).collect();
+        let op = SparseCholesky::new(a, &Ordering::Trailing { base: Box::new(Ordering::Amd), last })
+            .expect("factor");
+        let block = op.view().factor().trailing().expect("trailing block").clone();
+        let k = block.dofs.len();
+        assert_eq!(block.blocks.len(), 2, "one diagonal block per grid: {:?}", block.blocks);
+        assert_eq!(block.blocks.first().map(|b| b.start), Some(0));
+        assert_eq!(block.blocks.last().map(|b| b.end), Some(k));
+        let rhs: Vec<Vec<(usize, f64)>> = (0..k)
+            .map(|p| vec![(p, 1.0)])
+            .chain((0..k / 2).map(|p| vec![(p, 1.0), (k - 1 - p, -0.5)]))
+            .collect();
+        let got = block.solve_sparse_columns(&rhs, true).expect("solves");
+        for (c, x) in rhs.iter().zip(&got) {
+            let mut b = vec![0.0; n];
+            for &(p, v) in c {
+                b[block.dofs[p]] += v;
+            }
+            op.solve_in_place(&mut b).expect("solve");
+            let want: Vec<f64> = block.dofs.iter().map(|&d| b[d]).collect();
+            let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let err = x.iter().zip(&want).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs())) / scale;
+            assert!(err < 1e-12, "per-block solve differs by {err:e}");
+        }
+    }
+
+    /// [`crate::cholesky::diagonal_blocks`] of small lower-triangular matrices: a dense one is
+    /// one block, a diagonal one `k` blocks, and a coupling below the diagonal joins the blocks
+    /// it spans.
+    #[test]
+    fn diagonal_blocks_of_lower_triangular_matrices() {
+        use crate::cholesky::diagonal_blocks;
+        let dense = faer::Mat::<f64>::from_fn(4, 4, |i, j| if i >= j { 1.0 } else { 0.0 });
+        assert_eq!(diagonal_blocks(dense.as_ref()), vec![0..4]);
+        let diag = faer::Mat::<f64>::from_fn(3, 3, |i, j| if i == j { 2.0 } else { 0.0 });
+        assert_eq!(diagonal_blocks(diag.as_ref()), vec![0..1, 1..2, 2..3]);
+        // l[(3, 1)] couples rows 1..=3; row 0 and rows 4..6 stand alone or together
+        let mut l = faer::Mat::<f64>::from_fn(6, 6, |i, j| if i == j { 1.0 } else { 0.0 });
+        l[(3, 1)] = 0.5;
+        l[(5, 4)] = 0.25;
+        assert_eq!(diagonal_blocks(l.as_ref()), vec![0..1, 1..4, 4..6]);
+        assert!(diagonal_blocks(faer::Mat::<f64>::zeros(0, 0).as_ref()).is_empty());
+    }
 }
