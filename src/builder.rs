@@ -929,9 +929,10 @@ impl<const D: usize> JointModel<D> {
         Ok(self)
     }
 
-    /// Replaces the friction law of a contact pair in quasi-static and dynamic runs (default: its
-    /// constant coefficient; docs/model.md §3, [`QuasiStaticStepper::set_friction_law`],
-    /// [`DynamicStepper::set_friction_law`]).
+    /// Replaces the friction law of a contact pair in quasi-static and dynamic runs, linear or
+    /// nonlinear (default: its constant coefficient; docs/model.md §3,
+    /// [`QuasiStaticStepper::set_friction_law`], [`DynamicStepper::set_friction_law`],
+    /// [`NonlinearContact::set_friction_law`]).
     ///
     /// # Errors
     /// [`JointError::Invalid`] for an unknown pair.
@@ -1301,12 +1302,6 @@ impl<const D: usize> JointModel<D> {
     ) -> Result<RunResult<D>, JointError> {
         check_levels(times)?;
         self.check_nonlinear_rigid()?;
-        if !self.friction_laws.is_empty() {
-            return Err(JointError::Invalid(
-                "friction laws other than a constant coefficient are not supported with nonlinear materials or finite strain yet"
-                    .into(),
-            ));
-        }
         let mut nl = NonlinearContact::with_interface_block(
             &self.model,
             &self.pairs,
@@ -1315,6 +1310,11 @@ impl<const D: usize> JointModel<D> {
             self.newton,
             self.interface_block,
         )?;
+        // friction laws F_c(v): the slip bounds of a level from the slip speed over the two
+        // converged levels before it, as the linear quasi-static scheme's
+        for (pair, law) in &self.friction_laws {
+            nl.set_friction_law(pair, law.clone())?;
+        }
         nl.set_screening_band(self.screening_band)?;
         // the reference configuration before the first level (the same start as the linear
         // quasi-static scheme's first level, which is solved from the undeformed body)

@@ -1163,11 +1163,13 @@ impl RigidDriver {
         let length = joint.model_size();
         self.set_poses(joint);
         let owner_of = joint.pair_rigid_owner(nl.geometry());
-        let rigid_friction = nl
-            .geometry()
-            .nodes
-            .iter()
-            .any(|n| n.friction > 0.0 && owner_of.get(n.pair).copied().flatten().is_some());
+        // a positive coefficient or a friction law (NonlinearContact::set_friction_law) on a
+        // pair with a rigid body
+        let laws = nl.friction_laws();
+        let rigid_friction = nl.geometry().nodes.iter().any(|n| {
+            (n.friction > 0.0 || laws.is_some_and(|l| l.law(n.pair).is_some()))
+                && owner_of.get(n.pair).copied().flatten().is_some()
+        });
         let (level, solves) = match unknowns.as_slice() {
             [] if rigid_friction => {
                 // friction against partners whose coordinates are all prescribed (docs/model.md

@@ -628,3 +628,118 @@ fn several_force_controlled_coordinates_with_friction_equal_the_linear_path() ->
     compare_friction_runs(&linear, &routed, &[0.4, 0.7, 1.0], mu, Some(force))?;
     Ok(())
 }
+
+/// A slip-speed dependent friction law in the nonlinear path (`JointModel::friction_law`,
+/// `NonlinearContact::set_friction_law`): the exponential static-to-kinetic law
+/// `F_c(v) = μ_k + (μ_s − μ_k) exp(−v / v_c)` against the sliding, prescribed rigid body, on a
+/// pair built frictionless. The linear law through the Newton path equals the linear
+/// quasi-static path with the same law level by level (displacements, `Λ_n`, slip bounds,
+/// `Λ_t`, reactions to 1e-10; the Tresca and KKT conditions hold), and the law acts: every slip
+/// bound lies in `[μ_k, μ_s] |Λ_n|` of the level before, some well below `μ_s`, and the
+/// tangential force at the last level is below the constant `μ_s`'s.
+#[test]
+fn friction_law_against_a_prescribed_rigid_body_equals_the_linear_path() -> Result<(), Error> {
+    let (mu_s, mu_k) = (0.4, 0.1);
+    let law = Arc::new(ExponentialFriction {
+        static_coefficient: mu_s,
+        kinetic_coefficient: mu_k,
+        characteristic_speed: 2e-3,
+    });
+    let times = [0.3, 0.55, 0.8, 1.0];
+    let mut linear = model_prescribed(Arc::new(isotropic(E, NU)?), 0.0)?;
+    linear.friction_law("indent", law.clone())?;
+    let mut routed = model_prescribed(Arc::new(Hidden(isotropic(E, NU)?)), 0.0)?;
+    routed.friction_law("indent", law)?;
+    assert!(routed.is_nonlinear());
+    compare_friction_runs(&linear, &routed, &times, mu_s, None)?;
+    // the bounds against the pressures of the level before: g_c / |Λ_n| = F_c(v) ∈ [μ_k, μ_s]
+    let mut ratios: Vec<f64> = Vec::new();
+    let mut previous: Option<Vec<f64>> = None;
+    let with_law = routed.run_quasistatic_with(&times, |view| {
+        let r = view.result;
+        if let Some(p) = &previous {
+            for (&node, &g) in r.cell_node.iter().zip(&r.slip_bound) {
+                ratios.push(g / p[node].abs());
+            }
+        }
+        previous = Some(r.solution.lambda_n.clone());
+        Ok(())
+    })?;
+    assert!(!ratios.is_empty(), "no friction cells");
+    let (lo, hi) = ratios.iter().fold((f64::MAX, 0.0_f64), |(a, b), &x| (a.min(x), b.max(x)));
+    assert!(lo >= mu_k * (1.0 - 1e-12) && hi <= mu_s * (1.0 + 1e-12), "F_c in [{lo}, {hi}]");
+    assert!(lo < 0.9 * mu_s, "the law never left μ_s (smallest F_c {lo})");
+    let constant = model_prescribed(Arc::new(Hidden(isotropic(E, NU)?)), mu_s)?.run_quasistatic(&times)?;
+    let tangential = |run: &RunResult<3>| run.records.last().map_or(0.0, |r| r.pairs[0].tangential_force);
+    let (t_law, t_const) = (tangential(&with_law), tangential(&constant));
+    eprintln!("friction law: F_c / |Λ_n| in [{lo:.4}, {hi:.4}]; tangential force {t_law:.5} (law) vs {t_const:.5} (μ_s)");
+    assert!(t_law < 0.95 * t_const, "tangential force {t_law} with the law vs {t_const} with μ_s");
+    Ok(())
+}
+
+/// The same law on a pair with a fixed rigid obstacle (no rigid body: the Newton path's
+/// `NonlinearContact::step_to`, slip from the committed state): the block's top pushed down and
+/// sheared by a prescribed displacement onto a rigid sphere under its bottom. The linear law
+/// through the Newton path equals the linear quasi-static path with the law level by level
+/// (displacements, `Λ_n`, friction cells, slip bounds, `g Λ_t` to 1e-10), and the law acts
+/// (`F_c = g_c / |Λ_n|` of the level before below `0.9 μ_s` somewhere).
+#[test]
+fn friction_law_on_a_fixed_obstacle_equals_the_linear_path() -> Result<(), Error> {
+    let (mu_s, mu_k) = (0.4, 0.1);
+    let law = Arc::new(ExponentialFriction {
+        static_coefficient: mu_s,
+        kinetic_coefficient: mu_k,
+        characteristic_speed: 2e-3,
+    });
+    let times = [0.3, 0.55, 0.8, 1.0];
+    let build = |material: Arc<dyn Material<3>>| -> Result<JointModel<3>, Error> {
+        let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [12, 12, 6], [Grading::Uniform; 3])?;
+        let mut joint = JointModel::<3>::new();
+        joint.add_body("block", mesh, material)?;
+        joint.prescribe("block", "top", Vector::<3>::new(0.006, -0.002, -0.03), FnHistory::new(|t| t))?;
+        let sphere = SphereObstacle::new(Point::<3>::new(0.1, 0.05, -RADIUS), RADIUS, false)?;
+        joint.contact_rigid("bump", "block", "bottom", sphere, 0.0)?;
+        joint.friction_law("bump", law.clone())?;
+        Ok(joint)
+    };
+    let mut runs = Vec::new();
+    for joint in [build(Arc::new(isotropic(E, NU)?))?, build(Arc::new(Hidden(isotropic(E, NU)?)))?] {
+        let mut fields: Vec<Fields> = Vec::new();
+        let mut kkt = 0.0_f64;
+        joint.run_quasistatic_with(&times, |view| {
+            kkt = kkt.max(view.result.kkt.max());
+            fields.push(fields_of(view));
+            Ok(())
+        })?;
+        runs.push((fields, kkt));
+    }
+    let ((lin, _), (nl, nl_kkt)) = (&runs[0], &runs[1]);
+    assert_eq!(lin.len(), times.len());
+    assert_eq!(nl.len(), times.len());
+    assert!(*nl_kkt < 1e-8, "KKT {nl_kkt:e}");
+    let mut smallest = f64::MAX;
+    for (level, ((ua, la, ca), (ub, lb, cb))) in lin.iter().zip(nl).enumerate() {
+        let du = max_diff(ua, ub) / max_abs(ua);
+        let lmax = la.iter().copied().fold(0.0, f64::max);
+        assert!(lmax > 0.0, "level {level}: no contact");
+        let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
+        assert_eq!(ca.len(), cb.len(), "level {level}: friction cells");
+        let mut dg = 0.0_f64;
+        for ((na, ga, lta), (nb, gb, ltb)) in ca.iter().zip(cb) {
+            assert_eq!(na, nb, "level {level}");
+            dg = dg
+                .max((ga - gb).abs())
+                .max((ga * lta[0] - gb * ltb[0]).abs())
+                .max((ga * lta[1] - gb * ltb[1]).abs());
+            if level > 0 {
+                smallest = smallest.min(gb / nl[level - 1].1[*nb].abs());
+            }
+        }
+        let dg = dg / (mu_s * lmax);
+        eprintln!("fixed obstacle, level {level}: displacements {du:.1e}, pressures {dl:.1e}, slip bounds and g Λ_t {dg:.1e}, {} cells", cb.len());
+        assert!(du < 1e-10 && dl < 1e-10 && dg < 1e-10, "level {level}: {du:e} {dl:e} {dg:e}");
+    }
+    assert!(nl.iter().skip(1).any(|f| !f.2.is_empty()), "no friction cells");
+    assert!(smallest >= mu_k * (1.0 - 1e-12) && smallest < 0.9 * mu_s, "smallest F_c {smallest}");
+    Ok(())
+}

@@ -57,8 +57,10 @@
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+use std::sync::Arc;
 use std::time::Instant;
 
+use synovia_contact::friction::{slip_speeds, FrictionLaw, PairFrictionLaws};
 use synovia_contact::operators::{ContactGeometry, ContactPair};
 use synovia_contact::{ContactError, ContactSolution, ContactSolver, StaticContact, StaticContactResult};
 use synovia_fem::assembly::add_loads;
@@ -524,6 +526,9 @@ struct State<const D: usize> {
     /// Reduced contact forces `c` (for the line search's merit).
     contact_force: Vec<Real>,
     result: Option<StaticContactResult<D>>,
+    /// Slip speed `v_r` per contact node over the last two converged levels (empty: 0 at every
+    /// node), kept only when friction laws are set ([`NonlinearContact::set_friction_law`]).
+    slip_rate: Vec<Real>,
 }
 
 /// A converged state of a [`NonlinearContact`] ([`NonlinearContact::checkpoint`]).
@@ -551,6 +556,9 @@ pub struct NonlinearContact<const D: usize> {
     /// The stiffness of the linear bodies ([`NewtonParams::linear_bodies_by_stiffness`]),
     /// refreshed at the start of each level.
     linear_bodies: LinearBodies<D>,
+    /// Friction laws `F_c(v)` of the pairs ([`Self::set_friction_law`]; `None`: every pair's
+    /// constant coefficient).
+    friction_laws: Option<PairFrictionLaws>,
 }
 
 /// The extra terms of one level of [`NonlinearContact::step_with_terms`] (docs/model.md
@@ -711,11 +719,71 @@ impl<const D: usize> NonlinearContact<D> {
                 reduced: vec![0.0; n],
                 contact_force: vec![0.0; n],
                 result: None,
+                slip_rate: Vec::new(),
             },
             tangent_kept: false,
             constant,
             linear_bodies: LinearBodies::none(),
+            friction_laws: None,
         })
+    }
+
+    /// Replaces the friction law `F_c(|[u'_t]|)` of the contact pair `pair` (docs/model.md §3;
+    /// default: the pair's constant coefficient), as the linear quasi-static scheme's
+    /// `QuasiStaticStepper::set_friction_law` (`synovia-time`): the Tresca slip bounds of a
+    /// level are
+    ///
+    /// ```text
+    /// g_c,r = F_c(v_r) |Λ_n,r|,   v_r = ‖(I − n_r n_rᵀ)([u_{i−1}](s_r) − [u_{i−2}](s_r))‖ / (t_{i−1} − t_{i−2}),
+    /// ```
+    ///
+    /// with the pressure `Λ_n` of the converged state `i − 1` the level starts from and the slip
+    /// speed over the two converged states before it (relative to a moving partner,
+    /// [`ContactGeometry::slip_origin`]; 0 when there is no state before it, e.g. the first
+    /// level after the reference configuration). A law set on a pair built frictionless gives
+    /// it friction.
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] for an unknown pair name.
+    pub fn set_friction_law(&mut self, pair: &str, law: Arc<dyn FrictionLaw>) -> Result<(), NonlinearError> {
+        let laws = self.friction_laws.get_or_insert_with(|| PairFrictionLaws::new(self.contact.geometry()));
+        laws.set(pair, law).map_err(|e| NonlinearError::InvalidParameter(e.to_string()))
+    }
+
+    /// The friction laws set with [`Self::set_friction_law`] (`None`: none set, every pair's
+    /// constant coefficient).
+    pub fn friction_laws(&self) -> Option<&PairFrictionLaws> {
+        self.friction_laws.as_ref()
+    }
+
+    /// Slip speed `v_r` per contact node of the converged state (see [`Self::set_friction_law`];
+    /// empty when no law is set or there is no state before it: 0 at every node).
+    pub fn slip_rate(&self) -> &[Real] {
+        &self.state.slip_rate
+    }
+
+    /// The converged state of a level at `time` (load factor `scale`) that replaces the present
+    /// one, with the slip speeds of [`Self::set_friction_law`] when friction laws are set: the
+    /// tangential jump from the present state's displacement over the time between them (both
+    /// converged levels, `scale = 1`), else none.
+    fn next_state(
+        &self,
+        time: Real,
+        scale: Real,
+        reduced: Vec<Real>,
+        contact_force: Vec<Real>,
+        result: StaticContactResult<D>,
+    ) -> State<D> {
+        let slip_rate = match (&self.friction_laws, &self.state.result) {
+            (Some(_), Some(previous)) if scale >= 1.0 && self.state.scale >= 1.0 => slip_speeds(
+                self.contact.geometry(),
+                &result.displacement,
+                &previous.displacement,
+                time - self.state.time,
+            ),
+            _ => Vec::new(),
+        };
+        State { time, scale, reduced, contact_force, result: Some(result), slip_rate }
     }
 
     /// The constant matrix `B` of [`Self::with_constant_matrix`] (`None` for [`Self::new`]).
@@ -765,6 +833,7 @@ impl<const D: usize> NonlinearContact<D> {
             reduced: reduced.to_vec(),
             contact_force: vec![0.0; n],
             result: None,
+            slip_rate: Vec::new(),
         };
         self.tangent_kept = false;
         Ok(())
@@ -814,8 +883,14 @@ impl<const D: usize> NonlinearContact<D> {
     /// Back to the unloaded reference configuration at time `t0`.
     pub fn reset(&mut self, t0: Real) {
         let n = self.dofs.n_dofs();
-        self.state =
-            State { time: t0, scale: 0.0, reduced: vec![0.0; n], contact_force: vec![0.0; n], result: None };
+        self.state = State {
+            time: t0,
+            scale: 0.0,
+            reduced: vec![0.0; n],
+            contact_force: vec![0.0; n],
+            result: None,
+            slip_rate: Vec::new(),
+        };
         self.tangent_kept = false;
     }
 
@@ -1107,8 +1182,7 @@ impl<const D: usize> NonlinearContact<D> {
             match self.newton(model, time, scale, solver, &mut report, None, None, None) {
                 Ok((result, energy, iterations, reduced, force, _)) => {
                     report.sublevels += 1;
-                    self.state =
-                        State { time, scale, reduced, contact_force: force, result: Some(result.clone()) };
+                    self.state = self.next_state(time, scale, reduced, force, result.clone());
                     if target >= 1.0 {
                         report.iterations = iterations;
                         report.time_s = start.elapsed().as_secs_f64();
@@ -1371,13 +1445,7 @@ impl<const D: usize> NonlinearContact<D> {
                 report.sublevels = 1;
                 report.iterations = iterations;
                 report.time_s = start.elapsed().as_secs_f64();
-                self.state = State {
-                    time: t,
-                    scale: 1.0,
-                    reduced,
-                    contact_force: force,
-                    result: Some(result.clone()),
-                };
+                self.state = self.next_state(t, 1.0, reduced, force, result.clone());
                 Ok(NonlinearResult { time: t, contact: result, strain_energy: energy, report })
             }
             Err(e) => {
@@ -1505,12 +1573,18 @@ impl<const D: usize> NonlinearContact<D> {
                 None => (None, None),
             },
             None => {
+                let geometry = self.contact.geometry();
                 let friction = previous.is_some()
-                    && self.contact.geometry().nodes.iter().any(|node| node.friction > 0.0);
-                let slip_bound = match (friction, previous) {
-                    (true, Some(p)) => {
-                        Some(self.contact.geometry().slip_bounds_from_pressure(&p.solution.lambda_n))
+                    && match &self.friction_laws {
+                        Some(laws) => laws.any_friction(geometry),
+                        None => geometry.nodes.iter().any(|node| node.friction > 0.0),
+                    };
+                // g_c = F_c(v) |Λ_n| with the laws (Self::set_friction_law), else F_c |Λ_n|
+                let slip_bound = match (friction, previous, &self.friction_laws) {
+                    (true, Some(p), Some(laws)) => {
+                        Some(laws.slip_bounds(geometry, &p.solution.lambda_n, &self.state.slip_rate))
                     }
+                    (true, Some(p), None) => Some(geometry.slip_bounds_from_pressure(&p.solution.lambda_n)),
                     _ => None,
                 };
                 (slip_bound, if friction { previous.map(|p| p.displacement.clone()) } else { None })

@@ -375,9 +375,10 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
             .tie(a.as_str(), &pa, b.as_str(), &pb)
             .map_err(|e| cx.err(&k, t.body_a.span(), e.to_string()))?;
     }
-    let dynamic = matches!(analysis, Analysis::Dynamic { .. });
+    // friction laws F_c(v) need slip speeds, i.e. levels in time
+    let in_time = !matches!(analysis, Analysis::Static { .. });
     for (i, c) in doc.contact.iter().enumerate() {
-        contact(&cx, &mut joint, c, &format!("contact[{i}]"), &names, dynamic, &shapes)?;
+        contact(&cx, &mut joint, c, &format!("contact[{i}]"), &names, in_time, &shapes)?;
     }
     if let Some(s) = &doc.solver {
         solver(&cx, &mut joint, s)?;
@@ -395,7 +396,7 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
         };
         return Err(cx.err(k, span, e.to_string()));
     }
-    if dynamic {
+    if matches!(analysis, Analysis::Dynamic { .. }) {
         for (i, b) in doc.bodies.iter().enumerate() {
             let b = b.get_ref();
             if b.density.is_none() && b.material.get_ref().kind.get_ref() != "kelvin_voigt" {
@@ -1369,7 +1370,7 @@ fn contact<const D: usize>(
     c: &Sp<ContactSpec>,
     k: &str,
     names: &[String],
-    dynamic: bool,
+    in_time: bool,
     shapes: &HashMap<String, Shape<D>>,
 ) -> R<()> {
     let s = c.get_ref();
@@ -1413,7 +1414,7 @@ fn contact<const D: usize>(
                 .search_distance(&name, cx.positive(d, &dk)?)
                 .map_err(|e| cx.err(dk, d.span(), e.to_string()))?;
         }
-        return contact_options(cx, joint, s, k, &name, dynamic);
+        return contact_options(cx, joint, s, k, &name, in_time);
     }
     let mut pair = match (&s.partner, &s.obstacle) {
         (Some(p), None) => {
@@ -1510,7 +1511,7 @@ fn contact<const D: usize>(
     };
     pair.friction = friction;
     joint.add_contact(pair).map_err(|e| cx.err(key(k, "part"), s.part.span(), e.to_string()))?;
-    contact_options(cx, joint, s, k, &name, dynamic)
+    contact_options(cx, joint, s, k, &name, in_time)
 }
 
 /// The options of a contact pair once it is added: initial penetration policy, friction law.
@@ -1520,7 +1521,7 @@ fn contact_options<const D: usize>(
     s: &ContactSpec,
     k: &str,
     name: &str,
-    dynamic: bool,
+    in_time: bool,
 ) -> R<()> {
     let name = name.to_string();
     if let Some(r) = &s.refuse_initial_penetration {
@@ -1546,11 +1547,11 @@ fn contact_options<const D: usize>(
     }
     if let Some(l) = &s.friction_law {
         let lk = key(k, "friction_law");
-        if !dynamic {
+        if !in_time {
             return Err(cx.err(
                 lk,
                 l.span(),
-                "`friction_law` applies to dynamic analyses only (use `friction`)",
+                "`friction_law` needs slip speeds: quasi-static and dynamic analyses only (a static analysis: use `friction`)",
             ));
         }
         let ls = l.get_ref();
