@@ -58,7 +58,7 @@ use synovia_io::IoError;
 use synovia_material::{KelvinVoigt, LinearElastic, Material, MaterialError};
 use synovia_mesh::math::{Point, Real, Vector};
 use synovia_mesh::{BoundaryKind, Mesh, MeshError};
-use synovia_nonlinear::{NewtonParams, NonlinearContact};
+use synovia_nonlinear::{NewtonParams, NonlinearContact, NonlinearResult};
 use synovia_time::dynamic::{DynamicBody, DynamicParams, DynamicStepper};
 use synovia_time::history::{pressure, scaled, scaled_traction, LoadHistory, RigidMotion};
 use synovia_time::nonlinear_dynamic::NonlinearDynamicStepper;
@@ -1193,11 +1193,6 @@ impl<const D: usize> JointModel<D> {
     /// solver.
     pub fn prepare(&self) -> Result<JointSession<'_, D>, JointError> {
         self.check_penetration_policy()?;
-        if self.is_nonlinear() {
-            return Err(JointError::Invalid(
-                "re-solve sessions need a linear model: nonlinear materials and finite strain are solved by run_static / run_quasistatic".into(),
-            ));
-        }
         JointSession::new(self)
     }
 
@@ -1290,6 +1285,61 @@ impl<const D: usize> JointModel<D> {
         })
     }
 
+    /// The Newton iteration of a nonlinear model ([`NonlinearContact`]) with the model's
+    /// parameters, interface block, screening band and friction laws (friction laws `F_c(v)`:
+    /// the slip bounds of a level from the slip speed over the two converged levels before it,
+    /// as the linear quasi-static scheme's), at the unloaded reference configuration.
+    pub(crate) fn nonlinear_contact(&self) -> Result<NonlinearContact<D>, JointError> {
+        self.check_nonlinear_rigid()?;
+        let mut nl = NonlinearContact::with_interface_block(
+            &self.model,
+            &self.pairs,
+            &self.kinematics,
+            self.elastic_params,
+            self.newton,
+            self.interface_block,
+        )?;
+        for (pair, law) in &self.friction_laws {
+            nl.set_friction_law(pair, law.clone())?;
+        }
+        nl.set_screening_band(self.screening_band)?;
+        Ok(nl)
+    }
+
+    /// One level `t` (index `step`) of a nonlinear model from the converged state of `nl`: with
+    /// rigid bodies posed and their force-controlled coordinates found by `driver`
+    /// ([`RigidDriver::nonlinear_level`]), else [`NonlinearContact::step_to`]; its record.
+    pub(crate) fn nonlinear_level(
+        &self,
+        nl: &mut NonlinearContact<D>,
+        driver: Option<&mut RigidDriver>,
+        step: usize,
+        t: Real,
+        solver: &dyn ContactSolver,
+    ) -> Result<(StepRecord, NonlinearResult<D>), JointError> {
+        Ok(match driver {
+            Some(driver) => {
+                let (mut record, level) = driver.nonlinear_level(self, nl, t, solver)?;
+                record.step = step;
+                (record, level)
+            }
+            None => {
+                let level = nl.step_to(&self.model, t, solver)?;
+                let record = StepRecord {
+                    step,
+                    time: t,
+                    pairs: synovia_time::results::pair_records(nl.geometry(), &level.contact),
+                    strain_energy: level.strain_energy,
+                    iterations: level.report.total_iterations,
+                    solver: level.contact.solution.report.solver.clone(),
+                    fallback: level.contact.solution.report.fallback.clone(),
+                    ..Default::default()
+                };
+                (record, level)
+            }
+        })
+    }
+
     /// The levels of a nonlinear model (nonlinear materials or finite strain): the Newton
     /// iteration of [`synovia_nonlinear::NonlinearContact`] with load stepping and cut-back,
     /// Tresca friction frozen per level (docs/model.md §2.3, §8).
@@ -1301,21 +1351,7 @@ impl<const D: usize> JointModel<D> {
         mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
         check_levels(times)?;
-        self.check_nonlinear_rigid()?;
-        let mut nl = NonlinearContact::with_interface_block(
-            &self.model,
-            &self.pairs,
-            &self.kinematics,
-            self.elastic_params,
-            self.newton,
-            self.interface_block,
-        )?;
-        // friction laws F_c(v): the slip bounds of a level from the slip speed over the two
-        // converged levels before it, as the linear quasi-static scheme's
-        for (pair, law) in &self.friction_laws {
-            nl.set_friction_law(pair, law.clone())?;
-        }
-        nl.set_screening_band(self.screening_band)?;
+        let mut nl = self.nonlinear_contact()?;
         // the reference configuration before the first level (the same start as the linear
         // quasi-static scheme's first level, which is solved from the undeformed body)
         let t0 = times.first().copied().unwrap_or(0.0).min(0.0);
@@ -1329,27 +1365,7 @@ impl<const D: usize> JointModel<D> {
         let mut driver = (!self.rigid_bodies.is_empty()).then(|| RigidDriver::new(self));
         for (step, &t) in times.iter().enumerate() {
             let t_step = Instant::now();
-            let (record, level) = match driver.as_mut() {
-                Some(driver) => {
-                    let (mut record, level) = driver.nonlinear_level(self, &mut nl, t, solver)?;
-                    record.step = step;
-                    (record, level)
-                }
-                None => {
-                    let level = nl.step_to(&self.model, t, solver)?;
-                    let record = StepRecord {
-                        step,
-                        time: t,
-                        pairs: synovia_time::results::pair_records(nl.geometry(), &level.contact),
-                        strain_energy: level.strain_energy,
-                        iterations: level.report.total_iterations,
-                        solver: level.contact.solution.report.solver.clone(),
-                        fallback: level.contact.solution.report.fallback.clone(),
-                        ..Default::default()
-                    };
-                    (record, level)
-                }
-            };
+            let (record, level) = self.nonlinear_level(&mut nl, driver.as_mut(), step, t, solver)?;
             let record = StepRecord { step_s: t_step.elapsed().as_secs_f64(), ..record };
             let geometry = nl.geometry();
             tracing::debug!(

@@ -3,8 +3,8 @@
 //! warm-started from the previous contact state.
 //!
 //! [`JointModel::prepare`] validates the model, assembles and factorises the stiffness and
-//! builds the contact geometry once, and returns a [`JointSession`]. Its solves never
-//! refactorise:
+//! builds the contact geometry once, and returns a [`JointSession`]. The solves of a linear
+//! model never refactorise:
 //!
 //! * [`JointSession::solve_static`]`(t)`: the static problem at `t` (step 0 of the quasi-static
 //!   scheme, exactly what [`JointModel::run_static`] solves), warm-started from the last
@@ -13,6 +13,24 @@
 //!   ([`QuasiStaticStepper::step`]): Tresca friction with `g_c = F_c |Λ_n|` and the slip origin
 //!   of the previous level, warm-started from it, so a sequence of `step` calls is
 //!   [`JointModel::run_quasistatic`] one frame at a time.
+//!
+//! # Nonlinear models
+//!
+//! A model with a nonlinear material or finite strain ([`JointModel::is_nonlinear`]) gets a
+//! session on the Newton iteration of [`NonlinearContact`] (docs/nonlinear.md): the symbolic
+//! factorisation of the tangent and the contact set-up are done once, and each solve starts
+//! from the last converged state (its displacement and, for [`JointSession::step`], its
+//! friction state) instead of the reference configuration; the tangent is refactorised by the
+//! Newton iteration as it needs ([`JointSession::factorizations`] counts them).
+//!
+//! * [`JointSession::solve_static`]`(t)`: the frictionless static problem at `t` (as
+//!   [`JointModel::run_static`] solves it from the reference configuration), reached from the
+//!   last solution's displacement: the same solution to the Newton tolerance where it is
+//!   unique;
+//! * [`JointSession::step`]`(t)`: one quasi-static level from the last one (Coulomb frozen to
+//!   Tresca, friction laws, rigid bodies with mixed control as in
+//!   [`JointModel::run_quasistatic`]), so a sequence of `step` calls is that run one frame at
+//!   a time.
 //!
 //! # Changing loads between solves
 //!
@@ -41,6 +59,7 @@ use synovia_contact::operators::ContactGeometry;
 use synovia_contact::{ContactSolver, StaticContact, StaticContactResult};
 use synovia_fem::{ElasticInfo, ElasticSolver, Model};
 use synovia_mesh::math::{Real, Vector};
+use synovia_nonlinear::NonlinearContact;
 use synovia_time::quasistatic::QuasiStaticStepper;
 use synovia_time::results::StepRecord;
 
@@ -86,7 +105,19 @@ pub struct JointSession<'a, const D: usize> {
 #[allow(clippy::large_enum_variant)]
 enum Engine<const D: usize> {
     Contact(Box<QuasiStaticStepper<D>>),
-    Elastic { solver: Box<ElasticSolver<D>>, result: Option<StaticContactResult<D>>, step: usize },
+    Elastic {
+        solver: Box<ElasticSolver<D>>,
+        result: Option<StaticContactResult<D>>,
+        step: usize,
+    },
+    /// A nonlinear model: the Newton iteration, the last converged level's contact solution
+    /// and index, and the tangent factorisations of the solves so far.
+    Nonlinear {
+        nl: Box<NonlinearContact<D>>,
+        result: Option<StaticContactResult<D>>,
+        step: usize,
+        factorisations: usize,
+    },
 }
 
 impl<const D: usize> std::fmt::Debug for JointSession<'_, D> {
@@ -106,7 +137,14 @@ impl<'a, const D: usize> JointSession<'a, D> {
         model.validate()?;
         let solver = joint.build_solver()?;
         let (elastic_params, quasistatic_params, nested) = joint.session_params();
-        let engine = if joint.pairs().is_empty() {
+        let engine = if joint.is_nonlinear() {
+            Engine::Nonlinear {
+                nl: Box::new(joint.nonlinear_contact()?),
+                result: None,
+                step: 0,
+                factorisations: 0,
+            }
+        } else if joint.pairs().is_empty() {
             Engine::Elastic {
                 solver: Box::new(ElasticSolver::new(model, elastic_params)?),
                 result: None,
@@ -175,6 +213,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
                 Ok(self.commit(record, report))
             }
             Engine::Elastic { .. } => self.elastic(t, true),
+            Engine::Nonlinear { .. } => self.nonlinear(t, true),
         }
     }
 
@@ -209,14 +248,18 @@ impl<'a, const D: usize> JointSession<'a, D> {
                 let report = contact_report(&record, result, warm);
                 Ok(self.commit(record, report))
             }
-            Engine::Elastic { .. } => {
+            Engine::Elastic { .. } | Engine::Nonlinear { .. } => {
                 if let Some(last) = self.report.filter(|r| t <= r.time) {
                     return Err(JointError::Invalid(format!(
                         "time {t} must be later than the last solve's time {}",
                         last.time
                     )));
                 }
-                self.elastic(t, false)
+                if matches!(self.engine, Engine::Nonlinear { .. }) {
+                    self.nonlinear(t, false)
+                } else {
+                    self.elastic(t, false)
+                }
             }
         }
     }
@@ -228,6 +271,11 @@ impl<'a, const D: usize> JointSession<'a, D> {
         match &mut self.engine {
             Engine::Contact(stepper) => stepper.reset(),
             Engine::Elastic { result, step, .. } => {
+                *result = None;
+                *step = 0;
+            }
+            Engine::Nonlinear { nl, result, step, .. } => {
+                nl.reset(0.0);
                 *result = None;
                 *step = 0;
             }
@@ -268,6 +316,50 @@ impl<'a, const D: usize> JointSession<'a, D> {
         Ok(self.commit(record, report))
     }
 
+    /// A level of a nonlinear model at `t`: `restart` the frictionless static problem from the
+    /// last solution's displacement (its multipliers and friction state dropped), else the next
+    /// quasi-static level from the last one; with no last solution from the reference
+    /// configuration at `min(t, 0)` (as [`JointModel::run_quasistatic`]). On failure the last
+    /// converged state is restored.
+    fn nonlinear(&mut self, t: Real, restart: bool) -> Result<SolveReport, JointError> {
+        if !t.is_finite() {
+            return Err(JointError::Invalid(format!("time {t} is not finite")));
+        }
+        let start = Instant::now();
+        let joint = self.joint;
+        let driver = if joint.rigid_bodies().is_empty() { None } else { Some(&mut self.rigid) };
+        let Engine::Nonlinear { nl, result, step, factorisations } = &mut self.engine else {
+            return Err(JointError::Invalid("not a nonlinear session".into()));
+        };
+        let warm = result.is_some();
+        let checkpoint = nl.checkpoint();
+        let level_index = match (warm, restart) {
+            (true, true) => {
+                let reduced = nl.reduced().to_vec();
+                nl.set_state(nl.time(), &reduced)?;
+                0
+            }
+            (true, false) => *step + 1,
+            (false, _) => {
+                nl.reset(t.min(0.0));
+                0
+            }
+        };
+        let (record, level) = match joint.nonlinear_level(nl, driver, level_index, t, self.solver.as_ref()) {
+            Ok(solved) => solved,
+            Err(e) => {
+                nl.restore(checkpoint)?;
+                return Err(e);
+            }
+        };
+        *factorisations += level.report.factorisations;
+        let record = StepRecord { step_s: start.elapsed().as_secs_f64(), ..record };
+        let report = contact_report(&record, &level.contact, warm);
+        *result = Some(level.contact);
+        *step = level_index;
+        Ok(self.commit(record, report))
+    }
+
     fn commit(&mut self, record: StepRecord, report: SolveReport) -> SolveReport {
         self.record = Some(record);
         self.report = Some(report);
@@ -280,7 +372,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
     pub fn result(&self) -> Option<&StaticContactResult<D>> {
         match &self.engine {
             Engine::Contact(stepper) => stepper.last_result(),
-            Engine::Elastic { result, .. } => result.as_ref(),
+            Engine::Elastic { result, .. } | Engine::Nonlinear { result, .. } => result.as_ref(),
         }
     }
     /// Nodal displacements per body of the last solve.
@@ -299,6 +391,11 @@ impl<'a, const D: usize> JointSession<'a, D> {
     pub fn model(&self) -> &Model<D> {
         self.joint.model()
     }
+    /// The kinematics of the bodies (small strain, or finite strain for the stresses and
+    /// strains of a nonlinear model's solution: [`JointModel::kinematics`]).
+    pub fn kinematics(&self) -> &[synovia_fem::Kinematics] {
+        self.joint.kinematics()
+    }
     /// The contact nodes (empty without contact pairs): those of the last solve, rebuilt at
     /// every pose of a posed rigid partner — after a solve that failed, those of the pose it
     /// failed at (the nodes are the same at every pose, their normals and gaps are the pose's),
@@ -307,6 +404,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
         match &self.engine {
             Engine::Contact(stepper) => stepper.geometry(),
             Engine::Elastic { .. } => &self.no_geometry,
+            Engine::Nonlinear { nl, .. } => nl.geometry(),
         }
     }
     /// The contact solver's name.
@@ -319,12 +417,17 @@ impl<'a, const D: usize> JointSession<'a, D> {
         match &self.engine {
             Engine::Contact(stepper) => stepper.contact().elastic().info(),
             Engine::Elastic { solver, .. } => solver.info(),
+            Engine::Nonlinear { nl, .. } => nl.contact().elastic().info(),
         }
     }
-    /// Number of numeric factorisations of the stiffness the session has done: always 1 (in
-    /// [`JointModel::prepare`]); solves reuse it.
+    /// Number of numeric factorisations the session has done: for a linear model always 1 (of
+    /// the stiffness, in [`JointModel::prepare`]; solves reuse it); for a nonlinear model the
+    /// tangent factorisations of the Newton iterations of all solves so far.
     pub fn factorizations(&self) -> usize {
-        1
+        match &self.engine {
+            Engine::Nonlinear { factorisations, .. } => *factorisations,
+            _ => 1,
+        }
     }
     /// Set-up time of [`JointModel::prepare`] (validation, assembly, factorisation, contact
     /// geometry), s.
@@ -341,6 +444,7 @@ impl<'a, const D: usize> JointSession<'a, D> {
     pub fn cache_bytes(&self) -> usize {
         match &self.engine {
             Engine::Contact(stepper) => stepper.contact().context().bytes(),
+            Engine::Nonlinear { nl, .. } => nl.contact().context().bytes(),
             Engine::Elastic { .. } => 0,
         }
     }

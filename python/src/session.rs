@@ -37,12 +37,15 @@ struct Info {
     factor_nnz: usize,
     contact_nodes: usize,
     solver: String,
+    /// Numeric factorisations done by the session (updated after each solve).
+    factorizations: usize,
 }
 
 #[derive(Debug)]
 enum Reply {
     Started(Info),
-    Solved(Box<RunData>),
+    /// A solve's results and the session's numeric factorisations so far.
+    Solved(Box<RunData>, usize),
     Done,
 }
 
@@ -61,8 +64,8 @@ fn snapshot<const D: usize>(
         if !s.geometry().is_empty() {
             data.kkt = Some(result.kkt);
         }
-        // sessions are linear (JointModel::prepare refuses nonlinear models)
-        finish(&mut data, model, &result.displacement, &[])?;
+        // stresses with the bodies' kinematics (finite strain for a nonlinear model's session)
+        finish(&mut data, model, &result.displacement, s.kinematics())?;
     }
     data.records = s.record().cloned().into_iter().collect();
     data.n_dofs = info.n_dofs;
@@ -89,6 +92,7 @@ fn worker<const D: usize>(joint: Arc<JointModel<D>>, rx: Receiver<Cmd>, tx: Send
         factor_nnz: ei.factor_nnz,
         contact_nodes: session.geometry().len(),
         solver: session.solver_name().to_string(),
+        factorizations: session.factorizations(),
     };
     if tx.send(Ok(Reply::Started(info.clone()))).is_err() {
         return;
@@ -109,7 +113,7 @@ fn worker<const D: usize>(joint: Arc<JointModel<D>>, rx: Receiver<Cmd>, tx: Send
         let reply = r
             .map_err(|e| e.to_string())
             .and_then(|rep| snapshot(&session, rep, &info))
-            .map(|d| Reply::Solved(Box::new(d)));
+            .map(|d| Reply::Solved(Box::new(d), session.factorizations()));
         if tx.send(reply).is_err() {
             break;
         }
@@ -171,8 +175,9 @@ impl PySession {
 
     fn solve(&mut self, py: Python<'_>, cmd: Cmd) -> PyResult<PyRunResult> {
         match self.request(py, cmd)? {
-            Reply::Solved(data) => {
+            Reply::Solved(data, factorizations) => {
                 self.solves += 1;
+                self.info.factorizations = factorizations;
                 Ok(PyRunResult { data: *data })
             }
             _ => Err(msg("unexpected reply of the session thread")),
@@ -254,10 +259,12 @@ impl PySession {
     fn contact_nodes(&self) -> usize {
         self.info.contact_nodes
     }
-    /// Numeric factorisations of the stiffness done by the session: always 1.
+    /// Numeric factorisations done by the session: for a linear model always 1 (of the
+    /// stiffness, when it was prepared); for a nonlinear model the tangent factorisations of
+    /// the Newton iterations of its solves so far.
     #[getter]
     fn factorizations(&self) -> usize {
-        1
+        self.info.factorizations
     }
     /// Solves done so far.
     #[getter]

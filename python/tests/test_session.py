@@ -154,3 +154,37 @@ def test_session_with_friction_equals_rust(rust_reference):
     for r, rr in zip(results, ref):
         compare_session(r, rr)
     assert any(p["tangential_force"] > 0 for r in results for p in r.records[0]["pairs"])
+
+
+def test_neo_hookean_session_steps_equal_the_run():
+    """A neo-Hookean block in finite strain (the Newton iteration): the session's steps are the
+    quasi-static run one frame at a time — forces, displacements and finite-strain stresses —
+    and solve_static from the last frame gives run_static's force."""
+
+    def nh_model():
+        nodes, cells, parts = rectangle(0.0, 2.0, 0.0, 1.0, 8, 4)
+        m = synovia.Model(2)
+        m.add_body("block", nodes, cells, synovia.Material.neo_hookean(E, NU), parts=parts)
+        m.set_kinematics("block", "finite")
+        m.symmetry("block", "left")
+        m.prescribe("block", "top", [0.0, -0.2], history=lambda t: t, components=[1])
+        m.contact_plane("floor", "block", "bottom", [0.0, 0.0], [0.0, 1.0])
+        return m
+
+    m = nh_model()
+    times = [0.25, 0.5, 1.0]
+    run = m.run_quasistatic(times)
+    static = m.run_static(1.0)
+    with m.prepare() as s:
+        frames = [s.step(t) for t in times]
+        assert s.factorizations > 0
+        warm = s.solve_static(1.0)
+    forces = [f.pairs()["floor"]["normal_force"] for f in frames]
+    np.testing.assert_allclose(forces, run.pair_history("floor", "normal_force"), rtol=1e-12)
+    np.testing.assert_allclose(frames[-1].displacement("block"), run.displacement("block"), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(frames[-1].stress("block", "cell"), run.stress("block", "cell"), rtol=1e-10, atol=1e-12)
+    assert frames[-1].kkt["max"] < 1e-8
+    assert warm.warm_started is True
+    assert warm.pairs()["floor"]["normal_force"] == pytest.approx(
+        static.pairs()["floor"]["normal_force"], rel=1e-7
+    )
