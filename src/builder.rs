@@ -1397,16 +1397,23 @@ impl<const D: usize> JointModel<D> {
     }
 
     /// What the nonlinear path (static and quasi-static) does not take of the rigid bodies:
-    /// parts tied to them. (Friction against them is taken with one force-controlled
-    /// coordinate, the slip measured relative to the moving partner, docs/model.md (10.5);
-    /// [`crate::rigid`] refuses it when all their coordinates are prescribed.)
+    /// parts tied to a rigid body with force-controlled coordinates (the search for them
+    /// balances the contact forces only). Parts tied to rigid bodies whose coordinates are all
+    /// prescribed are prescribed displacements, their reactions (from the internal force,
+    /// [`synovia_fem::post::part_reactions_with_kinematics`]) loading the rigid body. (Friction
+    /// against rigid bodies is taken, the slip measured relative to the moving partner,
+    /// docs/model.md (10.5).)
     fn check_nonlinear_rigid(&self) -> Result<(), JointError> {
-        if !self.rigid_ties.is_empty() {
-            return Err(JointError::Invalid(
-                "rigid bodies (mixed control) are not supported with nonlinear materials or finite strain yet \
-                 when a part is tied to them (as contact partners they are); prescribe the part's motion or use a linear material"
-                    .into(),
-            ));
+        for (_, part, r) in &self.rigid_ties {
+            let body = &self.rigid_bodies[*r];
+            if body.controls.iter().any(|c| matches!(c, crate::rigid::DofControl::Force { .. })) {
+                return Err(JointError::Invalid(format!(
+                    "part `{part}` is tied to rigid body `{}`, which has force-controlled coordinates: not supported with \
+                     nonlinear materials or finite strain yet (a tied part to a rigid body whose coordinates are all \
+                     prescribed is); prescribe its coordinates or use a linear material",
+                    body.name
+                )));
+            }
         }
         Ok(())
     }

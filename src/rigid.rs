@@ -1696,7 +1696,22 @@ impl RigidDriver {
                 .get(body.0)
                 .ok_or_else(|| JointError::Invalid("internal: no displacement".into()))?;
             let mesh = &joint.model().body(*body)?.mesh;
-            for (i, r) in synovia_fem::post::part_reactions(joint.model(), *body, part, u, t)? {
+            // a nonlinear model's reactions from its internal force (finite strain: the
+            // first Piola–Kirchhoff nodal forces), a linear one's from K u
+            let reactions = if joint.is_nonlinear() {
+                let kinematics = joint.kinematics().get(body.0).copied().unwrap_or_default();
+                synovia_fem::post::part_reactions_with_kinematics(
+                    joint.model(),
+                    *body,
+                    part,
+                    u,
+                    t,
+                    kinematics,
+                )?
+            } else {
+                synovia_fem::post::part_reactions(joint.model(), *body, part, u, t)?
+            };
+            for (i, r) in reactions {
                 let x = pose.position(&mesh.nodes()[i]);
                 let f = embed(&-r);
                 let m = cross(embed(&x), f);

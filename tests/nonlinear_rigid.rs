@@ -196,7 +196,8 @@ fn unsupported_rigid_cases_are_refused() -> Result<(), Error> {
     assert!(matches!(err, JointError::Invalid(_)) && err.to_string().contains("not resisted"), "{err}");
     assert!(err.to_string().contains(".rx"), "{err}");
 
-    // a part tied to a rigid body: refused as before
+    // a part tied to a rigid body with a force-controlled coordinate: refused (tied to one
+    // whose coordinates are all prescribed: tied_plate_* below)
     let mut tied = JointModel::<3>::new();
     let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [4, 4, 2], [Grading::Uniform; 3])?;
     tied.add_body("block", mesh, Arc::new(neo_hookean(E, NU)?) as Arc<dyn Material<3>>)?;
@@ -741,5 +742,82 @@ fn friction_law_on_a_fixed_obstacle_equals_the_linear_path() -> Result<(), Error
     }
     assert!(nl.iter().skip(1).any(|f| !f.2.is_empty()), "no friction cells");
     assert!(smallest >= mu_k * (1.0 - 1e-12) && smallest < 0.9 * mu_s, "smallest F_c {smallest}");
+    Ok(())
+}
+
+/// The block `[-1, 1]² × [0, 1]` with `material` on a rigid sphere under its bottom (Coulomb
+/// 0.2), its top tied to a rigid plate whose coordinates are all prescribed: pushed down by
+/// `0.03 t`, moved sideways by `0.004 t` and tilted by `0.01 t` about `x`.
+fn tied_plate_model(material: Arc<dyn Material<3>>, finite: bool) -> Result<JointModel<3>, Error> {
+    let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [8, 8, 4], [Grading::Uniform; 3])?;
+    let mut joint = JointModel::<3>::new();
+    joint.add_body("block", mesh, material)?;
+    if finite {
+        joint.set_kinematics("block", Kinematics::FiniteStrain)?;
+    }
+    let plate = RigidBody::<3>::new("plate", Point::<3>::new(0.0, 0.0, 1.0))?
+        .prescribe(0, FnHistory::new(|t| 0.004 * t))?
+        .prescribe(1, Constant(0.0))?
+        .prescribe(2, FnHistory::new(|t| -0.03 * t))?
+        .prescribe(3, FnHistory::new(|t| 0.01 * t))?
+        .prescribe(4, Constant(0.0))?
+        .prescribe(5, Constant(0.0))?;
+    joint.add_rigid_body(plate)?;
+    joint.tie_to_rigid_body("block", "top", "plate")?;
+    let sphere = SphereObstacle::new(Point::<3>::new(0.1, 0.05, -RADIUS), RADIUS, false)?;
+    joint.contact_rigid("bump", "block", "bottom", sphere, 0.2)?;
+    Ok(joint)
+}
+
+/// A part tied to a rigid body whose coordinates are all prescribed, in the nonlinear path
+/// (no longer refused): the linear law through the Newton path equals the linear path level by
+/// level (the plate's reactions, displacements, `Λ_n` to 1e-10); with the neo-Hookean block in
+/// finite strain the plate's force (from the tied nodes' internal forces,
+/// `part_reactions_with_kinematics`) balances the contact force on the block to 1e-9 of it
+/// (the element forces sum to zero, so it is exact up to the Newton residual), and differs from
+/// the linear one's.
+#[test]
+fn tied_plate_with_prescribed_coordinates_in_the_nonlinear_path() -> Result<(), Error> {
+    let times = [0.4, 0.7, 1.0];
+    let linear = tied_plate_model(Arc::new(isotropic(E, NU)?), false)?.run_quasistatic(&times)?;
+    let routed = tied_plate_model(Arc::new(Hidden(isotropic(E, NU)?)), false)?;
+    assert!(routed.is_nonlinear());
+    let mut fields = Vec::new();
+    let routed = routed.run_quasistatic_with(&times, |view| {
+        fields.push((view.result.displacement.clone(), view.result.solution.lambda_n.clone()));
+        Ok(())
+    })?;
+    let mut lin_fields = Vec::new();
+    tied_plate_model(Arc::new(isotropic(E, NU)?), false)?.run_quasistatic_with(&times, |view| {
+        lin_fields.push((view.result.displacement.clone(), view.result.solution.lambda_n.clone()));
+        Ok(())
+    })?;
+    for (level, (a, b)) in linear.records.iter().zip(&routed.records).enumerate() {
+        let (ra, rb) = (&a.rigid[0], &b.rigid[0]);
+        let scale = ra.reaction.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let dr = ra.reaction.iter().zip(&rb.reaction).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale;
+        let du = max_diff(&lin_fields[level].0, &fields[level].0) / max_abs(&lin_fields[level].0);
+        let lmax = lin_fields[level].1.iter().copied().fold(0.0, f64::max);
+        let dl =
+            lin_fields[level].1.iter().zip(&fields[level].1).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+                / lmax;
+        eprintln!("tied plate, level {level}: reactions {dr:.1e}, displacements {du:.1e}, pressures {dl:.1e}; plate force {:?}", rb.force);
+        assert!(dr < 1e-10 && du < 1e-10 && dl < 1e-10, "level {level}: {dr:e} {du:e} {dl:e}");
+    }
+    // neo-Hookean, finite strain: the plate's force balances the contact force on the block
+    let hyper = tied_plate_model(Arc::new(neo_hookean(E, NU)?), true)?.run_quasistatic(&times)?;
+    for (level, r) in hyper.records.iter().enumerate() {
+        let (plate, contact) = (r.rigid[0].force, r.pairs[0].force);
+        let size = contact.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!(size > 0.0, "level {level}: no contact");
+        // the force the block exerts on the plate is the one the sphere exerts on the block
+        let balance = (0..3).map(|i| (plate[i] - contact[i]).abs()).fold(0.0, f64::max) / size;
+        let change = (plate[2] / linear.records[level].rigid[0].force[2] - 1.0).abs();
+        eprintln!(
+            "tied plate, neo-Hookean level {level}: plate force {plate:?}, contact force {contact:?}, balance {balance:.1e}, vs linear {change:.2e}"
+        );
+        assert!(balance < 1e-9, "level {level}: plate {plate:?} vs contact {contact:?}");
+        assert!(change > 1e-4, "level {level}: the neo-Hookean plate force equals the linear one");
+    }
     Ok(())
 }

@@ -269,7 +269,7 @@ pub(crate) fn check_kinematics<const D: usize>(
     Ok(())
 }
 
-fn failure<const D: usize>(model: &Model<D>, b: usize, c: usize, e: ElementFailure) -> FemError {
+pub(crate) fn failure<const D: usize>(model: &Model<D>, b: usize, c: usize, e: ElementFailure) -> FemError {
     FemError::InvertedElement { body: model.bodies()[b].name.clone(), cell: c, det_f: e.det_f }
 }
 

@@ -242,7 +242,91 @@ pub fn part_reactions<const D: usize>(
     displacement: &[Vector<D>],
     t: Real,
 ) -> Result<Vec<(usize, Vector<D>)>, FemError> {
-    use crate::element::{body_force_into, stiffness_into};
+    use crate::element::stiffness_into;
+    let b = model.body(body)?;
+    let c = b
+        .material
+        .linear_stiffness()
+        .ok_or_else(|| FemError::NonlinearMaterial { body: b.name.clone(), material: b.material.name() })?;
+    let n = D * (D + 1);
+    let mut ke = vec![0.0; n * n];
+    // R_i = Σ_T ((K_T u_T)_i − f_T,i), summed in that order per component
+    part_reactions_by(model, body, part, displacement, t, |geo, cell, _, fe, out| {
+        stiffness_into(geo, &c, &mut ke);
+        for (a, slot) in out.iter_mut().enumerate() {
+            for p in 0..D {
+                let row = &ke[(D * a + p) * n..(D * a + p + 1) * n];
+                let mut s = -fe[D * a + p];
+                for (bb, &j) in cell.iter().enumerate() {
+                    for q in 0..D {
+                        s += row[D * bb + q] * displacement[j][q];
+                    }
+                }
+                slot[p] = s;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// [`part_reactions`] of a body with any material and [`Kinematics`] (docs/nonlinear.md): the
+/// internal force of `element_response` (`F_int,T = ∫_T Bᵀ S(e(u))`, the total Lagrangian
+/// first Piola–Kirchhoff force in finite strain) in place of `K_T u_T`,
+///
+/// ```text
+/// R_i = Σ_{T ∋ i} F_int,T,i(u_T) − Σ_{T ∋ i} ∫_T f φ_i dx,
+/// ```
+///
+/// (the body force per reference volume). For a linear material in small strain it equals
+/// [`part_reactions`] up to rounding.
+///
+/// # Errors
+/// As [`part_reactions`] (but any material), and [`FemError::InvertedElement`] for a cell
+/// with `det F ≤ 0`.
+pub fn part_reactions_with_kinematics<const D: usize>(
+    model: &Model<D>,
+    body: crate::BodyId,
+    part: &str,
+    displacement: &[Vector<D>],
+    t: Real,
+    kinematics: crate::Kinematics,
+) -> Result<Vec<(usize, Vector<D>)>, FemError> {
+    let b = model.body(body)?;
+    let n = D * (D + 1);
+    let (mut ue, mut fi) = (vec![0.0; n], vec![0.0; n]);
+    part_reactions_by(model, body, part, displacement, t, |geo, cell, ci, fe, out| {
+        for (a, &j) in cell.iter().enumerate() {
+            ue[D * a..D * a + D].copy_from_slice(displacement[j].as_slice());
+        }
+        crate::nonlinear::element_response(geo, b.material.as_ref(), kinematics, &ue, &mut fi, None)
+            .map_err(|e| crate::nonlinear::failure(model, body.0, ci, e))?;
+        for (a, slot) in out.iter_mut().enumerate() {
+            for p in 0..D {
+                slot[p] = fi[D * a + p] - fe[D * a + p];
+            }
+        }
+        Ok(())
+    })
+}
+
+/// The loop of [`part_reactions`]: for each cell with a node on the part, `element(geometry,
+/// cell nodes, cell index, body-force load f_T, out)` writes the cell's reaction share per
+/// cell node into `out`; the shares of the part's nodes are summed.
+fn part_reactions_by<const D: usize>(
+    model: &Model<D>,
+    body: crate::BodyId,
+    part: &str,
+    displacement: &[Vector<D>],
+    t: Real,
+    mut element: impl FnMut(
+        &SimplexGeometry<D>,
+        &[usize],
+        usize,
+        &[Real],
+        &mut [Vector<D>],
+    ) -> Result<(), FemError>,
+) -> Result<Vec<(usize, Vector<D>)>, FemError> {
+    use crate::element::body_force_into;
     let b = model.body(body)?;
     let mesh = &b.mesh;
     if displacement.len() != mesh.nodes().len() {
@@ -259,14 +343,10 @@ pub fn part_reactions<const D: usize>(
     for (k, &i) in nodes.iter().enumerate() {
         slot[i] = k;
     }
-    let c = b
-        .material
-        .linear_stiffness()
-        .ok_or_else(|| FemError::NonlinearMaterial { body: b.name.clone(), material: b.material.name() })?;
     let rule = crate::QuadratureRule::simplex(D, 2)?;
     let n = D * (D + 1);
-    let mut ke = vec![0.0; n * n];
     let mut fe = vec![0.0; n];
+    let mut share = vec![Vector::<D>::zeros(); D + 1];
     let mut out = vec![Vector::<D>::zeros(); nodes.len()];
     for (ci, cell) in mesh.cells().enumerate() {
         if cell.iter().all(|&i| slot[i] == usize::MAX) {
@@ -277,7 +357,6 @@ pub fn part_reactions<const D: usize>(
             body: b.name.clone(),
             source: synovia_mesh::MeshError::DegenerateCell { cell: ci, det: 0.0 },
         })?;
-        stiffness_into(&geo, &c, &mut ke);
         match &b.body_force {
             Some(f) => {
                 let f = |x: &synovia_mesh::math::Point<D>| f(x, t);
@@ -287,20 +366,10 @@ pub fn part_reactions<const D: usize>(
             }
             None => fe.iter_mut().for_each(|v| *v = 0.0),
         }
+        element(&geo, cell, ci, &fe, &mut share)?;
         for (a, &i) in cell.iter().enumerate() {
-            let k = slot[i];
-            if k == usize::MAX {
-                continue;
-            }
-            for p in 0..D {
-                let row = &ke[(D * a + p) * n..(D * a + p + 1) * n];
-                let mut s = -fe[D * a + p];
-                for (bb, &j) in cell.iter().enumerate() {
-                    for q in 0..D {
-                        s += row[D * bb + q] * displacement[j][q];
-                    }
-                }
-                out[k][p] += s;
+            if slot[i] != usize::MAX {
+                out[slot[i]] += share[a];
             }
         }
     }
