@@ -630,6 +630,18 @@ fn several_force_controlled_coordinates_with_friction_equal_the_linear_path() ->
     Ok(())
 }
 
+/// The exponential static-to-kinetic law of the friction-law tests: `μ_s = 0.4`, `μ_k = 0.1`,
+/// `v_c = 2·10⁻³` (the sliding here is ≈ 6·10⁻³ per unit time): `(μ_s, μ_k, F_c)`.
+fn exponential_law() -> (f64, f64, Arc<ExponentialFriction>) {
+    let (mu_s, mu_k) = (0.4, 0.1);
+    let law = ExponentialFriction {
+        static_coefficient: mu_s,
+        kinetic_coefficient: mu_k,
+        characteristic_speed: 2e-3,
+    };
+    (mu_s, mu_k, Arc::new(law))
+}
+
 /// A slip-speed dependent friction law in the nonlinear path (`JointModel::friction_law`,
 /// `NonlinearContact::set_friction_law`): the exponential static-to-kinetic law
 /// `F_c(v) = μ_k + (μ_s − μ_k) exp(−v / v_c)` against the sliding, prescribed rigid body, on a
@@ -640,12 +652,7 @@ fn several_force_controlled_coordinates_with_friction_equal_the_linear_path() ->
 /// tangential force at the last level is below the constant `μ_s`'s.
 #[test]
 fn friction_law_against_a_prescribed_rigid_body_equals_the_linear_path() -> Result<(), Error> {
-    let (mu_s, mu_k) = (0.4, 0.1);
-    let law = Arc::new(ExponentialFriction {
-        static_coefficient: mu_s,
-        kinetic_coefficient: mu_k,
-        characteristic_speed: 2e-3,
-    });
+    let (mu_s, mu_k, law) = exponential_law();
     let times = [0.3, 0.55, 0.8, 1.0];
     let mut linear = model_prescribed(Arc::new(isotropic(E, NU)?), 0.0)?;
     linear.friction_law("indent", law.clone())?;
@@ -686,12 +693,7 @@ fn friction_law_against_a_prescribed_rigid_body_equals_the_linear_path() -> Resu
 /// (`F_c = g_c / |Λ_n|` of the level before below `0.9 μ_s` somewhere).
 #[test]
 fn friction_law_on_a_fixed_obstacle_equals_the_linear_path() -> Result<(), Error> {
-    let (mu_s, mu_k) = (0.4, 0.1);
-    let law = Arc::new(ExponentialFriction {
-        static_coefficient: mu_s,
-        kinetic_coefficient: mu_k,
-        characteristic_speed: 2e-3,
-    });
+    let (mu_s, mu_k, law) = exponential_law();
     let times = [0.3, 0.55, 0.8, 1.0];
     let build = |material: Arc<dyn Material<3>>| -> Result<JointModel<3>, Error> {
         let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [12, 12, 6], [Grading::Uniform; 3])?;
