@@ -1290,7 +1290,6 @@ impl<const D: usize> JointModel<D> {
     /// the slip bounds of a level from the slip speed over the two converged levels before it,
     /// as the linear quasi-static scheme's), at the unloaded reference configuration.
     pub(crate) fn nonlinear_contact(&self) -> Result<NonlinearContact<D>, JointError> {
-        self.check_nonlinear_rigid()?;
         let mut nl = NonlinearContact::with_interface_block(
             &self.model,
             &self.pairs,
@@ -1394,28 +1393,6 @@ impl<const D: usize> JointModel<D> {
             setup_s,
             total_s: start.elapsed().as_secs_f64(),
         })
-    }
-
-    /// What the nonlinear path (static and quasi-static) does not take of the rigid bodies:
-    /// parts tied to a rigid body with force-controlled coordinates (the search for them
-    /// balances the contact forces only). Parts tied to rigid bodies whose coordinates are all
-    /// prescribed are prescribed displacements, their reactions (from the internal force,
-    /// [`synovia_fem::post::part_reactions_with_kinematics`]) loading the rigid body. (Friction
-    /// against rigid bodies is taken, the slip measured relative to the moving partner,
-    /// docs/model.md (10.5).)
-    fn check_nonlinear_rigid(&self) -> Result<(), JointError> {
-        for (_, part, r) in &self.rigid_ties {
-            let body = &self.rigid_bodies[*r];
-            if body.controls.iter().any(|c| matches!(c, crate::rigid::DofControl::Force { .. })) {
-                return Err(JointError::Invalid(format!(
-                    "part `{part}` is tied to rigid body `{}`, which has force-controlled coordinates: not supported with \
-                     nonlinear materials or finite strain yet (a tied part to a rigid body whose coordinates are all \
-                     prescribed is); prescribe its coordinates or use a linear material",
-                    body.name
-                )));
-            }
-        }
-        Ok(())
     }
 
     /// The levels of a model with rigid bodies: each level poses them and finds their

@@ -1170,6 +1170,7 @@ impl RigidDriver {
             (n.friction > 0.0 || laws.is_some_and(|l| l.law(n.pair).is_some()))
                 && owner_of.get(n.pair).copied().flatten().is_some()
         });
+        let tied = |b: usize| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b);
         let (level, solves) = match unknowns.as_slice() {
             [] if rigid_friction => {
                 // friction against partners whose coordinates are all prescribed (docs/model.md
@@ -1182,11 +1183,17 @@ impl RigidDriver {
                 nl.rebuild_geometry(model)?;
                 (nl.step_to(model, t, solver)?, 1)
             }
-            &[(b, k)] => {
+            // a body with a tied part balances its tie's reactions too, which the search
+            // inside the Newton iteration (contact forces only) does not see: all its
+            // coordinates around whole levels
+            &[(b, k)] if !tied(b) => {
                 let scale = force_scales(bodies, &values, &unknowns, length)[0];
                 self.gap_level(joint, nl, t, solver, &values, (b, k), scale, rigid_friction)?
             }
-            _ => self.several_level(joint, nl, t, solver, &values, &unknowns, rigid_friction)?,
+            _ => {
+                let around = unknowns.iter().any(|&(b, _)| tied(b));
+                self.several_level(joint, nl, t, solver, &values, &unknowns, rigid_friction, around)?
+            }
         };
         self.set_poses(joint);
         for (bi, body) in bodies.iter().enumerate() {
@@ -1401,6 +1408,11 @@ impl RigidDriver {
     /// tenth of `|φ(0)|` (regula falsi once it changed sign) or the error fourfold. Accepted when
     /// `|r_j| ≤ tolerance × scale_j` ([`ForceControlParams`]). Returns the accepted level (its
     /// iterations and contact solves summed over the evaluations) and the contact solves.
+    ///
+    /// With `around` (a force-controlled rigid body with a tied part, whose balance includes
+    /// the tie's reactions from the internal forces, [`synovia_fem::post::
+    /// part_reactions_with_kinematics`]) no coordinate is found inside the iteration: all of
+    /// them are `z`, each evaluation a level with every coordinate prescribed.
     #[allow(clippy::too_many_arguments)]
     fn several_level<const D: usize>(
         &mut self,
@@ -1411,30 +1423,35 @@ impl RigidDriver {
         values: &[Vec<Real>],
         unknowns: &[(usize, usize)],
         rigid_friction: bool,
+        around: bool,
     ) -> Result<(NonlinearResult<D>, usize), JointError> {
         let bodies = joint.rigid_bodies();
         let length = joint.model_size();
         let params = joint.force_control_params();
         let scales = force_scales(bodies, values, unknowns, length);
-        let Some(p) = unknowns
+        let inside = unknowns
             .iter()
             .enumerate()
             .filter(|(_, &(b, k))| k < D && values[b][k] != 0.0)
             .max_by(|(_, &(b1, k1)), (_, &(b2, k2))| values[b1][k1].abs().total_cmp(&values[b2][k2].abs()))
-            .map(|(i, _)| i)
-        else {
-            return Err(JointError::Unsupported {
+            .map(|(i, _)| i);
+        let p = match (around, inside) {
+            (true, _) => None,
+            (false, Some(p)) => Some(p),
+            (false, None) => {
+                return Err(JointError::Unsupported {
                 solver: "nonlinear (Newton)".into(),
                 feature: format!(
                     "{} force-controlled degrees of freedom of rigid bodies with nonlinear materials or finite strain, none of them a translation with a non-zero applied force at t = {t} (the Newton path finds one such translation inside the iteration and the others around it)",
                     unknowns.len()
                 ),
             });
+            }
         };
         let extras: Vec<(usize, usize)> =
-            unknowns.iter().enumerate().filter(|(i, _)| *i != p).map(|(_, u)| *u).collect();
+            unknowns.iter().enumerate().filter(|(i, _)| Some(*i) != p).map(|(_, u)| *u).collect();
         let extra_scales: Vec<Real> =
-            scales.iter().enumerate().filter(|(i, _)| *i != p).map(|(_, s)| *s).collect();
+            scales.iter().enumerate().filter(|(i, _)| Some(*i) != p).map(|(_, s)| *s).collect();
         let target: Vec<Real> = extras.iter().map(|&(b, k)| values[b][k]).collect();
         let m = extras.len();
         let start = nl.checkpoint();
@@ -1453,7 +1470,9 @@ impl RigidDriver {
             // iterate it starts from, and one near it needs fewer Newton iterations and
             // geometry passes; measured at tkr3d's poses 0, 13, 50: Newton iterations 820 -> 562,
             // contact solves 1 946 -> 1 237, the same solutions to the balance tolerance)
-            if !std::mem::take(&mut first) && rigid_friction {
+            // (with every coordinate prescribed, `around`: always from the level's start, so
+            // that the evaluation is a level from the last accepted time to `t`)
+            if !std::mem::take(&mut first) && (rigid_friction || p.is_none()) {
                 nl.restore(start.clone())?;
             }
             for (&(b, k), &zj) in extras.iter().zip(z) {
@@ -1461,8 +1480,20 @@ impl RigidDriver {
             }
             this.set_poses(joint);
             tracing::debug!(t, ?z, "force control around the Newton level: evaluation");
-            let (level, trials) =
-                this.gap_level(joint, nl, t, solver, values, unknowns[p], scales[p], rigid_friction)?;
+            let (level, trials) = match p {
+                Some(p) => {
+                    this.gap_level(joint, nl, t, solver, values, unknowns[p], scales[p], rigid_friction)?
+                }
+                // every coordinate prescribed at `z` (as a level without force control)
+                None if rigid_friction => {
+                    let motion = this.partner_motion_fn(joint);
+                    (nl.step_with_partner_motion(joint.model(), t, solver, &motion)?, 1)
+                }
+                None => {
+                    nl.rebuild_geometry(joint.model())?;
+                    (nl.step_to(joint.model(), t, solver)?, 1)
+                }
+            };
             evaluations.set(evaluations.get() + 1);
             solves.set(solves.get() + trials);
             iterations.set(iterations.get() + level.report.total_iterations);
@@ -1498,16 +1529,31 @@ impl RigidDriver {
             if jac.is_none() {
                 let mut j = nalgebra::DMatrix::<Real>::zeros(m, m);
                 for col in 0..m {
-                    let h = if extras[col].1 < D { 1e-6 * length } else { 1e-6 };
+                    let mut h = if extras[col].1 < D { 1e-6 * length } else { 1e-6 };
+                    // with every coordinate around the levels, the step along the applied
+                    // force (a tied block lifted off its only contact would feel nothing)
+                    if p.is_none() && target[col] < 0.0 {
+                        h = -h;
+                    }
                     let mut zh = z.clone();
                     zh[col] += h;
-                    let (_, rh, _) = evaluate(self, nl, &zh)?;
+                    let (_, mut rh, _) = evaluate(self, nl, &zh)?;
+                    // ... and, while nothing it moves touches (a tied block held off its
+                    // contact by the prescribed coordinates), tenfold steps up to 1 % of the
+                    // model size: a secant to first contact
+                    let unchanged =
+                        |rh: &[Real]| (0..m).all(|row| (rh[row] - r[row]).abs() <= 1e-9 * extra_scales[row]);
+                    while p.is_none() && unchanged(&rh) && h.abs() < 1e-2 * length {
+                        h *= 10.0;
+                        zh[col] = z[col] + h;
+                        rh = evaluate(self, nl, &zh)?.1;
+                    }
                     for row in 0..m {
                         j[(row, col)] = (rh[row] - r[row]) / h;
                     }
                     // a coordinate whose motion changes no balance beyond rounding is not
                     // resisted (e.g. a rotation of a sphere about its centre)
-                    if (0..m).all(|row| (rh[row] - r[row]).abs() <= 1e-9 * extra_scales[row]) {
+                    if unchanged(&rh) {
                         return Err(self.unresisted(joint, &extras[col..=col]));
                     }
                 }

@@ -177,7 +177,7 @@ fn neo_hookean_at_a_small_load_equals_linear_and_balances() -> Result<(), Error>
 }
 
 /// What the nonlinear path does not take is refused with a typed error: a force-controlled
-/// coordinate that nothing resists, a part tied to a rigid body.
+/// coordinate that nothing resists.
 #[test]
 fn unsupported_rigid_cases_are_refused() -> Result<(), Error> {
     let shape = Arc::new(SphereObstacle::new(Point::<3>::new(0.0, 0.0, 3.0), RADIUS, false)?);
@@ -196,18 +196,6 @@ fn unsupported_rigid_cases_are_refused() -> Result<(), Error> {
     assert!(matches!(err, JointError::Invalid(_)) && err.to_string().contains("not resisted"), "{err}");
     assert!(err.to_string().contains(".rx"), "{err}");
 
-    // a part tied to a rigid body with a force-controlled coordinate: refused (tied to one
-    // whose coordinates are all prescribed: tied_plate_* below)
-    let mut tied = JointModel::<3>::new();
-    let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [4, 4, 2], [Grading::Uniform; 3])?;
-    tied.add_body("block", mesh, Arc::new(neo_hookean(E, NU)?) as Arc<dyn Material<3>>)?;
-    tied.clamp("block", "bottom")?;
-    tied.add_rigid_body(
-        RigidBody::<3>::new("plate", Point::<3>::new(0.0, 0.0, 1.0))?.force(2, Constant(-1.0))?,
-    )?;
-    tied.tie_to_rigid_body("block", "top", "plate")?;
-    let err = tied.run_static(1.0).err().ok_or("a part tied to a rigid body accepted")?;
-    assert!(matches!(err, JointError::Invalid(_)) && err.to_string().contains("tied"), "{err}");
     Ok(())
 }
 
@@ -751,6 +739,16 @@ fn friction_law_on_a_fixed_obstacle_equals_the_linear_path() -> Result<(), Error
 /// 0.2), its top tied to a rigid plate whose coordinates are all prescribed: pushed down by
 /// `0.03 t`, moved sideways by `0.004 t` and tilted by `0.01 t` about `x`.
 fn tied_plate_model(material: Arc<dyn Material<3>>, finite: bool) -> Result<JointModel<3>, Error> {
+    tied_plate_model_with(material, finite, None)
+}
+
+/// [`tied_plate_model`], with `force = Some(F)` the plate's vertical translation loaded by
+/// `−F t` instead of prescribed.
+fn tied_plate_model_with(
+    material: Arc<dyn Material<3>>,
+    finite: bool,
+    force: Option<f64>,
+) -> Result<JointModel<3>, Error> {
     let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [8, 8, 4], [Grading::Uniform; 3])?;
     let mut joint = JointModel::<3>::new();
     joint.add_body("block", mesh, material)?;
@@ -759,8 +757,12 @@ fn tied_plate_model(material: Arc<dyn Material<3>>, finite: bool) -> Result<Join
     }
     let plate = RigidBody::<3>::new("plate", Point::<3>::new(0.0, 0.0, 1.0))?
         .prescribe(0, FnHistory::new(|t| 0.004 * t))?
-        .prescribe(1, Constant(0.0))?
-        .prescribe(2, FnHistory::new(|t| -0.03 * t))?
+        .prescribe(1, Constant(0.0))?;
+    let plate = match force {
+        Some(f) => plate.force(2, FnHistory::new(move |t| -f * t))?,
+        None => plate.prescribe(2, FnHistory::new(|t| -0.03 * t))?,
+    };
+    let plate = plate
         .prescribe(3, FnHistory::new(|t| 0.01 * t))?
         .prescribe(4, Constant(0.0))?
         .prescribe(5, Constant(0.0))?;
@@ -820,6 +822,42 @@ fn tied_plate_with_prescribed_coordinates_in_the_nonlinear_path() -> Result<(), 
         );
         assert!(balance < 1e-9, "level {level}: plate {plate:?} vs contact {contact:?}");
         assert!(change > 1e-4, "level {level}: the neo-Hookean plate force equals the linear one");
+    }
+    Ok(())
+}
+
+/// A part tied to a rigid body whose vertical translation is force-controlled, in the nonlinear
+/// path: the coordinate is found around whole Newton levels (the tie's reactions come from the
+/// internal forces after each level). The linear law through the Newton path equals the linear
+/// path (travel, reactions to 1e-8: the balance tolerance); the neo-Hookean block in finite
+/// strain balances the applied force (`balance_error` within the tolerance) and the plate's force
+/// equals the contact force on the block.
+#[test]
+fn tied_plate_with_a_force_controlled_coordinate_in_the_nonlinear_path() -> Result<(), Error> {
+    let force = 15.0;
+    let times = [0.4, 0.7, 1.0];
+    let linear =
+        tied_plate_model_with(Arc::new(isotropic(E, NU)?), false, Some(force))?.run_quasistatic(&times)?;
+    let routed = tied_plate_model_with(Arc::new(Hidden(isotropic(E, NU)?)), false, Some(force))?
+        .run_quasistatic(&times)?;
+    let hyper =
+        tied_plate_model_with(Arc::new(neo_hookean(E, NU)?), true, Some(force))?.run_quasistatic(&times)?;
+    for (level, ((a, b), c)) in linear.records.iter().zip(&routed.records).zip(&hyper.records).enumerate() {
+        let (ra, rb, rc) = (&a.rigid[0], &b.rigid[0], &c.rigid[0]);
+        let travel = (ra.dofs[2] - rb.dofs[2]).abs() / ra.dofs[2].abs();
+        let dr = ra.reaction.iter().zip(&rb.reaction).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / force;
+        let applied = force * c.time;
+        let size = c.pairs[0].force.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let balance = (0..3).map(|i| (rc.force[i] - c.pairs[0].force[i]).abs()).fold(0.0, f64::max) / size;
+        eprintln!(
+            "tied force-controlled plate, level {level}: travel {travel:.1e}, reactions {dr:.1e} (linear law); neo-Hookean tz {:.6} vs linear {:.6}, reaction {:.6} for {applied}, balance error {:.1e}, plate vs contact force {balance:.1e}, {} solves",
+            rc.dofs[2], ra.dofs[2], rc.reaction[2], rc.balance_error, rc.solves
+        );
+        assert!(travel < 1e-8 && dr < 1e-8, "level {level}: {travel:e} {dr:e}");
+        assert!(rc.balance_error < 1e-9, "level {level}: {rc:?}");
+        assert!((rc.reaction[2] - applied).abs() < 1e-9 * force, "level {level}: {rc:?}");
+        assert!(balance < 1e-9, "level {level}: plate {:?} vs contact {:?}", rc.force, c.pairs[0].force);
+        assert!((rc.dofs[2] / ra.dofs[2] - 1.0).abs() > 1e-4, "level {level}: neo-Hookean travel = linear");
     }
     Ok(())
 }
