@@ -280,3 +280,39 @@ fn a_lifted_start_with_frozen_friction_returns_to_contact() -> Result<(), Box<dy
     assert!(rigid.solves <= 12, "{} solves", rigid.solves);
     Ok(())
 }
+
+/// Dynamic runs do not pose rigid bodies: a model with one is refused with a typed error that
+/// names it (linear and neo-Hookean), instead of a run whose indenter never moves (a linear
+/// dynamic run used to finish with a zero contact force here).
+#[test]
+fn rigid_bodies_in_dynamic_runs_are_refused() -> Result<(), Box<dyn std::error::Error>> {
+    use synovia::material::neo_hookean;
+    use synovia::time::history::FnHistory;
+    let materials: [Arc<dyn Material<3>>; 2] =
+        [Arc::new(isotropic(1.0e3, 0.3)?), Arc::new(neo_hookean(1.0e3, 0.3)?)];
+    for (k, material) in materials.into_iter().enumerate() {
+        let mesh = box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [4, 4, 2], [Grading::Uniform; 3])?;
+        let mut joint = JointModel::<3>::new();
+        joint.add_body("block", mesh, material)?;
+        joint.clamp("block", "bottom")?;
+        joint.set_density("block", 1e-6)?;
+        let mut indenter = RigidBody::<3>::new("indenter", Point::<3>::new(0.0, 0.0, 3.0))?;
+        for k in [0, 1, 3, 4, 5] {
+            indenter = indenter.prescribe(k, Constant(0.0))?;
+        }
+        let indenter = indenter.prescribe(2, FnHistory::new(|t| -0.005 * t))?;
+        joint.add_rigid_body(indenter)?;
+        let shape = Arc::new(SphereObstacle::new(Point::<3>::new(0.0, 0.0, 3.0), 2.0, false)?);
+        joint.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+        let err = joint.run_dynamic(0.1, 10).err().ok_or("a dynamic run with a rigid body accepted")?;
+        let text = err.to_string();
+        assert!(matches!(err, JointError::Invalid(_)), "{text}");
+        assert!(text.contains("`indenter`") && text.contains("dynamic analyses"), "{text}");
+        // the same (linear) model runs quasi-statically and the indenter presses the block
+        if k == 0 {
+            let run = joint.run_quasistatic(&[0.5, 1.0])?;
+            assert!(run.records[1].pairs[0].normal_force > 0.0);
+        }
+    }
+    Ok(())
+}

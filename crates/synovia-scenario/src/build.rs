@@ -410,6 +410,15 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
                 ));
             }
         }
+        // the dynamic steppers do not pose rigid bodies (`JointModel::run_dynamic` refuses
+        // them): said by `check` at the rigid body, not first by `run`
+        if let Some(r) = doc.rigid_bodies.first() {
+            return Err(cx.err(
+                "rigid_body[0]",
+                r.span(),
+                "rigid bodies with mixed control are not supported in dynamic analyses yet (static and quasi-static analyses take them); give the partner a prescribed motion instead",
+            ));
+        }
     }
     joint.set_analysis(analysis.clone());
     if joint.uses_tfeti() {

@@ -5,7 +5,8 @@
 //! * a law with `μ_s = μ_k = 0.3` gives the file's run with `friction = 0.3` (the same bounds);
 //! * a decreasing law gives what the Rust API's `JointModel::friction_law` gives on the same
 //!   model (bit for bit), and less tangential force than the constant `μ_s`;
-//! * a static analysis with a law is refused with a message naming the key.
+//! * a static analysis with a law is refused with a message naming the key;
+//! * (and a dynamic analysis with a rigid body is refused at the rigid body.)
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
@@ -87,4 +88,29 @@ fn quasi_static_friction_law_from_a_scenario() {
         Err(e) => e.to_string(),
     };
     assert!(err.contains("friction_law") && err.contains("quasi-static and dynamic"), "{err}");
+}
+
+/// A dynamic analysis with a rigid body (`examples/scenarios/hertz3d_force.toml` with its
+/// analysis made dynamic and densities given) is refused by the build, at the rigid body.
+#[test]
+fn rigid_body_in_a_dynamic_scenario_is_refused_at_the_rigid_body() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/hertz3d_force.toml");
+    let text = std::fs::read_to_string(&path).expect("scenario file");
+    assert!(text.contains("[analysis]\ntype = \"static\"\n"));
+    let dynamic = text
+        .replace("[analysis]\ntype = \"static\"\n", "[analysis]\ntype = \"dynamic\"\ndt = 0.01\nsteps = 3\n")
+        .replace(
+            "material = { type = \"isotropic\", E = 10.0, nu = 0.3 }",
+            "material = { type = \"isotropic\", E = 10.0, nu = 0.3 }\ndensity = 1e-9",
+        )
+        .replace(
+            "material = { type = \"isotropic\", E = 10000.0, nu = 0.3 }",
+            "material = { type = \"isotropic\", E = 10000.0, nu = 0.3 }\ndensity = 1e-9",
+        );
+    let scenario = Scenario::parse(Source::new(&path, dynamic)).expect("parse");
+    let err = match build::<3>(&scenario) {
+        Ok(_) => panic!("a dynamic analysis with a rigid body was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("rigid_body[0]") && err.contains("dynamic analyses"), "{err}");
 }
