@@ -1156,7 +1156,6 @@ impl RigidDriver {
         t: Real,
         solver: &dyn ContactSolver,
     ) -> Result<(StepRecord, NonlinearResult<D>), JointError> {
-        let model = joint.model();
         let bodies = joint.rigid_bodies();
         let values = self.set_controls(joint, t)?;
         let unknowns = force_unknowns(bodies);
@@ -1172,17 +1171,7 @@ impl RigidDriver {
         });
         let tied = |b: usize| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b);
         let (level, solves) = match unknowns.as_slice() {
-            [] if rigid_friction => {
-                // friction against partners whose coordinates are all prescribed (docs/model.md
-                // (10.5)): the slip measured relative to each partner's motion since the last
-                // accepted level, nothing to search for
-                let motion = self.partner_motion_fn(joint);
-                (nl.step_with_partner_motion(model, t, solver, &motion)?, 1)
-            }
-            [] => {
-                nl.rebuild_geometry(model)?;
-                (nl.step_to(model, t, solver)?, 1)
-            }
+            [] => self.prescribed_level(joint, nl, t, solver, rigid_friction)?,
             // a body with a tied part balances its tie's reactions too, which the search
             // inside the Newton iteration (contact forces only) does not see: all its
             // coordinates around whole levels
@@ -1228,6 +1217,28 @@ impl RigidDriver {
         let accepted = self.accepted.clone();
         let q = self.q.clone();
         move |geometry, previous| partner_motion(joint, accepted.as_deref(), &q, geometry, previous)
+    }
+
+    /// One Newton level with every rigid coordinate at its value in `self.q` (the bodies
+    /// posed): with friction against a rigid body ([`NonlinearContact::step_with_partner_motion`],
+    /// docs/model.md (10.5): the slip measured relative to each partner's motion since the last
+    /// accepted level), else the geometry rebuilt at the poses and [`NonlinearContact::step_to`].
+    /// Returns the level and its one contact-solve count.
+    fn prescribed_level<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        nl: &mut NonlinearContact<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        rigid_friction: bool,
+    ) -> Result<(NonlinearResult<D>, usize), JointError> {
+        let model = joint.model();
+        if rigid_friction {
+            let motion = self.partner_motion_fn(joint);
+            return Ok((nl.step_with_partner_motion(model, t, solver, &motion)?, 1));
+        }
+        nl.rebuild_geometry(model)?;
+        Ok((nl.step_to(model, t, solver)?, 1))
     }
 
     /// One Newton level with the force-controlled coordinate `(b, k)` found inside the
@@ -1485,14 +1496,7 @@ impl RigidDriver {
                     this.gap_level(joint, nl, t, solver, values, unknowns[p], scales[p], rigid_friction)?
                 }
                 // every coordinate prescribed at `z` (as a level without force control)
-                None if rigid_friction => {
-                    let motion = this.partner_motion_fn(joint);
-                    (nl.step_with_partner_motion(joint.model(), t, solver, &motion)?, 1)
-                }
-                None => {
-                    nl.rebuild_geometry(joint.model())?;
-                    (nl.step_to(joint.model(), t, solver)?, 1)
-                }
+                None => this.prescribed_level(joint, nl, t, solver, rigid_friction)?,
             };
             evaluations.set(evaluations.get() + 1);
             solves.set(solves.get() + trials);
