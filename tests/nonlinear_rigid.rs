@@ -83,6 +83,13 @@ fn max_abs(u: &[Vec<Vector<3>>]) -> f64 {
     u.iter().flatten().map(|v| v.amax()).fold(0.0, f64::max)
 }
 
+/// The largest pressure `Λ_n` of `a` and the largest difference of `b` from it relative to it:
+/// `(max a, max |a − b| / max a)`.
+fn pressure_difference(a: &[f64], b: &[f64]) -> (f64, f64) {
+    let lmax = a.iter().copied().fold(0.0, f64::max);
+    (lmax, a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax)
+}
+
 fn max_diff(a: &[Vec<Vector<3>>], b: &[Vec<Vector<3>>]) -> f64 {
     a.iter().flatten().zip(b.iter().flatten()).map(|(x, y)| (x - y).amax()).fold(0.0, f64::max)
 }
@@ -122,8 +129,7 @@ fn linear_law_through_newton_equals_the_linear_path() -> Result<(), Error> {
         let (ub, lb) = &nl_fields[level];
         let du = max_diff(ua, ub) / max_abs(ua);
         assert!(du < 1e-8, "level {level}: displacements differ by {du:e}");
-        let lmax = la.iter().copied().fold(0.0, f64::max);
-        let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
+        let (_, dl) = pressure_difference(la, lb);
         assert!(dl < 1e-8, "level {level}: pressures differ by {dl:e}");
         assert!(a.pairs[0].peak_pressure > 0.0 && b.pairs[0].contact_area > 0.0);
         eprintln!("level {level}: linear law through Newton vs linear path: travel {travel:.1e}, displacements {du:.1e}, pressures {dl:.1e}");
@@ -342,8 +348,7 @@ fn compare_friction_runs(
         let (ub, lb, cb) = &nl_fields[level];
         let du = max_diff(ua, ub) / max_abs(ua);
         assert!(du < tol, "level {level}: displacements differ by {du:e}");
-        let lmax = la.iter().copied().fold(0.0, f64::max);
-        let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
+        let (lmax, dl) = pressure_difference(la, lb);
         assert!(dl < tol, "level {level}: pressures differ by {dl:e}");
         // the same friction cells, slip bounds and tangential multipliers
         assert_eq!(ca.len(), cb.len(), "level {level}: friction cells");
@@ -545,8 +550,7 @@ fn several_force_controlled_coordinates_equal_the_linear_path() -> Result<(), Er
             let (ub, lb) = &nl_fields[level];
             let du = max_diff(ua, ub) / max_abs(ua);
             assert!(du < 1e-8, "level {level}: displacements differ by {du:e}");
-            let lmax = la.iter().copied().fold(0.0, f64::max);
-            let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
+            let (_, dl) = pressure_difference(la, lb);
             assert!(dl < 1e-8, "level {level}: pressures differ by {dl:e}");
             eprintln!(
                 "{} force-controlled, level {level}: q {:?}; coordinates {dq:.1e}, reactions {dr:.1e}, displacements {du:.1e}, pressures {dl:.1e}, balance {:.1e}; Newton path: {} Newton iterations, {} contact solves; linear path: {} contact solves",
@@ -711,9 +715,8 @@ fn friction_law_on_a_fixed_obstacle_equals_the_linear_path() -> Result<(), Error
     let mut smallest = f64::MAX;
     for (level, ((ua, la, ca), (ub, lb, cb))) in lin.iter().zip(nl).enumerate() {
         let du = max_diff(ua, ub) / max_abs(ua);
-        let lmax = la.iter().copied().fold(0.0, f64::max);
+        let (lmax, dl) = pressure_difference(la, lb);
         assert!(lmax > 0.0, "level {level}: no contact");
-        let dl = la.iter().zip(lb).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / lmax;
         assert_eq!(ca.len(), cb.len(), "level {level}: friction cells");
         let mut dg = 0.0_f64;
         for ((na, ga, lta), (nb, gb, ltb)) in ca.iter().zip(cb) {
@@ -801,10 +804,7 @@ fn tied_plate_with_prescribed_coordinates_in_the_nonlinear_path() -> Result<(), 
         let scale = ra.reaction.iter().map(|v| v.abs()).fold(0.0, f64::max);
         let dr = ra.reaction.iter().zip(&rb.reaction).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max) / scale;
         let du = max_diff(&lin_fields[level].0, &fields[level].0) / max_abs(&lin_fields[level].0);
-        let lmax = lin_fields[level].1.iter().copied().fold(0.0, f64::max);
-        let dl =
-            lin_fields[level].1.iter().zip(&fields[level].1).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
-                / lmax;
+        let (_, dl) = pressure_difference(&lin_fields[level].1, &fields[level].1);
         eprintln!("tied plate, level {level}: reactions {dr:.1e}, displacements {du:.1e}, pressures {dl:.1e}; plate force {:?}", rb.force);
         assert!(dr < 1e-10 && du < 1e-10 && dl < 1e-10, "level {level}: {dr:e} {du:e} {dl:e}");
     }
