@@ -1114,7 +1114,21 @@ mod tests {
             })
             .collect();
         let got = block.solve_sparse_columns(&rhs, true).expect("solves");
-        for (c, x) in rhs.iter().zip(&got) {
+        assert_equal_whole_solves(&op, &block, &rhs, &got, "sparse trailing solve");
+        assert!(block.solve_sparse_columns(&[vec![(k, 1.0)]], false).is_err());
+    }
+
+    /// Each column `x` of `got` equals the trailing rows of the whole solve `A⁻¹ c` of its
+    /// right-hand side `c` (`(trailing position, value)` pairs) to 1e-12 relative.
+    fn assert_equal_whole_solves(
+        op: &SparseCholesky,
+        block: &crate::cholesky::TrailingBlock,
+        rhs: &[Vec<(usize, f64)>],
+        got: &[Vec<f64>],
+        what: &str,
+    ) {
+        let n = op.view().n();
+        for (c, x) in rhs.iter().zip(got) {
             let mut b = vec![0.0; n];
             for &(p, v) in c {
                 b[block.dofs[p]] += v;
@@ -1123,9 +1137,8 @@ mod tests {
             let want: Vec<f64> = block.dofs.iter().map(|&d| b[d]).collect();
             let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
             let err = x.iter().zip(&want).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs())) / scale;
-            assert!(err < 1e-12, "sparse trailing solve differs by {err:e}");
+            assert!(err < 1e-12, "{what} differs by {err:e}");
         }
-        assert!(block.solve_sparse_columns(&[vec![(k, 1.0)]], false).is_err());
     }
 
     /// Two grids that nothing couples (two bodies touching only through contact), trailing
@@ -1168,17 +1181,7 @@ mod tests {
             .chain((0..k / 2).map(|p| vec![(p, 1.0), (k - 1 - p, -0.5)]))
             .collect();
         let got = block.solve_sparse_columns(&rhs, true).expect("solves");
-        for (c, x) in rhs.iter().zip(&got) {
-            let mut b = vec![0.0; n];
-            for &(p, v) in c {
-                b[block.dofs[p]] += v;
-            }
-            op.solve_in_place(&mut b).expect("solve");
-            let want: Vec<f64> = block.dofs.iter().map(|&d| b[d]).collect();
-            let scale = want.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
-            let err = x.iter().zip(&want).fold(0.0_f64, |m, (a, b)| m.max((a - b).abs())) / scale;
-            assert!(err < 1e-12, "per-block solve differs by {err:e}");
-        }
+        assert_equal_whole_solves(&op, &block, &rhs, &got, "per-block solve");
     }
 
     /// [`crate::cholesky::diagonal_blocks`] of small lower-triangular matrices: a dense one is
