@@ -861,3 +861,80 @@ fn tied_plate_with_a_force_controlled_coordinate_in_the_nonlinear_path() -> Resu
     }
     Ok(())
 }
+
+/// A hyperelastic block pressed by a rigid sphere whose coordinates are all prescribed, without
+/// friction (the partner's motion changes only the gaps: the level starts in equilibrium, so its
+/// first Newton step is taken whole), equals the same block pushed up against the same sphere
+/// held fixed as an obstacle: the two differ by the rigid translation `d(t) e_z`, under which the
+/// neo-Hookean stress (finite strain) and the gaps are invariant, and which the small-strain law
+/// does not see either. Displacements (less the translation), `Λ_n` and the normal force agree
+/// level by level; the rigid body's reaction balances the contact resultant; KKT holds. (Before
+/// the fix the rigid-body run stopped at the first level: "the line search found no decrease".)
+#[test]
+fn neo_hookean_under_a_prescribed_rigid_body_equals_the_fixed_obstacle() -> Result<(), Error> {
+    let press = 0.03;
+    let times = [0.25, 0.5, 0.75, 1.0];
+    for finite in [false, true] {
+        let mesh = || box_mesh([-1.0, -1.0, 0.0], [1.0, 1.0, 1.0], [6, 6, 3], [Grading::Uniform; 3]);
+        let law = || -> Result<Arc<dyn Material<3>>, Error> { Ok(Arc::new(neo_hookean(E, NU)?)) };
+        let kinematics = if finite { Kinematics::FiniteStrain } else { Kinematics::SmallStrain };
+        let mut moving = JointModel::<3>::new();
+        moving.add_body("block", mesh()?, law()?)?;
+        moving.set_kinematics("block", kinematics)?;
+        moving.clamp("block", "bottom")?;
+        let indenter = RigidBody::<3>::new("indenter", Point::<3>::new(0.0, 0.0, 3.0))?
+            .prescribe(0, Constant(0.0))?
+            .prescribe(1, Constant(0.0))?
+            .prescribe(2, FnHistory::new(move |t| -press * t))?
+            .prescribe(3, Constant(0.0))?
+            .prescribe(4, Constant(0.0))?
+            .prescribe(5, Constant(0.0))?;
+        moving.add_rigid_body(indenter)?;
+        let shape = Arc::new(SphereObstacle::new(Point::<3>::new(0.0, 0.0, 3.0), RADIUS, false)?);
+        moving.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+        let mut fixed = JointModel::<3>::new();
+        fixed.add_body("block", mesh()?, law()?)?;
+        fixed.set_kinematics("block", kinematics)?;
+        fixed.prescribe("block", "bottom", Vector::<3>::new(0.0, 0.0, press), FnHistory::new(|t| t))?;
+        let sphere = SphereObstacle::new(Point::<3>::new(0.0, 0.0, 3.0), RADIUS, false)?;
+        fixed.contact_rigid("indent", "block", "top", sphere, 0.0)?;
+        assert!(moving.is_nonlinear() && fixed.is_nonlinear());
+        let mut runs = Vec::new();
+        for joint in [&moving, &fixed] {
+            let mut levels = Vec::new();
+            let run = joint.run_quasistatic_with(&times, |view| {
+                let (u, lambda_n, _) = fields_of(view);
+                levels.push((u, lambda_n, view.result.kkt.max()));
+                Ok(())
+            })?;
+            assert_eq!(run.records.len(), times.len());
+            runs.push((run, levels));
+        }
+        let ((rm, lm), (rf, lf)) = (&runs[0], &runs[1]);
+        for (level, &t) in times.iter().enumerate() {
+            let ((um, pm, kkt_m), (uf, pf, kkt_f)) = (&lm[level], &lf[level]);
+            let shift = Vector::<3>::new(0.0, 0.0, press * t);
+            let shifted: Vec<Vec<Vector<3>>> =
+                uf.iter().map(|b| b.iter().map(|v| v - shift).collect()).collect();
+            let du = max_diff(um, &shifted) / max_abs(um);
+            let (lmax, dl) = pressure_difference(pf, pm);
+            let (nm, nf) = (rm.records[level].pairs[0].normal_force, rf.records[level].pairs[0].normal_force);
+            let rigid = &rm.records[level].rigid[0];
+            eprintln!(
+                "finite {finite}, t = {t}: normal force {nm:.6} vs {nf:.6}, displacements {du:.1e}, pressures {dl:.1e}, KKT {kkt_m:.1e} / {kkt_f:.1e}, reaction {:.6}",
+                rigid.reaction[2]
+            );
+            assert!(lmax > 0.0 && nm > 0.0, "level {level}: no contact");
+            assert!(du < 1e-6 && dl < 1e-6, "level {level}: displacements {du:e}, pressures {dl:e}");
+            assert!((nm - nf).abs() < 1e-6 * nf, "level {level}: normal force {nm} vs {nf}");
+            assert!(*kkt_m < 1e-8 && *kkt_f < 1e-8, "level {level}: KKT {kkt_m:e} {kkt_f:e}");
+            // the prescribed body's reaction (what holds it at its pose) balances the contact
+            // resultant (the pair's force, on the partner)
+            assert!(
+                (rigid.reaction[2] + rm.records[level].pairs[0].force[2]).abs() < 1e-9 * nm,
+                "level {level}: {rigid:?}"
+            );
+        }
+    }
+    Ok(())
+}

@@ -1872,6 +1872,11 @@ impl<const D: usize> NonlinearContact<D> {
             // equilibrium residual was at its minimum for the old sets (measured: damped to
             // α = 1/128 three times running, a failed level, on every Hertz case)
             let rebuilt = rebuilt || std::mem::take(&mut new_anchor);
+            // the first step of a level that starts in equilibrium (its residual at the
+            // tolerance), e.g. a rigid partner moved by prescribed coordinates: only the gaps
+            // changed, which the merit `‖R‖` does not see (it was at its minimum, zero, before
+            // the step), so the step is taken whole, as the predictor
+            let rebuilt = rebuilt || (iterations.is_empty() && r_norm <= settled);
             let mut alpha = 1.0;
             let mut forced = false;
             let accepted = loop {
