@@ -1498,21 +1498,29 @@ impl<const D: usize> JointModel<D> {
     ) -> Result<RunResult<D>, JointError> {
         let start = Instant::now();
         self.model.validate()?;
-        // the dynamic steppers do not pose rigid bodies (their shapes would stay where they
-        // were built, the controls ignored): refused rather than run without them
-        if let Some(body) = self.rigid_bodies.first() {
-            return Err(JointError::Invalid(format!(
-                "rigid body `{}`: rigid bodies with mixed control are not supported in dynamic analyses yet \
-                 (static and quasi-static analyses take them); give the partner a prescribed motion \
-                 (e.g. a moving obstacle or a prescribed displacement) instead",
-                body.name
-            )));
-        }
+        // rigid bodies: massless, every coordinate prescribed; posed at t₀ before the stepper
+        // builds its contact rows, then at the end of every step (sub-step)
+        let mut driver = if self.rigid_bodies.is_empty() {
+            None
+        } else {
+            let friction: Vec<&str> = self
+                .pairs
+                .iter()
+                .filter(|p| p.friction > 0.0 || self.friction_laws.iter().any(|(n, _)| *n == p.name))
+                .map(|p| p.name.as_str())
+                .collect();
+            RigidDriver::check_dynamic(self, self.is_nonlinear(), &friction)?;
+            let mut driver = RigidDriver::new(self);
+            driver.pose_prescribed(self, self.dynamic_params.t0)?;
+            driver.accept();
+            Some(driver)
+        };
         let solver = self.build_solver()?;
         let bodies = self.dynamic_bodies()?;
         if self.is_nonlinear() {
-            return self.run_nonlinear_dynamic(dt, steps, &bodies, solver.as_ref(), start, observer);
+            return self.run_nonlinear_dynamic(dt, steps, &bodies, solver.as_ref(), start, driver, observer);
         }
+        let posed_pairs = !self.rigid_pair_bodies().is_empty();
         let params = self.dynamic_params.clone().with_dt(dt);
         let mut stepper = DynamicStepper::new(&self.model, &bodies, &self.pairs, params)?;
         for (pair, law) in &self.friction_laws {
@@ -1522,14 +1530,18 @@ impl<const D: usize> JointModel<D> {
             stepper.set_initial_state(&self.model, None, Some(&v))?;
         }
         let setup_s = start.elapsed().as_secs_f64();
-        let geometry = stepper.geometry().clone();
         let n_steps = steps + 1;
         let mut records = Vec::with_capacity(n_steps);
-        let initial = stepper.initial_record();
-        let result = zero_result(stepper.displacement().to_vec(), geometry.len());
+        let mut initial = stepper.initial_record();
+        let result = zero_result(stepper.displacement().to_vec(), stepper.geometry().len());
+        if let Some(driver) = driver.as_mut() {
+            let values = driver.pose_prescribed(self, stepper.time())?;
+            initial =
+                driver.record_level(self, stepper.geometry(), initial, &result, &values, stepper.time())?;
+        }
         observer(&StepView {
             model: &self.model,
-            geometry: &geometry,
+            geometry: stepper.geometry(),
             record: &initial,
             result: &result,
             n_steps,
@@ -1537,14 +1549,34 @@ impl<const D: usize> JointModel<D> {
         records.push(initial);
         let mut last = None;
         for _ in 0..steps {
-            let record = stepper.step(&self.model, solver.as_ref())?;
+            // the rigid partners at the end of the step: the step's constraints are those of
+            // their position there, the slip measured relative to their motion over the step
+            let t_next = stepper.params().t0 + (stepper.step_index() + 1) as Real * stepper.dt();
+            let values = match driver.as_mut() {
+                Some(driver) => {
+                    let values = driver.pose_prescribed(self, t_next)?;
+                    if posed_pairs {
+                        stepper.rebuild_geometry(&self.model, &self.pairs)?;
+                        let motion =
+                            driver.motion_since_accepted(self, stepper.geometry(), stepper.displacement());
+                        stepper.set_partner_motion(motion)?;
+                    }
+                    Some(values)
+                }
+                None => None,
+            };
+            let mut record = stepper.step(&self.model, solver.as_ref())?;
             let result = match stepper.last_contact() {
                 Some(r) => r.clone(),
-                None => zero_result(stepper.displacement().to_vec(), geometry.len()),
+                None => zero_result(stepper.displacement().to_vec(), stepper.geometry().len()),
             };
+            if let (Some(driver), Some(values)) = (driver.as_mut(), values) {
+                driver.accept();
+                record = driver.record_level(self, stepper.geometry(), record, &result, &values, t_next)?;
+            }
             observer(&StepView {
                 model: &self.model,
-                geometry: &geometry,
+                geometry: stepper.geometry(),
                 record: &record,
                 result: &result,
                 n_steps,
@@ -1557,7 +1589,7 @@ impl<const D: usize> JointModel<D> {
             displacement: stepper.displacement().to_vec(),
             contact: last.filter(|_| !self.pairs.is_empty()),
             n_dofs: stepper.info().n_dofs,
-            contact_nodes: geometry.len(),
+            contact_nodes: stepper.geometry().len(),
             solver: solver.name().to_string(),
             setup_s,
             total_s: start.elapsed().as_secs_f64(),
@@ -1598,6 +1630,7 @@ impl<const D: usize> JointModel<D> {
     /// step the nonlinear contact problem of docs/model.md (12.2) solved by the Newton
     /// iteration with the model's [`NewtonParams`], cut back into halves on failure
     /// ([`synovia_time::nonlinear_dynamic::NonlinearDynamicStepper`]).
+    #[allow(clippy::too_many_arguments)]
     fn run_nonlinear_dynamic(
         &self,
         dt: Real,
@@ -1605,6 +1638,7 @@ impl<const D: usize> JointModel<D> {
         bodies: &[DynamicBody],
         solver: &dyn ContactSolver,
         start: Instant,
+        mut driver: Option<RigidDriver>,
         mut observer: impl FnMut(&StepView<'_, D>) -> Result<(), JointError>,
     ) -> Result<RunResult<D>, JointError> {
         let params = self.dynamic_params.clone().with_dt(dt);
@@ -1625,8 +1659,13 @@ impl<const D: usize> JointModel<D> {
         let setup_s = start.elapsed().as_secs_f64();
         let n_steps = steps + 1;
         let mut records = Vec::with_capacity(n_steps);
-        let initial = stepper.initial_record();
+        let mut initial = stepper.initial_record();
         let result = zero_result(stepper.displacement().to_vec(), stepper.geometry().len());
+        if let Some(driver) = driver.as_mut() {
+            let values = driver.pose_prescribed(self, stepper.time())?;
+            initial =
+                driver.record_level(self, stepper.geometry(), initial, &result, &values, stepper.time())?;
+        }
         observer(&StepView {
             model: &self.model,
             geometry: stepper.geometry(),
@@ -1636,8 +1675,22 @@ impl<const D: usize> JointModel<D> {
         })?;
         records.push(initial);
         let mut last = None;
+        let posed_pairs = !self.rigid_pair_bodies().is_empty();
         for _ in 0..steps {
-            let record = stepper.step(&self.model, solver)?;
+            // the rigid partners posed at the end of every sub-step (frictionless: no partner
+            // motion in the slip), the contact rows rebuilt there
+            let mut record = match driver.as_mut().filter(|_| posed_pairs) {
+                Some(driver) => {
+                    let mut pose = |t: Real| -> Result<(), TimeError> {
+                        driver
+                            .pose_prescribed(self, t)
+                            .map(|_| ())
+                            .map_err(|e| TimeError::InvalidParameter(e.to_string()))
+                    };
+                    stepper.step_posing(&self.model, solver, Some(&mut pose))?
+                }
+                None => stepper.step(&self.model, solver)?,
+            };
             let report = stepper.last_report();
             tracing::debug!(
                 step = record.step,
@@ -1649,6 +1702,12 @@ impl<const D: usize> JointModel<D> {
                 Some(r) if !self.pairs.is_empty() => r.clone(),
                 _ => zero_result(stepper.displacement().to_vec(), stepper.geometry().len()),
             };
+            if let Some(driver) = driver.as_mut() {
+                let t = record.time;
+                let values = driver.pose_prescribed(self, t)?;
+                driver.accept();
+                record = driver.record_level(self, stepper.geometry(), record, &result, &values, t)?;
+            }
             observer(&StepView {
                 model: &self.model,
                 geometry: stepper.geometry(),

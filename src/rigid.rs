@@ -859,6 +859,93 @@ impl RigidDriver {
         Self { q: zeros(), offset: zeros(), jacobian: None, accepted: None, slope: None }
     }
 
+    /// Refuses what the dynamic analyses do not take with rigid bodies, naming the body: a
+    /// force-controlled coordinate (the rigid bodies have no mass, so a dynamic analysis
+    /// prescribes all their coordinates), a part tied to a rigid body (its reaction would need
+    /// the part's inertial forces), and in a nonlinear model friction against a rigid body
+    /// (`friction_pairs`: the names of pairs with friction).
+    pub(crate) fn check_dynamic<const D: usize>(
+        joint: &JointModel<D>,
+        nonlinear: bool,
+        friction_pairs: &[&str],
+    ) -> Result<(), JointError> {
+        let names = dof_names(D);
+        for body in joint.rigid_bodies() {
+            if let Some(k) = body.force_dofs().first() {
+                return Err(JointError::Invalid(format!(
+                    "rigid body `{}`: the force-controlled coordinate `{}` is not supported in dynamic analyses \
+                     (rigid bodies have no mass there: prescribe every coordinate, or use a static or \
+                     quasi-static analysis for force control)",
+                    body.name,
+                    names.get(*k).copied().unwrap_or("?")
+                )));
+            }
+        }
+        if let Some((_, part, b)) = joint.rigid_ties().first() {
+            return Err(JointError::Invalid(format!(
+                "part `{part}` tied to rigid body `{}`: tied parts are not supported in dynamic analyses yet \
+                 (static and quasi-static analyses take them); prescribe the part's motion instead",
+                joint.rigid_bodies().get(*b).map(|r| r.name.as_str()).unwrap_or("?")
+            )));
+        }
+        if nonlinear {
+            for (pair, b) in joint.rigid_pair_bodies() {
+                if friction_pairs.contains(&pair.as_str()) {
+                    return Err(JointError::Invalid(format!(
+                        "contact pair `{pair}` with rigid body `{}`: friction against a rigid body is not supported \
+                         in nonlinear dynamic analyses yet (frictionless, or a linear model, or a quasi-static analysis)",
+                        joint.rigid_bodies().get(*b).map(|r| r.name.as_str()).unwrap_or("?")
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Sets every rigid coordinate to its prescribed value at `t` and poses the bodies
+    /// (dynamic analyses: every coordinate prescribed, [`Self::check_dynamic`]); returns the
+    /// control values.
+    pub(crate) fn pose_prescribed<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        t: Real,
+    ) -> Result<Vec<Vec<Real>>, JointError> {
+        let values = self.set_controls(joint, t)?;
+        self.set_poses(joint);
+        Ok(values)
+    }
+
+    /// The rigid partners' motion at the contact nodes from the last accepted coordinates to
+    /// the current ones, at the nodes' deformed positions of `previous` ([`partner_motion`];
+    /// empty before the first accepted level).
+    pub(crate) fn motion_since_accepted<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        geometry: &ContactGeometry<D>,
+        previous: &[Vec<Vector<D>>],
+    ) -> Vec<Vector<D>> {
+        partner_motion(joint, self.accepted.as_deref(), &self.q, geometry, previous)
+    }
+
+    /// Accepts the current coordinates (the origin of the next [`Self::motion_since_accepted`]).
+    pub(crate) fn accept(&mut self) {
+        self.accepted = Some(self.q.clone());
+    }
+
+    /// `record` with the rigid bodies' records of a level solved elsewhere (a dynamic step):
+    /// coordinates and reactions from the contact forces of `result` on `geometry`.
+    pub(crate) fn record_level<const D: usize>(
+        &self,
+        joint: &JointModel<D>,
+        geometry: &ContactGeometry<D>,
+        record: StepRecord,
+        result: &StaticContactResult<D>,
+        values: &[Vec<Real>],
+        t: Real,
+    ) -> Result<StepRecord, JointError> {
+        self.finish(joint, geometry, record, result, values, t, 1)
+    }
+
     /// Forgets the force-controlled coordinates and the Jacobian.
     pub(crate) fn reset<const D: usize>(&mut self, joint: &JointModel<D>) {
         *self = Self::new(joint);

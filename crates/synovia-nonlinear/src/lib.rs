@@ -625,13 +625,13 @@ impl<const D: usize> NonlinearContact<D> {
     /// Rebuilds the contact geometry of the pairs on the reference meshes
     /// ([`StaticContact::rebuild_geometry`]; e.g. after a rigid partner moved: a posed shape
     /// reads its pose when the geometry is built). In finite strain the next level rebuilds it
-    /// on the deformed configuration anyway.
+    /// on the deformed configuration anyway. Returns the geometry it replaced (to carry nodal
+    /// data to the new rows, [`ContactGeometry::transfer`]).
     ///
     /// # Errors
     /// As [`StaticContact::rebuild_geometry`].
-    pub fn rebuild_geometry(&mut self, model: &Model<D>) -> Result<(), NonlinearError> {
-        self.contact.rebuild_geometry(model, &self.pairs)?;
-        Ok(())
+    pub fn rebuild_geometry(&mut self, model: &Model<D>) -> Result<ContactGeometry<D>, NonlinearError> {
+        Ok(self.contact.rebuild_geometry(model, &self.pairs)?)
     }
 
     /// Gap screening of the contact solves ([`StaticContact::set_screening_band`]).

@@ -410,14 +410,31 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
                 ));
             }
         }
-        // the dynamic steppers do not pose rigid bodies (`JointModel::run_dynamic` refuses
-        // them): said by `check` at the rigid body, not first by `run`
-        if let Some(r) = doc.rigid_bodies.first() {
-            return Err(cx.err(
-                "rigid_body[0]",
-                r.span(),
-                "rigid bodies with mixed control are not supported in dynamic analyses yet (static and quasi-static analyses take them); give the partner a prescribed motion instead",
-            ));
+        // rigid bodies in a dynamic analysis are massless and prescribed in every coordinate
+        // (`JointModel::run_dynamic` refuses force control and tied parts): said by `check`
+        // at the key, not first by `run`
+        for (i, r) in doc.rigid_bodies.iter().enumerate() {
+            let s = r.get_ref();
+            let dofs =
+                [("tx", &s.tx), ("ty", &s.ty), ("tz", &s.tz), ("rx", &s.rx), ("ry", &s.ry), ("rz", &s.rz)];
+            for (name, dof) in dofs {
+                if let Some(f) = dof.as_ref().and_then(|d| d.get_ref().force.as_ref()) {
+                    return Err(cx.err(
+                        format!("rigid_body[{i}].{name}.force"),
+                        f.span(),
+                        "force-controlled coordinates of rigid bodies are not supported in dynamic analyses (rigid bodies have no mass there: prescribe every coordinate, or use a static or quasi-static analysis)",
+                    ));
+                }
+            }
+        }
+        for (j, bc) in doc.boundary.iter().enumerate() {
+            if bc.get_ref().kind.get_ref() == "rigid_body" {
+                return Err(cx.err(
+                    format!("boundary[{j}].kind"),
+                    bc.get_ref().kind.span(),
+                    "parts tied to a rigid body are not supported in dynamic analyses yet (static and quasi-static analyses take them); prescribe the part's motion instead",
+                ));
+            }
         }
     }
     joint.set_analysis(analysis.clone());

@@ -90,10 +90,11 @@ fn quasi_static_friction_law_from_a_scenario() {
     assert!(err.contains("friction_law") && err.contains("quasi-static and dynamic"), "{err}");
 }
 
-/// A dynamic analysis with a rigid body (`examples/scenarios/hertz3d_force.toml` with its
-/// analysis made dynamic and densities given) is refused by the build, at the rigid body.
+/// A dynamic analysis with a force-controlled rigid body (`examples/scenarios/hertz3d_force.toml`
+/// with its analysis made dynamic and densities given) is refused by the build, at the force of
+/// the rigid body's coordinate (rigid bodies are massless and prescribed in dynamic analyses).
 #[test]
-fn rigid_body_in_a_dynamic_scenario_is_refused_at_the_rigid_body() {
+fn force_controlled_rigid_body_in_a_dynamic_scenario_is_refused_at_its_force() {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/hertz3d_force.toml");
     let text = std::fs::read_to_string(&path).expect("scenario file");
     assert!(text.contains("[analysis]\ntype = \"static\"\n"));
@@ -109,8 +110,11 @@ fn rigid_body_in_a_dynamic_scenario_is_refused_at_the_rigid_body() {
         );
     let scenario = Scenario::parse(Source::new(&path, dynamic)).expect("parse");
     let err = match build::<3>(&scenario) {
-        Ok(_) => panic!("a dynamic analysis with a rigid body was accepted"),
+        Ok(_) => panic!("a dynamic analysis with a force-controlled rigid body was accepted"),
         Err(e) => e.to_string(),
     };
-    assert!(err.contains("rigid_body[0]") && err.contains("dynamic analyses"), "{err}");
+    assert!(
+        err.contains("rigid_body[0].") && err.contains(".force") && err.contains("dynamic analyses"),
+        "{err}"
+    );
 }

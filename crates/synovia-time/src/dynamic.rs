@@ -97,7 +97,7 @@ use synovia_material::{voigt_len, KelvinVoigt, VoigtMatrix};
 use synovia_mesh::math::{Point, Real, Vector};
 
 use crate::error::TimeError;
-use crate::quasistatic::{friction_dissipation, warm_start};
+use crate::quasistatic::{friction_dissipation, transfer_result, warm_start};
 use crate::results::{empty_pair_records, pair_records, StepRecord};
 
 /// Largest element matrix size `(D(D+1))²` for `D ≤ 3`.
@@ -619,6 +619,42 @@ impl<const D: usize> DynamicStepper<D> {
     /// ([`PairFrictionLaws::slip_bounds`]).
     fn slip_bounds(&self, pressure: &[Real], speed: &[Real]) -> Vec<Real> {
         self.laws.slip_bounds(self.geometry(), pressure, speed)
+    }
+
+    /// Rebuilds the contact rows from the model's current data before the next step — e.g. a
+    /// rigid partner posed at `t_{i+1}` (docs/model.md §10: its posed shape is read when the
+    /// rows are built; the step's constraints are then those of the partner's position at the
+    /// end of the step). The level's pressures, slip speeds and warm start are carried node by
+    /// node to the new rows ([`ContactGeometry::node_map`]; nodes new in the rows start at
+    /// zero). The factorisation of `Ã` is kept. The partner motion of the new rows is none
+    /// until [`DynamicStepper::set_partner_motion`].
+    ///
+    /// # Errors
+    /// [`TimeError::ContactSetup`] from [`StaticContact::rebuild_geometry`].
+    pub fn rebuild_geometry(&mut self, model: &Model<D>, pairs: &[ContactPair<D>]) -> Result<(), TimeError> {
+        let old = self.contact.rebuild_geometry(model, pairs)?;
+        let new = self.contact.geometry();
+        let same_rows = old.len() == new.len()
+            && old.nodes.iter().zip(&new.nodes).all(|(a, b)| a.pair == b.pair && a.node == b.node);
+        if !same_rows {
+            self.pressure = new.transfer(&old, &self.pressure);
+            self.slip_speed = new.transfer(&old, &self.slip_speed);
+            self.warm = self.warm.take().map(|w| transfer_result(&old, new, &w));
+            self.last = self.last.take().map(|l| transfer_result(&old, new, &l));
+        }
+        Ok(())
+    }
+
+    /// Sets the motion `w_r` of the contact partners' material points at the contact nodes
+    /// over the next step (one vector per contact node, or empty for none;
+    /// [`ContactGeometry::set_partner_motion`]): friction against a moving rigid partner
+    /// measures the slip `[U^{i+1}_t] − ([U^i_t] + w_{r,t})` relative to it, in the step
+    /// problem, the friction work and the slip speeds of the friction law.
+    ///
+    /// # Errors
+    /// [`TimeError::ContactSetup`] for a wrong length or non-finite values.
+    pub fn set_partner_motion(&mut self, motion: Vec<Vector<D>>) -> Result<(), TimeError> {
+        Ok(self.contact.set_partner_motion(motion)?)
     }
 
     /// `|[u'_t]|` per contact node from two nodal displacement levels ([`slip_speeds`]).

@@ -328,6 +328,26 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
     /// the last converged sub-step); [`TimeError::Fem`] for load or lift evaluation errors;
     /// [`TimeError::InvalidParameter`] for another model than the stepper's.
     pub fn step(&mut self, model: &Model<D>, solver: &dyn ContactSolver) -> Result<StepRecord, TimeError> {
+        self.step_posing(model, solver, None)
+    }
+
+    /// As [`Self::step`], with contact partners that move: before every (sub-)step to `t`,
+    /// `pose(t)` poses them (e.g. rigid bodies at their prescribed coordinates, docs/model.md
+    /// §10) and the contact rows are rebuilt ([`NonlinearContact::rebuild_geometry`]; the
+    /// level's pressures and slip speeds carried node by node to the new rows), so a cut-back
+    /// step poses the partners at its sub-step times. For frictionless pairs with the moving
+    /// partners: the slip of friction cells would be measured from the last level without the
+    /// partners' motion.
+    ///
+    /// # Errors
+    /// As [`Self::step`]; whatever `pose` returns; [`TimeError::NonlinearSetup`] from the
+    /// rebuild of the rows.
+    pub fn step_posing(
+        &mut self,
+        model: &Model<D>,
+        solver: &dyn ContactSolver,
+        mut pose: Option<&mut dyn FnMut(Real) -> Result<(), TimeError>>,
+    ) -> Result<StepRecord, TimeError> {
         let t_start = Instant::now();
         if model.n_nodes() != self.n_nodes {
             return Err(TimeError::InvalidParameter(
@@ -345,6 +365,17 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
             let parts = 1usize << halvings;
             let h = dt / parts as Real;
             let t_new = if done + 1 == parts { t_end } else { self.time + h };
+            if let Some(pose) = pose.as_deref_mut() {
+                pose(t_new)?;
+                let old = self.nl.rebuild_geometry(model)?;
+                let new = self.nl.geometry();
+                let same_rows = old.len() == new.len()
+                    && old.nodes.iter().zip(&new.nodes).all(|(a, b)| a.pair == b.pair && a.node == b.node);
+                if !same_rows {
+                    self.pressure = new.transfer(&old, &self.pressure);
+                    self.slip_speed = new.transfer(&old, &self.slip_speed);
+                }
+            }
             match self.substep(model, h, t_new, solver) {
                 Ok(sub) => {
                     report.newton_iterations += sub.report.total_iterations;
