@@ -1503,13 +1503,7 @@ impl<const D: usize> JointModel<D> {
         let mut driver = if self.rigid_bodies.is_empty() {
             None
         } else {
-            let friction: Vec<&str> = self
-                .pairs
-                .iter()
-                .filter(|p| p.friction > 0.0 || self.friction_laws.iter().any(|(n, _)| *n == p.name))
-                .map(|p| p.name.as_str())
-                .collect();
-            RigidDriver::check_dynamic(self, self.is_nonlinear(), &friction)?;
+            RigidDriver::check_dynamic(self)?;
             let mut driver = RigidDriver::new(self);
             driver.pose_prescribed(self, self.dynamic_params.t0)?;
             driver.accept();
@@ -1677,17 +1671,12 @@ impl<const D: usize> JointModel<D> {
         let mut last = None;
         let posed_pairs = !self.rigid_pair_bodies().is_empty();
         for _ in 0..steps {
-            // the rigid partners posed at the end of every sub-step (frictionless: no partner
-            // motion in the slip), the contact rows rebuilt there
+            // the rigid partners posed at the end of every sub-step, the contact rows rebuilt
+            // there, the slip of friction measured relative to their motion
             let mut record = match driver.as_mut().filter(|_| posed_pairs) {
                 Some(driver) => {
-                    let mut pose = |t: Real| -> Result<(), TimeError> {
-                        driver
-                            .pose_prescribed(self, t)
-                            .map(|_| ())
-                            .map_err(|e| TimeError::InvalidParameter(e.to_string()))
-                    };
-                    stepper.step_posing(&self.model, solver, Some(&mut pose))?
+                    let mut partners = crate::rigid::PrescribedPartners { joint: self, driver };
+                    stepper.step_posing(&self.model, solver, Some(&mut partners))?
                 }
                 None => stepper.step(&self.model, solver)?,
             };

@@ -55,6 +55,7 @@
 
 use std::fmt;
 use std::sync::{Arc, RwLock};
+use synovia_time::nonlinear_dynamic::MovingPartners;
 use synovia_time::results::{cross3 as cross, embed3 as embed};
 
 use synovia_contact::operators::SignedDistance;
@@ -861,14 +862,9 @@ impl RigidDriver {
 
     /// Refuses what the dynamic analyses do not take with rigid bodies, naming the body: a
     /// force-controlled coordinate (the rigid bodies have no mass, so a dynamic analysis
-    /// prescribes all their coordinates), a part tied to a rigid body (its reaction would need
-    /// the part's inertial forces), and in a nonlinear model friction against a rigid body
-    /// (`friction_pairs`: the names of pairs with friction).
-    pub(crate) fn check_dynamic<const D: usize>(
-        joint: &JointModel<D>,
-        nonlinear: bool,
-        friction_pairs: &[&str],
-    ) -> Result<(), JointError> {
+    /// prescribes all their coordinates) and a part tied to a rigid body (its reaction would
+    /// need the part's inertial forces).
+    pub(crate) fn check_dynamic<const D: usize>(joint: &JointModel<D>) -> Result<(), JointError> {
         let names = dof_names(D);
         for body in joint.rigid_bodies() {
             if let Some(k) = body.force_dofs().first() {
@@ -887,17 +883,6 @@ impl RigidDriver {
                  (static and quasi-static analyses take them); prescribe the part's motion instead",
                 joint.rigid_bodies().get(*b).map(|r| r.name.as_str()).unwrap_or("?")
             )));
-        }
-        if nonlinear {
-            for (pair, b) in joint.rigid_pair_bodies() {
-                if friction_pairs.contains(&pair.as_str()) {
-                    return Err(JointError::Invalid(format!(
-                        "contact pair `{pair}` with rigid body `{}`: friction against a rigid body is not supported \
-                         in nonlinear dynamic analyses yet (frictionless, or a linear model, or a quasi-static analysis)",
-                        joint.rigid_bodies().get(*b).map(|r| r.name.as_str()).unwrap_or("?")
-                    )));
-                }
-            }
         }
         Ok(())
     }
@@ -2307,6 +2292,29 @@ impl LineSearch {
         };
         self.alpha = next;
         Some(next)
+    }
+}
+
+/// The rigid bodies of a dynamic run (every coordinate prescribed) as the moving contact
+/// partners of the nonlinear dynamic scheme ([`MovingPartners`]): posed at each sub-step's
+/// time, their motion since the last committed sub-step from [`partner_motion`].
+pub(crate) struct PrescribedPartners<'a, const D: usize> {
+    pub(crate) joint: &'a JointModel<D>,
+    pub(crate) driver: &'a mut RigidDriver,
+}
+
+impl<const D: usize> MovingPartners<D> for PrescribedPartners<'_, D> {
+    fn pose(&mut self, t: Real) -> Result<(), synovia_time::TimeError> {
+        self.driver
+            .pose_prescribed(self.joint, t)
+            .map(|_| ())
+            .map_err(|e| synovia_time::TimeError::InvalidParameter(e.to_string()))
+    }
+    fn motion(&self, geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>]) -> Vec<Vector<D>> {
+        self.driver.motion_since_accepted(self.joint, geometry, previous)
+    }
+    fn commit(&mut self) {
+        self.driver.accept();
     }
 }
 

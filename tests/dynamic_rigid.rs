@@ -10,7 +10,7 @@
 //! see only relative motion), so the two runs agree step by step: displacements (less the
 //! translation), `Λ_n`, friction cells and `Λ_t`, pair forces. The linear scheme is checked
 //! with friction (μ = 0.3, cells slip), the nonlinear one (neo-Hookean, finite strain)
-//! frictionless. The rigid body's reaction is the contact resultant. What dynamic analyses do
+//! frictionless and with friction. The rigid body's reaction is the contact resultant. What dynamic analyses do
 //! not take is refused with a typed error naming it.
 
 use std::sync::Arc;
@@ -153,11 +153,13 @@ fn compare(nonlinear: bool, mu: f64, tol: f64) -> Result<(usize, usize), Error> 
             in_contact += 1;
         }
         eprintln!(
-            "t = {t:.3}: normal force {:.6} / {:.6}, tangential x {:.6}, displacements {du:.1e}, Λ_n {dl:.1e}, {} cells",
+            "t = {t:.3}: normal force {:.6} / {:.6}, tangential x {:.6}, displacements {du:.1e}, Λ_n {dl:.1e}, {} cells, iterations {} / {}",
             pm.normal_force,
             pf.normal_force,
             pm.force[0],
-            cm.len()
+            cm.len(),
+            rm.iterations,
+            rf.iterations
         );
     }
     Ok((in_contact, slipping))
@@ -175,6 +177,18 @@ fn linear_block_under_a_moving_rigid_plane_with_friction_equals_the_moving_block
 fn neo_hookean_block_under_a_moving_rigid_plane_equals_the_moving_block() -> Result<(), Error> {
     let (in_contact, _) = compare(true, 0.0, 1e-7)?;
     assert!(in_contact >= 10, "{in_contact} steps in contact");
+    Ok(())
+}
+
+#[test]
+fn neo_hookean_block_under_a_moving_rigid_plane_with_friction_equals_the_moving_block() -> Result<(), Error> {
+    // the geometry passes on the deformed configuration stop at their tolerance (1e-8) along
+    // different iterates in the two runs: agreement to about that (measured ≤ 2.3e-8 in the
+    // displacements, ≤ 3.6e-7 in `Λ_n`, whose weights are the lumped areas of the
+    // configuration the last geometry was built at)
+    let (in_contact, slipping) = compare(true, 0.3, 1e-6)?;
+    assert!(in_contact >= 10, "{in_contact} steps in contact");
+    assert!(slipping > 0, "no friction cell slipped");
     Ok(())
 }
 
@@ -203,11 +217,5 @@ fn what_dynamic_analyses_do_not_take_is_refused() -> Result<(), Error> {
     joint.tie_to_rigid_body("block", "top", "plate")?;
     let err = joint.run_dynamic(DT, 2).err().ok_or("a tied part accepted")?;
     assert!(matches!(err, JointError::Invalid(_)) && err.to_string().contains("tied"), "{err}");
-    // friction against a rigid body in a nonlinear model
-    let err = moving(true, 0.2)?
-        .run_dynamic(DT, 2)
-        .err()
-        .ok_or("nonlinear friction against a rigid body accepted")?;
-    assert!(matches!(err, JointError::Invalid(_)) && err.to_string().contains("`press`"), "{err}");
     Ok(())
 }

@@ -1425,6 +1425,60 @@ impl<const D: usize> NonlinearContact<D> {
         self.whole_level(model, t, solver, None, Some(terms), None)
     }
 
+    /// [`Self::step_with_terms`] with contact partners that moved by a prescribed motion since
+    /// the committed state (rigid bodies posed at `t`), the Tresca slip of `terms`' bounds
+    /// measured relative to them as in [`Self::step_with_partner_motion`]:
+    /// `s_c = T_cᵀ ([u](x_c) − [u_{i−1}](x_c) − w_c)`, `w_c = motion(geometry, u_{i−1})_c` on
+    /// every geometry the iteration builds. The dynamic scheme's step against moving rigid
+    /// bodies (docs/dynamics.md §9).
+    ///
+    /// # Errors
+    /// As [`Self::step_with_terms`].
+    #[allow(clippy::type_complexity)]
+    pub fn step_with_terms_and_partner_motion(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        terms: &LevelTerms<'_>,
+        solver: &dyn ContactSolver,
+        motion: &dyn Fn(&ContactGeometry<D>, &[Vec<Vector<D>>]) -> Vec<Vector<D>>,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
+        let n = self.dofs.n_dofs();
+        if !t.is_finite() || terms.load.len() != n || terms.load.iter().any(|v| !v.is_finite()) {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "level with extra terms: a finite time and {n} finite load values needed, got t = {t} and {} values",
+                terms.load.len()
+            )));
+        }
+        if self.state.scale < 1.0 {
+            return Err(NonlinearError::InvalidParameter(
+                "a level with extra terms starts from a loaded state (set_state)".into(),
+            ));
+        }
+        // as in step_with_partner_motion: a gap control with nothing to search for
+        let pose = |_: Real| {};
+        let sensitivity = |geometry: &ContactGeometry<D>| vec![0.0; geometry.len()];
+        let resultant = |_: &ContactGeometry<D>, _: &[Real]| 0.0;
+        let moved =
+            |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>], _: Real| motion(geometry, previous);
+        let friction_resultant = |_: &ContactGeometry<D>, _: &[usize], _: &[Real], _: &[Real]| 0.0;
+        let mut control = GapControl {
+            pose: &pose,
+            sensitivity: &sensitivity,
+            resultant: &resultant,
+            target: 0.0,
+            tolerance: 1.0,
+            slope: 0.0,
+            w: 0.0,
+            overlap: 0.0,
+            max_step: 0.0,
+            base: 0.0,
+            trials: 0,
+            friction: Some(GapFriction { motion: &moved, resultant: &friction_resultant }),
+        };
+        self.whole_level(model, t, solver, None, Some(terms), Some(&mut control))
+    }
+
     /// One level solved whole (no cut-back) from the committed state by the Newton iteration,
     /// with load control and/or extra terms, committed on success at the level's time (the
     /// one load control found, else `t`); on failure the committed state is unchanged and the

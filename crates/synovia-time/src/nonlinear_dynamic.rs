@@ -136,6 +136,24 @@ pub struct NonlinearDynamicStepper<const D: usize> {
     cumulative_friction: Real,
 }
 
+/// Contact partners that move by a prescribed motion during a dynamic run (rigid bodies whose
+/// coordinates are all prescribed, docs/dynamics.md §9), for
+/// [`NonlinearDynamicStepper::step_posing`].
+pub trait MovingPartners<const D: usize> {
+    /// Poses the partners at `t`, the end of the next (sub-)step (their shapes read the pose
+    /// when the contact rows are built).
+    ///
+    /// # Errors
+    /// Whatever keeps them from being posed (e.g. a history value that is not finite).
+    fn pose(&mut self, t: Real) -> Result<(), TimeError>;
+    /// Their motion `w_r` at the contact nodes of `geometry` from the last committed (sub-)step
+    /// to the pose set last, at the nodes' positions `x_r + [u](previous)` (one vector per
+    /// node; the slip of friction is measured relative to it, docs/model.md (10.5)).
+    fn motion(&self, geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>]) -> Vec<Vector<D>>;
+    /// The (sub-)step to the pose set last was committed: the origin of the next motion.
+    fn commit(&mut self);
+}
+
 /// The result of one (sub-)step before it is committed.
 struct SubStep<const D: usize> {
     u: Vec<Real>,
@@ -332,12 +350,13 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
     }
 
     /// As [`Self::step`], with contact partners that move: before every (sub-)step to `t`,
-    /// `pose(t)` poses them (e.g. rigid bodies at their prescribed coordinates, docs/model.md
-    /// §10) and the contact rows are rebuilt ([`NonlinearContact::rebuild_geometry`]; the
-    /// level's pressures and slip speeds carried node by node to the new rows), so a cut-back
-    /// step poses the partners at its sub-step times. For frictionless pairs with the moving
-    /// partners: the slip of friction cells would be measured from the last level without the
-    /// partners' motion.
+    /// [`MovingPartners::pose`] poses them (e.g. rigid bodies at their prescribed coordinates,
+    /// docs/model.md §10) and the contact rows are rebuilt
+    /// ([`NonlinearContact::rebuild_geometry`]; the level's pressures and slip speeds carried
+    /// node by node to the new rows), so a cut-back step poses the partners at its sub-step
+    /// times; friction measures the slip relative to [`MovingPartners::motion`]
+    /// ([`NonlinearContact::step_with_terms_and_partner_motion`]), and the slip speeds and
+    /// friction work of the step use the same relative slip.
     ///
     /// # Errors
     /// As [`Self::step`]; whatever `pose` returns; [`TimeError::NonlinearSetup`] from the
@@ -346,7 +365,7 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
         &mut self,
         model: &Model<D>,
         solver: &dyn ContactSolver,
-        mut pose: Option<&mut dyn FnMut(Real) -> Result<(), TimeError>>,
+        mut partners: Option<&mut dyn MovingPartners<D>>,
     ) -> Result<StepRecord, TimeError> {
         let t_start = Instant::now();
         if model.n_nodes() != self.n_nodes {
@@ -365,8 +384,8 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
             let parts = 1usize << halvings;
             let h = dt / parts as Real;
             let t_new = if done + 1 == parts { t_end } else { self.time + h };
-            if let Some(pose) = pose.as_deref_mut() {
-                pose(t_new)?;
+            if let Some(partners) = partners.as_deref_mut() {
+                partners.pose(t_new)?;
                 let old = self.nl.rebuild_geometry(model)?;
                 let new = self.nl.geometry();
                 let same_rows = old.len() == new.len()
@@ -376,11 +395,14 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
                     self.slip_speed = new.transfer(&old, &self.slip_speed);
                 }
             }
-            match self.substep(model, h, t_new, solver) {
+            match self.substep(model, h, t_new, solver, partners.as_deref()) {
                 Ok(sub) => {
                     report.newton_iterations += sub.report.total_iterations;
                     report.factorisations += sub.report.factorisations;
                     self.commit(model, h, t_new, sub, &mut sum, &mut report)?;
+                    if let Some(partners) = partners.as_deref_mut() {
+                        partners.commit();
+                    }
                     report.substeps += 1;
                     done += 1;
                     if done == parts {
@@ -447,6 +469,7 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
         h: Real,
         t_new: Real,
         solver: &dyn ContactSolver,
+        partners: Option<&dyn MovingPartners<D>>,
     ) -> Result<SubStep<D>, NonlinearError> {
         if self.b_step != h {
             self.set_step_matrix(h)?;
@@ -489,7 +512,16 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
         }
         let bounds = self.laws.slip_bounds(self.nl.geometry(), &self.pressure, &self.slip_speed);
         let slip_bound = bounds.iter().any(|v| *v > 0.0).then_some(&bounds[..]);
-        let level = self.nl.step_with_terms(model, t_new, &LevelTerms { load: &g, slip_bound }, solver)?;
+        let terms = LevelTerms { load: &g, slip_bound };
+        let level = match partners.filter(|_| slip_bound.is_some()) {
+            // friction against moving partners: the slip measured relative to their motion
+            Some(p) => {
+                let motion =
+                    |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>]| p.motion(geometry, previous);
+                self.nl.step_with_terms_and_partner_motion(model, t_new, &terms, solver, &motion)?
+            }
+            None => self.nl.step_with_terms(model, t_new, &terms, solver)?,
+        };
         let u = self.nl.reduced().to_vec();
         let disp = level.contact.displacement.clone();
         Ok(SubStep {
