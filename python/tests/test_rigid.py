@@ -605,3 +605,28 @@ def test_parameter_and_callable_rigid_histories():
     bad = ball_model(0.0, prescribe={"tz": -0.05, "rx": lambda t: 1.0 / 0.0})
     with pytest.raises(ZeroDivisionError):
         bad.run_static()
+
+
+# ----- a rigid body as a moving contact partner in a dynamic run -----
+
+
+def test_dynamic_run_with_a_prescribed_rigid_roller():
+    """examples/scenarios/dynamic_roller2d.toml through Python: the roller follows its
+    prescribed path (20 mm along x, pressed 0.6 mm), its reaction is the contact force on it
+    (minus the pair's force on the pad) at every step, and friction drags the pad along."""
+    m = synovia.Model.from_scenario(SCENARIOS / "dynamic_roller2d.toml")
+    r = m.run()
+    assert len(r.records) == 101
+    assert r.rigid_bodies()["roller"]["dofs"] == pytest.approx([20.0, -0.6, 0.0], abs=1e-12)
+    in_contact = 0
+    for rec in r.records:
+        pair, roller = rec["pairs"][0], rec["rigid"][0]
+        assert roller["name"] == "roller"
+        scale = max(1.0, pair["normal_force"])
+        assert np.allclose(roller["force"][:2], -np.asarray(pair["force"][:2]), atol=1e-12 * scale)
+        if pair["normal_force"] > 1e-6:
+            in_contact += 1
+        if rec["time"] >= 0.003:
+            # pressed in, the roller slides along +x and drags the pad along +x
+            assert pair["force"][0] > 0.1 * pair["normal_force"]
+    assert in_contact > 80
