@@ -1529,9 +1529,7 @@ impl<const D: usize> JointModel<D> {
         let mut initial = stepper.initial_record();
         let result = zero_result(stepper.displacement().to_vec(), stepper.geometry().len());
         if let Some(driver) = driver.as_mut() {
-            let values = driver.pose_prescribed(self, stepper.time())?;
-            initial =
-                driver.record_level(self, stepper.geometry(), initial, &result, &values, stepper.time())?;
+            initial = driver.record_prescribed_level(self, stepper.geometry(), initial, &result)?;
         }
         observer(&StepView {
             model: &self.model,
@@ -1546,27 +1544,23 @@ impl<const D: usize> JointModel<D> {
             // the rigid partners at the end of the step: the step's constraints are those of
             // their position there, the slip measured relative to their motion over the step
             let t_next = stepper.params().t0 + (stepper.step_index() + 1) as Real * stepper.dt();
-            let values = match driver.as_mut() {
-                Some(driver) => {
-                    let values = driver.pose_prescribed(self, t_next)?;
-                    if posed_pairs {
-                        stepper.rebuild_geometry(&self.model, &self.pairs)?;
-                        let motion =
-                            driver.motion_since_accepted(self, stepper.geometry(), stepper.displacement());
-                        stepper.set_partner_motion(motion)?;
-                    }
-                    Some(values)
+            if let Some(driver) = driver.as_mut() {
+                driver.pose_prescribed(self, t_next)?;
+                if posed_pairs {
+                    stepper.rebuild_geometry(&self.model, &self.pairs)?;
+                    let motion =
+                        driver.motion_since_accepted(self, stepper.geometry(), stepper.displacement());
+                    stepper.set_partner_motion(motion)?;
                 }
-                None => None,
-            };
+            }
             let mut record = stepper.step(&self.model, solver.as_ref())?;
             let result = match stepper.last_contact() {
                 Some(r) => r.clone(),
                 None => zero_result(stepper.displacement().to_vec(), stepper.geometry().len()),
             };
-            if let (Some(driver), Some(values)) = (driver.as_mut(), values) {
+            if let Some(driver) = driver.as_mut() {
                 driver.accept();
-                record = driver.record_level(self, stepper.geometry(), record, &result, &values, t_next)?;
+                record = driver.record_prescribed_level(self, stepper.geometry(), record, &result)?;
             }
             observer(&StepView {
                 model: &self.model,
@@ -1656,9 +1650,7 @@ impl<const D: usize> JointModel<D> {
         let mut initial = stepper.initial_record();
         let result = zero_result(stepper.displacement().to_vec(), stepper.geometry().len());
         if let Some(driver) = driver.as_mut() {
-            let values = driver.pose_prescribed(self, stepper.time())?;
-            initial =
-                driver.record_level(self, stepper.geometry(), initial, &result, &values, stepper.time())?;
+            initial = driver.record_prescribed_level(self, stepper.geometry(), initial, &result)?;
         }
         observer(&StepView {
             model: &self.model,
@@ -1692,10 +1684,8 @@ impl<const D: usize> JointModel<D> {
                 _ => zero_result(stepper.displacement().to_vec(), stepper.geometry().len()),
             };
             if let Some(driver) = driver.as_mut() {
-                let t = record.time;
-                let values = driver.pose_prescribed(self, t)?;
                 driver.accept();
-                record = driver.record_level(self, stepper.geometry(), record, &result, &values, t)?;
+                record = driver.record_prescribed_level(self, stepper.geometry(), record, &result)?;
             }
             observer(&StepView {
                 model: &self.model,

@@ -917,18 +917,19 @@ impl RigidDriver {
         self.accepted = Some(self.q.clone());
     }
 
-    /// `record` with the rigid bodies' records of a level solved elsewhere (a dynamic step):
-    /// coordinates and reactions from the contact forces of `result` on `geometry`.
-    pub(crate) fn record_level<const D: usize>(
-        &self,
+    /// `record` with the rigid bodies' records of a level solved elsewhere (a dynamic step, every
+    /// coordinate prescribed): the bodies posed at the record's time, their reactions from the
+    /// contact forces of `result` on `geometry`.
+    pub(crate) fn record_prescribed_level<const D: usize>(
+        &mut self,
         joint: &JointModel<D>,
         geometry: &ContactGeometry<D>,
         record: StepRecord,
         result: &StaticContactResult<D>,
-        values: &[Vec<Real>],
-        t: Real,
     ) -> Result<StepRecord, JointError> {
-        self.finish(joint, geometry, record, result, values, t, 1)
+        let t = record.time;
+        let values = self.pose_prescribed(joint, t)?;
+        self.finish(joint, geometry, record, result, &values, t, 1)
     }
 
     /// Forgets the force-controlled coordinates and the Jacobian.

@@ -1360,8 +1360,25 @@ impl<const D: usize> NonlinearContact<D> {
         solver: &dyn ContactSolver,
         motion: &dyn Fn(&ContactGeometry<D>, &[Vec<Vector<D>>]) -> Vec<Vector<D>>,
     ) -> Result<NonlinearResult<D>, NonlinearError> {
-        // a gap control whose resultant is its target at any `w`: the search accepts the first
-        // trial, the partners stay where they are posed
+        if !t.is_finite() {
+            return Err(NonlinearError::InvalidParameter(format!("level t = {t} must be finite")));
+        }
+        self.level_with_partner_motion(model, t, solver, None, motion)
+    }
+
+    /// The level of [`Self::step_with_partner_motion`] (and, with `terms`, of
+    /// [`Self::step_with_terms_and_partner_motion`]): a gap control whose resultant is its
+    /// target at any `w`, so the search accepts the first trial and the partners stay where
+    /// they are posed, with the friction slip measured relative to `motion`.
+    #[allow(clippy::type_complexity)]
+    fn level_with_partner_motion(
+        &mut self,
+        model: &Model<D>,
+        t: Real,
+        solver: &dyn ContactSolver,
+        terms: Option<&LevelTerms<'_>>,
+        motion: &dyn Fn(&ContactGeometry<D>, &[Vec<Vector<D>>]) -> Vec<Vector<D>>,
+    ) -> Result<NonlinearResult<D>, NonlinearError> {
         let pose = |_: Real| {};
         let sensitivity = |geometry: &ContactGeometry<D>| vec![0.0; geometry.len()];
         let resultant = |_: &ContactGeometry<D>, _: &[Real]| 0.0;
@@ -1382,7 +1399,7 @@ impl<const D: usize> NonlinearContact<D> {
             trials: 0,
             friction: Some(GapFriction { motion: &moved, resultant: &friction_resultant }),
         };
-        self.step_gap_controlled(model, t, solver, &mut control)
+        self.whole_level(model, t, solver, None, terms, Some(&mut control))
     }
 
     /// Solves one level `t` with extra terms from the committed state (docs/model.md (12.1)):
@@ -1410,6 +1427,13 @@ impl<const D: usize> NonlinearContact<D> {
         terms: &LevelTerms<'_>,
         solver: &dyn ContactSolver,
     ) -> Result<NonlinearResult<D>, NonlinearError> {
+        self.check_terms(t, terms)?;
+        self.whole_level(model, t, solver, None, Some(terms), None)
+    }
+
+    /// `Err` unless `t` is finite, `terms.load` has one finite value per reduced dof and the
+    /// committed state is loaded (what a level with extra terms starts from).
+    fn check_terms(&self, t: Real, terms: &LevelTerms<'_>) -> Result<(), NonlinearError> {
         let n = self.dofs.n_dofs();
         if !t.is_finite() || terms.load.len() != n || terms.load.iter().any(|v| !v.is_finite()) {
             return Err(NonlinearError::InvalidParameter(format!(
@@ -1422,7 +1446,7 @@ impl<const D: usize> NonlinearContact<D> {
                 "a level with extra terms starts from a loaded state (set_state)".into(),
             ));
         }
-        self.whole_level(model, t, solver, None, Some(terms), None)
+        Ok(())
     }
 
     /// [`Self::step_with_terms`] with contact partners that moved by a prescribed motion since
@@ -1443,40 +1467,8 @@ impl<const D: usize> NonlinearContact<D> {
         solver: &dyn ContactSolver,
         motion: &dyn Fn(&ContactGeometry<D>, &[Vec<Vector<D>>]) -> Vec<Vector<D>>,
     ) -> Result<NonlinearResult<D>, NonlinearError> {
-        let n = self.dofs.n_dofs();
-        if !t.is_finite() || terms.load.len() != n || terms.load.iter().any(|v| !v.is_finite()) {
-            return Err(NonlinearError::InvalidParameter(format!(
-                "level with extra terms: a finite time and {n} finite load values needed, got t = {t} and {} values",
-                terms.load.len()
-            )));
-        }
-        if self.state.scale < 1.0 {
-            return Err(NonlinearError::InvalidParameter(
-                "a level with extra terms starts from a loaded state (set_state)".into(),
-            ));
-        }
-        // as in step_with_partner_motion: a gap control with nothing to search for
-        let pose = |_: Real| {};
-        let sensitivity = |geometry: &ContactGeometry<D>| vec![0.0; geometry.len()];
-        let resultant = |_: &ContactGeometry<D>, _: &[Real]| 0.0;
-        let moved =
-            |geometry: &ContactGeometry<D>, previous: &[Vec<Vector<D>>], _: Real| motion(geometry, previous);
-        let friction_resultant = |_: &ContactGeometry<D>, _: &[usize], _: &[Real], _: &[Real]| 0.0;
-        let mut control = GapControl {
-            pose: &pose,
-            sensitivity: &sensitivity,
-            resultant: &resultant,
-            target: 0.0,
-            tolerance: 1.0,
-            slope: 0.0,
-            w: 0.0,
-            overlap: 0.0,
-            max_step: 0.0,
-            base: 0.0,
-            trials: 0,
-            friction: Some(GapFriction { motion: &moved, resultant: &friction_resultant }),
-        };
-        self.whole_level(model, t, solver, None, Some(terms), Some(&mut control))
+        self.check_terms(t, terms)?;
+        self.level_with_partner_motion(model, t, solver, Some(terms), motion)
     }
 
     /// One level solved whole (no cut-back) from the committed state by the Newton iteration,
