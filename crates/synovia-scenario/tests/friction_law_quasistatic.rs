@@ -118,3 +118,35 @@ fn force_controlled_rigid_body_in_a_dynamic_scenario_is_refused_at_its_force() {
         "{err}"
     );
 }
+
+/// `examples/scenarios/dynamic_roller2d.toml` (a rigid roller with all coordinates prescribed
+/// in a dynamic analysis) builds and runs; the same file with a force on the roller's `ty`, or
+/// with a part tied to the roller, is refused by the build at that key.
+#[test]
+fn prescribed_rigid_body_in_a_dynamic_scenario_runs_and_what_it_cannot_take_is_refused_at_the_key() {
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios/dynamic_roller2d.toml");
+    let text = std::fs::read_to_string(&path).expect("scenario file");
+    let scenario = Scenario::parse(Source::new(&path, text.clone())).expect("parse");
+    let built = build::<2>(&scenario).expect("build");
+    let run = built.joint.run_with(|_| Ok(())).expect("run");
+    let last = run.records.last().expect("records");
+    assert_eq!(last.rigid[0].name, "roller");
+    assert!((last.rigid[0].dofs[0] - 20.0).abs() < 1e-12 && last.pairs[0].normal_force > 0.0, "{last:?}");
+    let ty = "ty = { value = -0.6, history = { table = [[0.0, 0.0], [0.003, 1.0], [0.01, 1.0]] } }";
+    assert!(text.contains(ty));
+    let forced = text.replace(ty, "ty = { force = -5.0 }");
+    let err = match build::<2>(&Scenario::parse(Source::new(&path, forced)).expect("parse")) {
+        Ok(_) => panic!("a force-controlled roller in a dynamic analysis was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("rigid_body[0].ty.force") && err.contains("dynamic analyses"), "{err}");
+    let tied = format!(
+        "{text}\n[[boundary]]\nbody = \"pad\"\npart = \"left\"\nkind = \"rigid_body\"\nrigid_body = \"roller\"\n"
+    );
+    let err = match build::<2>(&Scenario::parse(Source::new(&path, tied)).expect("parse")) {
+        Ok(_) => panic!("a part tied to a rigid body in a dynamic analysis was accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(err.contains("boundary[1].kind") && err.contains("dynamic analyses"), "{err}");
+}
