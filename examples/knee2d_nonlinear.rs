@@ -31,17 +31,22 @@ fn main() -> Result<(), KneeError> {
     // which would flatter the ratio)
     let mut linear_s = f64::INFINITY;
     let mut linear = Vec::new();
+    let c0 = process_cpu_s();
     for _ in 0..3 {
         let t0 = Instant::now();
         linear = knee.run(&times, &solver, |_| Ok(()))?;
         linear_s = linear_s.min(t0.elapsed().as_secs_f64());
     }
+    // CPU time of the process (all threads) per linear cycle: the mean of the three runs
+    let linear_cpu_s = (process_cpu_s() - c0) / 3.0;
     // ## Step 2: neo-Hookean cartilage, finite strain, deformed contact geometry; each pose
     // starts from the linear approach
     let guesses: Vec<f64> = linear.iter().map(|s| s.approach).collect();
     let t1 = Instant::now();
+    let c1 = process_cpu_s();
     let nonlinear = nonlinear_cycle(&knee, &times, &guesses, &solver, Knee2d::nonlinear_newton_params())?;
     let nonlinear_s = t1.elapsed().as_secs_f64();
+    let nonlinear_cpu_s = process_cpu_s() - c1;
     // ## Step 3: the comparison
     println!(
         "{:>6} {:>8} {:>9} {:>9} {:>7} {:>8} {:>8} {:>8} {:>8} {:>6} {:>5} {:>9} {:>7}",
@@ -95,14 +100,33 @@ fn main() -> Result<(), KneeError> {
     let controlled = nonlinear.iter().filter(|h| h.load_controlled).count();
     let trials: usize = nonlinear.iter().map(|h| h.load_control_trials).sum();
     let cost_ratio = nonlinear_s / linear_s;
+    let cpu_ratio = nonlinear_cpu_s / linear_cpu_s;
     println!(
-        "linear {linear_s:.3} s (fastest of 3), neo-Hookean {nonlinear_s:.2} s ({cost_ratio:.1}x): {solves} Newton solves ({controlled} poses under load control inside the Newton iteration), {newton} Newton iterations, {factorisations} factorisations, {trials} load-control trials"
+        "linear {linear_s:.3} s (fastest of 3), neo-Hookean {nonlinear_s:.2} s ({cost_ratio:.1}x); CPU time {linear_cpu_s:.3} s (mean of 3) and {nonlinear_cpu_s:.2} s ({cpu_ratio:.1}x): {solves} Newton solves ({controlled} poses under load control inside the Newton iteration), {newton} Newton iterations, {factorisations} factorisations, {trials} load-control trials"
     );
     println!(
-        "{{\"problem\":\"knee2d_nonlinear\",\"poses\":{},\"peak_pressure_linear_mpa\":{:.4},\"peak_pressure_neo_hookean_mpa\":{:.4},\"min_peak_ratio\":{min_ratio:.4},\"max_peak_ratio\":{max_ratio:.4},\"max_balance_error\":{balance:.3e},\"max_kkt\":{kkt:.3e},\"max_gap_error_per_h\":{gap:.3e},\"h_mm\":{h:.4},\"max_penetration_mm\":{penetration:.3e},\"newton_solves\":{solves},\"load_controlled_poses\":{controlled},\"newton_iterations\":{newton},\"factorisations\":{factorisations},\"load_control_trials\":{trials},\"linear_s\":{linear_s:.3},\"nonlinear_s\":{nonlinear_s:.3},\"cost_ratio\":{cost_ratio:.2}}}",
+        "{{\"problem\":\"knee2d_nonlinear\",\"poses\":{},\"peak_pressure_linear_mpa\":{:.4},\"peak_pressure_neo_hookean_mpa\":{:.4},\"min_peak_ratio\":{min_ratio:.4},\"max_peak_ratio\":{max_ratio:.4},\"max_balance_error\":{balance:.3e},\"max_kkt\":{kkt:.3e},\"max_gap_error_per_h\":{gap:.3e},\"h_mm\":{h:.4},\"max_penetration_mm\":{penetration:.3e},\"newton_solves\":{solves},\"load_controlled_poses\":{controlled},\"newton_iterations\":{newton},\"factorisations\":{factorisations},\"load_control_trials\":{trials},\"linear_s\":{linear_s:.3},\"nonlinear_s\":{nonlinear_s:.3},\"cost_ratio\":{cost_ratio:.2},\"linear_cpu_s\":{linear_cpu_s:.3},\"nonlinear_cpu_s\":{nonlinear_cpu_s:.3},\"cpu_ratio\":{cpu_ratio:.2}}}",
         times.len(),
         peak(&mut linear.iter().map(|s| s.peak_pressure)),
         peak(&mut nonlinear.iter().map(|h| h.step.peak_pressure)),
     );
     Ok(())
+}
+
+/// CPU time of this process, all threads, user + system (s): from `/proc/self/stat` (fields 14
+/// and 15, in clock ticks of 1/100 s on Linux), NaN where that file cannot be read (other
+/// systems), so the ratio shows as NaN rather than a wrong number.
+fn process_cpu_s() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else { return f64::NAN };
+    // the command name (field 2) is in parentheses and may hold spaces: fields after the last ')'
+    let Some(rest) = stat.rfind(')').map(|i| &stat[i + 1..]) else { return f64::NAN };
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    // after ')': field 3 (state) is index 0, so utime (14) is index 11 and stime (15) index 12
+    match (
+        fields.get(11).and_then(|v| v.parse::<f64>().ok()),
+        fields.get(12).and_then(|v| v.parse::<f64>().ok()),
+    ) {
+        (Some(u), Some(s)) => (u + s) / 100.0,
+        _ => f64::NAN,
+    }
 }
