@@ -264,6 +264,24 @@ pub struct CholeskySolver {
     trailing_dofs: Option<Vec<usize>>,
     trailing: Option<Arc<TrailingBlock>>,
     memory_limit: Option<u64>,
+    /// faer's workspace of the numeric factorisation (from the symbolic analysis and
+    /// [`Self::numeric_par`], both fixed): computed once in [`Self::analyse`] instead of twice
+    /// per factorisation (a loop over every supernode's descendants, 2.4 % of the CPU time of
+    /// the `knee2d` neo-Hookean cycle's 56 refactorisations; docs/nonlinear.md, "Fourth round").
+    numeric_scratch: (Par, faer::dyn_stack::StackReq),
+}
+
+/// The parallelism of the numeric factorisation of `symbolic`: threads pay only for large
+/// factors; below `nnz(L)² / n = 1e10` (≈ flops / 2) the sequential factorisation is faster
+/// (docs/performance.md, "Parallel assembly").
+fn numeric_par_of(symbolic: &SymbolicCholesky<usize>) -> Par {
+    let len = symbolic.len_val();
+    let work = (len as f64) * (len as f64) / (symbolic.nrows().max(1) as f64);
+    if work < 1e10 {
+        Par::Seq
+    } else {
+        faer::get_global_parallelism()
+    }
 }
 
 impl CholeskySolver {
@@ -319,6 +337,8 @@ impl CholeskySolver {
         .map_err(|e| LinalgError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
         let len = symbolic.len_val();
         let info = CholeskyInfo { symbolic_s: t0.elapsed().as_secs_f64(), numeric_s: 0.0, factor_nnz: len };
+        let par = numeric_par_of(&symbolic);
+        let numeric_scratch = (par, symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
         Ok(Self {
             symbolic: Arc::new(symbolic),
             factor: Vec::new(),
@@ -327,6 +347,7 @@ impl CholeskySolver {
             trailing_dofs,
             trailing: None,
             memory_limit: None,
+            numeric_scratch,
         })
     }
 
@@ -334,12 +355,15 @@ impl CholeskySolver {
     /// below `nnz(L)² / n = 1e10` (≈ flops / 2) the sequential factorisation is faster
     /// (docs/performance.md, "Parallel assembly").
     fn numeric_par(&self) -> Par {
-        let len = self.symbolic.len_val();
-        let work = (len as f64) * (len as f64) / (self.symbolic.nrows().max(1) as f64);
-        if work < 1e10 {
-            Par::Seq
-        } else {
-            faer::get_global_parallelism()
+        numeric_par_of(&self.symbolic)
+    }
+
+    /// faer's workspace of the numeric factorisation with `par`: the one kept from the analysis
+    /// unless the global parallelism changed since.
+    fn numeric_scratch_for(&self, par: Par) -> faer::dyn_stack::StackReq {
+        match self.numeric_scratch {
+            (p, req) if p == par => req,
+            _ => self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
         }
     }
 
@@ -347,7 +371,7 @@ impl CholeskySolver {
     /// trailing block), from the symbolic analysis.
     pub fn memory_estimate(&self) -> MemoryEstimate {
         let entries = self.symbolic.len_val();
-        let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(self.numeric_par(), Default::default());
+        let req = self.numeric_scratch_for(self.numeric_par());
         let k = self.trailing_dofs.as_ref().map_or(0, Vec::len) as u64;
         MemoryEstimate {
             dofs: self.symbolic.nrows(),
@@ -401,13 +425,20 @@ impl CholeskySolver {
         self.factorized = false;
         self.check_memory()?;
         let len = self.symbolic.len_val();
-        self.factor.clear();
-        self.factor.try_reserve_exact(len).map_err(|_| {
-            LinalgError::Sparse(format!("out of memory for a Cholesky factor of {len} entries"))
-        })?;
-        self.factor.resize(len, 0.0);
+        // the supernodal factorisation sets every value of the factor to zero itself before
+        // it scatters `a` (faer 0.24), so a factor of the right length is refactorised in
+        // place; the simplicial one expects zeros
+        let supernodal =
+            matches!(self.symbolic.raw(), faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(_));
+        if !(supernodal && self.factor.len() == len) {
+            self.factor.clear();
+            self.factor.try_reserve_exact(len).map_err(|_| {
+                LinalgError::Sparse(format!("out of memory for a Cholesky factor of {len} entries"))
+            })?;
+            self.factor.resize(len, 0.0);
+        }
         let par = self.numeric_par();
-        let req = self.symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default());
+        let req = self.numeric_scratch_for(par);
         let mut mem =
             MemBuffer::try_new(req).map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
         self.symbolic
