@@ -45,6 +45,7 @@ pub struct SolveContext {
     load: KeptLoadSolve,
     row_solves: Arc<BlockSolveStore>,
     recycled: Arc<Mutex<LoadSubspace>>,
+    forward: Arc<Mutex<ForwardSpan>>,
     memory_budget: usize,
 }
 
@@ -76,6 +77,7 @@ impl SolveContext {
             load: Arc::default(),
             row_solves: Arc::new(BlockSolveStore::with_budget(bytes / 4)),
             recycled: Arc::new(Mutex::new(LoadSubspace::new(Self::RECYCLED_LOADS))),
+            forward: Arc::default(),
             memory_budget: bytes,
         }
     }
@@ -96,6 +98,7 @@ impl SolveContext {
             load: self.load.clone(),
             row_solves: self.row_solves.clone(),
             recycled: self.recycled.clone(),
+            forward: self.forward.clone(),
             memory_budget: self.memory_budget,
         }
     }
@@ -145,6 +148,7 @@ impl SolveContext {
         *lock(&self.load) = None;
         self.row_solves.clear();
         lock(&self.recycled).clear();
+        lock(&self.forward).clear();
     }
     /// Forgets the kept columns of `S`, the load solve and the row solves, keeping the
     /// recycled load solves (new rows on the same operator: a new geometry or pose).
@@ -183,6 +187,21 @@ impl SolveContext {
     ) -> Result<Vec<f64>, ContactError> {
         Ok(lock(&self.recycled).solve(operator, load)?)
     }
+    /// The forward half `y = L⁻¹ P F` of `load` from the forward halves of the loads solved
+    /// before on this factorisation ([`ForwardSpan`]), when `load` lies in their span; `None`
+    /// otherwise.
+    pub(crate) fn forward_from_span(&self, load: &[f64]) -> Option<Vec<f64>> {
+        lock(&self.forward).combine(load)
+    }
+    /// Keeps the forward half `y` of `load` (solved) for [`Self::forward_from_span`].
+    pub(crate) fn put_forward(&self, load: &[f64], y: &Arc<Vec<f64>>) {
+        lock(&self.forward).push(load, y);
+    }
+    /// `(recycled, solved)` counts of the forward halves since the last [`Self::clear`].
+    pub fn forward_counts(&self) -> (usize, usize) {
+        let f = lock(&self.forward);
+        (f.recycled, f.solved)
+    }
     pub(crate) fn given_load_solution(&self, n: usize) -> Option<Arc<Vec<f64>>> {
         self.load_solution.clone().filter(|x| x.len() == n)
     }
@@ -220,6 +239,117 @@ impl SolveContext {
             }
         }
         *lock(&self.columns) = Some((fingerprint, columns));
+    }
+}
+
+/// Forward halves `y_j = L⁻¹ P F_j` of the last loads `F_j` solved on one factorisation, for
+/// loads in their span: a load `F = Σ_j a_j F_j + r` with `‖r‖ ≤ 10⁻¹³ ‖F‖` has the forward
+/// half `Σ_j a_j y_j` (the forward half is linear in the load), no solve. The case it is for:
+/// the trials of a load control on one factorisation (`synovia-nonlinear`), whose loads are
+/// affine in the control, `F(δ) = F(δ₀) + (δ − δ₀) d` — with the direction `d` in the span of
+/// two earlier trials, every trial after the first of a Newton iteration is recycled. The
+/// loads are kept as an orthonormal basis `Q` (modified Gram–Schmidt, twice) with `F_j = Σ_i
+/// R_ij q_i`; `a = R⁻¹ Qᵀ F`. A combination whose coefficients would amplify rounding
+/// (`Σ |a_j| ‖F_j‖ > 10³ ‖F‖`) is solved instead; a load nearly dependent on the basis
+/// (`‖r‖ < 10⁻¹⁰ ‖F‖` but above the bound) is solved and not added; when
+/// [`ForwardSpan::CAPACITY`] loads are kept the basis restarts from the new one.
+#[derive(Debug, Default)]
+pub(crate) struct ForwardSpan {
+    /// Orthonormal directions of the kept loads.
+    q: Vec<Vec<f64>>,
+    /// `R` by columns: `F_j = Σ_{i ≤ j} r[j][i] q_i`.
+    r: Vec<Vec<f64>>,
+    /// The kept loads' norms and forward halves.
+    norms: Vec<f64>,
+    y: Vec<Arc<Vec<f64>>>,
+    recycled: usize,
+    solved: usize,
+}
+
+impl ForwardSpan {
+    /// Loads kept at most.
+    pub(crate) const CAPACITY: usize = 8;
+    const IN_SPAN: f64 = 1e-13;
+    const NEW_DIRECTION: f64 = 1e-10;
+    const AMPLIFICATION: f64 = 1e3;
+
+    fn clear(&mut self) {
+        *self = Self::default();
+    }
+
+    /// `Qᵀ F` (two passes of modified Gram–Schmidt) and the residual `F − Q Qᵀ F`.
+    fn project(&self, load: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let mut r = load.to_vec();
+        let mut c = vec![0.0; self.q.len()];
+        for _ in 0..2 {
+            for (cj, q) in c.iter_mut().zip(&self.q) {
+                let d: f64 = q.iter().zip(&r).map(|(a, b)| a * b).sum();
+                r.iter_mut().zip(q).for_each(|(ri, qi)| *ri -= d * qi);
+                *cj += d;
+            }
+        }
+        (c, r)
+    }
+
+    fn combine(&mut self, load: &[f64]) -> Option<Vec<f64>> {
+        let k = self.q.len();
+        if k == 0 || self.y.iter().any(|y| y.len() != load.len()) {
+            return None;
+        }
+        let norm = load.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if norm == 0.0 || !norm.is_finite() {
+            return None;
+        }
+        let (c, r) = self.project(load);
+        let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if rn > Self::IN_SPAN * norm {
+            return None;
+        }
+        // R a = c (R upper triangular, by columns)
+        let mut a = c;
+        for j in (0..k).rev() {
+            let d = self.r[j][j];
+            if d == 0.0 {
+                return None;
+            }
+            a[j] /= d;
+            let aj = a[j];
+            for (i, ai) in a.iter_mut().enumerate().take(j) {
+                *ai -= self.r[j][i] * aj;
+            }
+        }
+        let weight: f64 = a.iter().zip(&self.norms).map(|(a, n)| a.abs() * n).sum();
+        if !weight.is_finite() || weight > Self::AMPLIFICATION * norm {
+            return None;
+        }
+        let mut y = vec![0.0; load.len()];
+        for (aj, yj) in a.iter().zip(&self.y) {
+            y.iter_mut().zip(yj.iter()).for_each(|(o, v)| *o += aj * v);
+        }
+        self.recycled += 1;
+        Some(y)
+    }
+
+    fn push(&mut self, load: &[f64], y: &Arc<Vec<f64>>) {
+        self.solved += 1;
+        let norm = load.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if norm == 0.0 || !norm.is_finite() || y.len() != load.len() {
+            return;
+        }
+        if self.q.len() >= Self::CAPACITY || self.y.iter().any(|v| v.len() != load.len()) {
+            let (recycled, solved) = (self.recycled, self.solved);
+            *self = Self { recycled, solved, ..Self::default() };
+        }
+        let (mut c, r) = self.project(load);
+        let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if rn < Self::NEW_DIRECTION * norm {
+            return;
+        }
+        c.push(rn);
+        self.q.push(r.into_iter().map(|v| v / rn).collect());
+        self.r.push(c);
+        self.norms.push(norm);
+        self.y.push(y.clone());
     }
 }
 

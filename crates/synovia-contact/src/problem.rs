@@ -260,24 +260,35 @@ impl<'a> Interface<'a> {
                 match (context.load_solve(key), context.load_solve(forward_key).filter(|_| covered)) {
                     (Some(x), _) => (LoadSolution::Full(x), 0),
                     (None, Some(y)) => (LoadSolution::Forward(y), 0),
-                    (None, None) => match covered
-                        .then(|| problem.operator.forward_solve(problem.load))
-                        .transpose()?
-                        .flatten()
-                    {
-                        Some(y) => {
-                            let y = std::sync::Arc::new(y);
-                            context.put_load_solve(forward_key, y.clone());
-                            (LoadSolution::Forward(y), 1)
+                    (None, None) => {
+                        match covered.then(|| context.forward_from_span(problem.load)).flatten() {
+                            // a load in the span of the loads solved before on this factorisation
+                            Some(y) => {
+                                let y = std::sync::Arc::new(y);
+                                context.put_load_solve(forward_key, y.clone());
+                                (LoadSolution::Forward(y), 0)
+                            }
+                            None => match covered
+                                .then(|| problem.operator.forward_solve(problem.load))
+                                .transpose()?
+                                .flatten()
+                            {
+                                Some(y) => {
+                                    let y = std::sync::Arc::new(y);
+                                    context.put_load_solve(forward_key, y.clone());
+                                    context.put_forward(problem.load, &y);
+                                    (LoadSolution::Forward(y), 1)
+                                }
+                                None => {
+                                    let mut x = problem.load.to_vec();
+                                    problem.operator.solve_in_place(&mut x)?;
+                                    let x = std::sync::Arc::new(x);
+                                    context.put_load_solve(key, x.clone());
+                                    (LoadSolution::Full(x), 1)
+                                }
+                            },
                         }
-                        None => {
-                            let mut x = problem.load.to_vec();
-                            problem.operator.solve_in_place(&mut x)?;
-                            let x = std::sync::Arc::new(x);
-                            context.put_load_solve(key, x.clone());
-                            (LoadSolution::Full(x), 1)
-                        }
-                    },
+                    }
                 }
             }
         };

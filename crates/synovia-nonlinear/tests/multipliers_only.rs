@@ -94,3 +94,47 @@ fn multiplier_only_solve_and_completion_equal_the_full_solve() {
     assert!(contact.complete_load(&load_a[1..], &lifts_a, None, None, ma).is_err());
     assert!(contact.solve_load_multipliers(&load_a, &lifts_a[1..], &solver, None, None, None).is_err());
 }
+
+/// A load in the span of the loads solved before on the same factorisation (the trials of a
+/// load control are affine in the approach) takes its forward half from theirs, no solve
+/// (`SolveContext::forward_counts`): its multipliers and completed displacement equal those of
+/// the load solved on its own to 1e-12; a load outside the span is solved.
+#[test]
+fn a_load_in_the_span_of_earlier_trials_is_recycled_and_equals_its_own_solve() {
+    let (model, pairs) = pressed_block();
+    let solver = Pdas::new(ContactParams::default().with_tolerance(1e-13));
+    let c0 = body_stiffnesses(&model).unwrap();
+    let contact = StaticContact::with_system_matrix(&model, &pairs, ElasticParams::default(), |dofs, a| {
+        assemble_matrix(&model, dofs, a, |b, _, geo, out| stiffness_into(geo, &c0[b], out))
+    })
+    .unwrap();
+    let elastic = ElasticSolver::new(&model, ElasticParams::default()).unwrap();
+    let (load_a, lifts_a) = elastic.rhs(&model, 0.8).unwrap();
+    let (load_b, lifts_b) = elastic.rhs(&model, 1.0).unwrap();
+    // the trial between them: its load an affine combination of theirs (the push is linear in t)
+    let s = 0.37;
+    let load_c: Vec<Real> = load_a.iter().zip(&load_b).map(|(a, b)| a + s * (b - a)).collect();
+    let lifts_c: Vec<Vector<2>> = lifts_a.iter().zip(&lifts_b).map(|(a, b)| a + (b - a) * s).collect();
+    // the reference: load c solved on its own
+    contact.context().clear();
+    let (own, _) = contact.solve_load_multipliers(&load_c, &lifts_c, &solver, None, None, None).unwrap();
+    let own_done = contact.complete_load(&load_c, &lifts_c, None, None, own.clone()).unwrap();
+    assert_eq!(contact.context().forward_counts(), (0, 1));
+    // a solved, then b and c from its forward half
+    contact.context().clear();
+    let (ma, _) = contact.solve_load_multipliers(&load_a, &lifts_a, &solver, None, None, None).unwrap();
+    let (mb, _) = contact.solve_load_multipliers(&load_b, &lifts_b, &solver, None, None, Some(&ma)).unwrap();
+    let (mc, _) = contact.solve_load_multipliers(&load_c, &lifts_c, &solver, None, None, Some(&mb)).unwrap();
+    // the push is proportional to t here, so b is a multiple of a: a solved, b and c recycled
+    assert_eq!(contact.context().forward_counts(), (2, 1), "b and c recycled, a solved");
+    let ln = max_abs(&own.lambda_n);
+    assert!(ln > 0.0);
+    assert!(max_diff(&own.lambda_n, &mc.lambda_n) <= 1e-12 * ln, "recycled trial: Λ_n");
+    let done = contact.complete_load(&load_c, &lifts_c, None, None, mc).unwrap();
+    assert_same(&own_done, &done, "recycled trial");
+    // a load outside the span (a sideways push) is solved
+    let side: Vec<Real> =
+        load_a.iter().enumerate().map(|(i, a)| if i % 2 == 0 { 1.1 * a } else { *a }).collect();
+    let _ = contact.solve_load_multipliers(&side, &lifts_a, &solver, None, None, None).unwrap();
+    assert_eq!(contact.context().forward_counts(), (2, 2), "a load outside the span is solved");
+}
