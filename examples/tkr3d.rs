@@ -48,6 +48,9 @@ type Error = Box<dyn std::error::Error>;
 /// Threshold of the `film_area` columns (MPa): the lower limit of Fuji Prescale LW film, with
 /// which published TKR contact areas are measured (docs/tkr3d.md).
 const FILM_THRESHOLD_MPA: f64 = 2.5;
+/// Radius (mm) of the fillets of the femur's concave edges in the neo-Hookean comparison with
+/// friction (`--femur-fillet`; docs/tkr3d.md, "Neo-Hookean insert").
+const NH_FRICTION_FILLET: f64 = 0.1;
 
 /// Figures of one pose.
 struct Pose {
@@ -127,6 +130,15 @@ fn main() -> Result<(), Error> {
         model.friction = 0.0;
     }
     let friction = model.friction;
+    // `--femur-fillet R`: round the femoral surface's concave edges by fillets of radius R (mm;
+    // `Tkr3d::femur_fillet`). Default 0 (the STL's facets as they are), except for the
+    // neo-Hookean comparison with friction, where a node pressed into a concave edge keeps the
+    // geometry passes from settling without them (docs/tkr3d.md, "Neo-Hookean insert")
+    if let Some(v) = std::env::args().skip_while(|a| a != "--femur-fillet").nth(1) {
+        model.femur_fillet = v.parse()?;
+    } else if friction > 0.0 && std::env::args().any(|a| a == "--neo-hookean") {
+        model.femur_fillet = NH_FRICTION_FILLET;
+    }
     // `--insert-material E,nu`: Young's modulus (MPa) and Poisson's ratio of the insert
     // (default UHMWPE 463 MPa, 0.46)
     if let Some(v) = std::env::args().skip_while(|a| a != "--insert-material").nth(1) {
@@ -388,6 +400,18 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
             view.record.rigid.first().map_or(0, |r| r.solves),
             view.record.step_s,
         ));
+        // progress on stderr (a long run shows the pose it reached)
+        if let Some(f) = nonlinear.last() {
+            eprintln!(
+                "neo-Hookean pose {:.0} %: peak {:.3} MPa, balance {:.1e}, KKT {:.1e}, {} Newton iterations, {:.1} s since the start",
+                100.0 * view.record.time,
+                f.peak,
+                f.balance,
+                f.kkt,
+                view.record.iterations,
+                start.elapsed().as_secs_f64()
+            );
+        }
         Ok(())
     })?;
     let nonlinear_s = t_nonlinear.elapsed().as_secs_f64();

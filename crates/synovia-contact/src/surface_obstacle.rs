@@ -56,6 +56,8 @@ pub struct SurfaceObstacle {
     /// A smoothed surface's control surface and the bound `δ` on the distance between the two
     /// ([`SurfaceObstacle::smoothed_solid`]).
     coarse: Option<(Box<SurfaceObstacle>, Real)>,
+    /// Concave edges rounded by fillets ([`SurfaceObstacle::with_concave_fillet`]).
+    fillet: Option<Arc<Fillet>>,
     /// Far answers of bounded queries, kept for the next ones
     /// ([`SignedDistance::distance_and_gradient_within`]); shared by clones (they hold
     /// points in the surface's own frame, valid for every pose).
@@ -91,6 +93,69 @@ struct FarAnswer {
 const FAR_PER_CELL: usize = 8;
 /// Cubes of the grid of far answers kept (at most 2¹⁶ × 8 answers of 80 bytes: 42 MB).
 const FAR_CELLS: usize = 1 << 16;
+
+/// A concave edge of the surface rounded by a circular fillet
+/// ([`SurfaceObstacle::with_concave_fillet`]), in the surface's frame.
+#[derive(Debug, Clone, Copy)]
+struct FilletEdge {
+    /// One end of the edge.
+    a: Vector3<Real>,
+    /// Unit direction from `a` to the other end.
+    u: Vector3<Real>,
+    /// Length of the edge.
+    len: Real,
+    /// Unit normals of the two faces (into the free space).
+    n1: Vector3<Real>,
+    n2: Vector3<Real>,
+    /// `n1 · n2`.
+    c: Real,
+    /// The fillet's radius at this edge.
+    radius: Real,
+    /// The fillet's axis relative to the edge, `radius (n1 + n2) / (1 + n1 · n2)` (the line at
+    /// the distance `radius` from both faces' planes, on the free side).
+    axis: Vector3<Real>,
+}
+
+impl FilletEdge {
+    /// The signed distance to the fillet and its gradient at `x` (surface frame), if `x` lies
+    /// in the fillet's zone: beside the edge (its projection on the edge's line within the
+    /// edge) and in the cone `axis − β₁ n₁ − β₂ n₂ (β ≥ 0)` about the fillet's axis, where the
+    /// closest point of the rounded surface lies on the fillet.
+    fn distance(&self, x: &Vector3<Real>) -> Option<(Real, Vector3<Real>)> {
+        let w = x - self.a;
+        let s = w.dot(&self.u);
+        if !(0.0..=self.len).contains(&s) {
+            return None;
+        }
+        let q = w - self.u * s - self.axis;
+        let qq = q.norm();
+        if qq <= 1e-12 * self.radius {
+            return None;
+        }
+        // q = −β₁ n₁ − β₂ n₂: [1 c; c 1] β = −(q·n₁, q·n₂)
+        let (q1, q2) = (q.dot(&self.n1), q.dot(&self.n2));
+        let det = 1.0 - self.c * self.c;
+        let b1 = (-q1 + self.c * q2) / det;
+        let b2 = (-q2 + self.c * q1) / det;
+        if b1 < 0.0 || b2 < 0.0 {
+            return None;
+        }
+        Some((self.radius - qq, -q / qq))
+    }
+}
+
+/// The fillets of a surface's concave edges and, per triangle, the fillets that may hold the
+/// closest point of a query whose closest point on the faceted surface lies on that triangle
+/// (the concave edges incident to its vertices).
+#[derive(Debug)]
+struct Fillet {
+    edges: Vec<FilletEdge>,
+    near: Vec<Vec<u32>>,
+    /// The largest distance between a fillet and its edge, `max radius (1 / cos(θ/2) − 1)`:
+    /// the rounded distance is within it of the faceted one, and it bounds the jumps of the
+    /// rounded distance at the edges' ends.
+    deficit: Real,
+}
 
 impl SurfaceObstacle {
     /// An obstacle bounded by `surface`, which must be a consistently oriented manifold (open
@@ -203,8 +268,116 @@ impl SurfaceObstacle {
             rotation: Rotation3::identity(),
             translation: Vector3::zeros(),
             coarse: None,
+            fillet: None,
             far: Arc::default(),
         }
+    }
+
+    /// The obstacle with its concave edges rounded by circular fillets of radius `radius`
+    /// (surface units): where two faces meet at an edge that the free space sees as a convex
+    /// corner (the solid's inner corner, e.g. a groove), the signed distance is that of the
+    /// surface with the corner filled by a cylinder of radius `radius` tangent to both faces.
+    /// Its gradient is then continuous across the edge: a contact node pressed into such a
+    /// corner has a closest point and a normal that move continuously with it, where on the
+    /// faceted surface its normal jumps between the two faces' normals (docs/nonlinear.md,
+    /// "A node in a concave corner"). Near an edge whose faces are narrow the radius is
+    /// reduced so that the fillet touches each face within half its height over the edge. The
+    /// rounded surface lies within `radius (1 / cos(θ/2) − 1)` of the faceted one (`θ` the
+    /// angle between the faces' normals; [`SurfaceObstacle::fillet_deficit`]). Fillets are
+    /// per edge: at a vertex where concave edges meet, the distance is the least of theirs
+    /// (a fillet ends at the ends of its edge). Replaces any fillet set before; `radius = 0`
+    /// removes them.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] for a radius that is negative or not finite.
+    pub fn with_concave_fillet(mut self, radius: Real) -> Result<Self, ContactError> {
+        if !(radius.is_finite() && radius >= 0.0) {
+            return Err(ContactError::InvalidParameter(format!(
+                "surface obstacle: fillet radius {radius} must be finite and ≥ 0"
+            )));
+        }
+        self.fillet = None;
+        if radius > 0.0 {
+            self.fillet = Some(Arc::new(self.concave_fillets(radius)));
+        }
+        // kept far answers were measured without (or with other) fillets
+        self.far = Arc::default();
+        Ok(self)
+    }
+
+    /// The bound on the distance between the rounded and the faceted surface
+    /// ([`SurfaceObstacle::with_concave_fillet`]; 0 without fillets).
+    pub fn fillet_deficit(&self) -> Real {
+        self.fillet.as_ref().map_or(0.0, |f| f.deficit)
+    }
+
+    /// The number of concave edges rounded ([`SurfaceObstacle::with_concave_fillet`]).
+    pub fn filleted_edges(&self) -> usize {
+        self.fillet.as_ref().map_or(0, |f| f.edges.len())
+    }
+
+    fn concave_fillets(&self, radius: Real) -> Fillet {
+        let surface = &self.surface;
+        let v = surface.vertices();
+        let tris = surface.triangles();
+        // edge → the triangles on it with their vertex opposite the edge
+        let mut sides: HashMap<(usize, usize), Vec<(usize, usize)>> = HashMap::new();
+        for (t, tri) in tris.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b, o) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+                sides.entry((a.min(b), a.max(b))).or_default().push((t, o));
+            }
+        }
+        let mut keys: Vec<_> = sides.keys().copied().collect();
+        keys.sort_unstable();
+        let mut edges = Vec::new();
+        let mut ends = Vec::new();
+        let mut deficit: Real = 0.0;
+        for key in keys {
+            let [(t1, o1), (t2, o2)] = sides[&key][..] else { continue };
+            let (a, b) = (v[key.0], v[key.1]);
+            let (n1, n2) = (self.face_normals[t1], self.face_normals[t2]);
+            let c = n1.dot(&n2);
+            // concave: each face's far vertex on the free side of the other face's plane
+            let concave = n1.dot(&(v[o2] - a)) > 0.0 && n2.dot(&(v[o1] - a)) > 0.0;
+            if !concave || !(c > -1.0 + 1e-9 && c < 1.0 - 1e-12) {
+                continue;
+            }
+            let e = b - a;
+            let len = e.norm();
+            if len <= 0.0 {
+                continue;
+            }
+            let u = e / len;
+            // the fillet touches each face at radius tan(θ/2) from the edge: within half
+            // the face's height over the edge
+            let height = |o: usize| (v[o] - a - u * (v[o] - a).dot(&u)).norm();
+            let half_angle_tan = ((1.0 - c) / (1.0 + c)).sqrt();
+            let r = radius.min(0.5 * height(o1).min(height(o2)) / half_angle_tan);
+            if !(r > 0.0) {
+                continue;
+            }
+            deficit = deficit.max(r * ((2.0 / (1.0 + c)).sqrt() - 1.0));
+            edges.push(FilletEdge { a, u, len, n1, n2, c, radius: r, axis: (n1 + n2) * (r / (1.0 + c)) });
+            ends.push(key);
+        }
+        // per triangle: the fillets of the edges incident to its vertices
+        let mut at_vertex: Vec<Vec<u32>> = vec![Vec::new(); v.len()];
+        for (i, &(p, q)) in ends.iter().enumerate() {
+            let i = u32::try_from(i).unwrap_or(u32::MAX);
+            at_vertex[p].push(i);
+            at_vertex[q].push(i);
+        }
+        let near = tris
+            .iter()
+            .map(|tri| {
+                let mut list: Vec<u32> = tri.iter().flat_map(|&k| at_vertex[k].iter().copied()).collect();
+                list.sort_unstable();
+                list.dedup();
+                list
+            })
+            .collect();
+        Fillet { edges, near, deficit }
     }
 
     /// The surface (in its own frame).
@@ -267,7 +440,21 @@ impl SurfaceObstacle {
         } else {
             pseudo.try_normalize(0.0).unwrap_or(self.face_normals[t])
         };
-        (c, t, side * len, gradient_local)
+        let (mut distance, mut gradient, mut point) = (side * len, gradient_local, c);
+        // the rounded surface lies on the free side of the faceted one: the least distance
+        if let Some(fillet) = &self.fillet {
+            for &e in fillet.near.get(t).map_or(&[][..], Vec::as_slice) {
+                let Some(edge) = fillet.edges.get(e as usize) else { continue };
+                if let Some((df, gf)) = edge.distance(local) {
+                    if df < distance {
+                        distance = df;
+                        gradient = gf;
+                        point = local - gf * df;
+                    }
+                }
+            }
+        }
+        (point, t, distance, gradient)
     }
 }
 
@@ -298,8 +485,11 @@ impl SignedDistance<3> for SurfaceObstacle {
     /// Otherwise the exact [`SignedDistance::distance_and_gradient`].
     fn distance_and_gradient_within(&self, x: &Point<3>, reach: Real) -> (Real, Vector<3>) {
         let local = self.rotation.inverse() * (x - self.translation);
+        // the rounded distance jumps by at most the fillets' deficit at the ends of their edges
+        let deficit = self.fillet_deficit();
         if let Some((coarse, delta)) = &self.coarse {
             let (_, _, d, g) = coarse.closest_local(&local);
+            let delta = delta + deficit;
             if d - delta > reach {
                 return (d - delta, self.rotation * g);
             }
@@ -311,7 +501,7 @@ impl SignedDistance<3> for SurfaceObstacle {
             if far.reach == reach {
                 let best = far.cells.get(&far.cell(&local)).and_then(|kept| {
                     kept.iter()
-                        .map(|a| (a.distance - (local - a.local).norm(), a.gradient))
+                        .map(|a| (a.distance - deficit - (local - a.local).norm(), a.gradient))
                         .max_by(|a, b| a.0.total_cmp(&b.0))
                 });
                 if let Some((bound, gradient)) = best.filter(|(b, _)| *b > reach) {
@@ -346,6 +536,74 @@ impl SignedDistance<3> for SurfaceObstacle {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The groove `z = 1 − 0.1 x` (x ≥ 0), `z = 1 + 0.25 x` (x < 0), normals down: its crease
+    /// at x = 0 is concave (the free space below is a convex wedge).
+    fn groove() -> TriangleSurface {
+        let v = |x: Real, y: Real| Point::<3>::new(x, y, if x >= 0.0 { 1.0 - 0.1 * x } else { 1.0 + 0.25 * x });
+        let vertices = vec![v(-2.0, -2.0), v(0.0, -2.0), v(2.0, -2.0), v(-2.0, 2.0), v(0.0, 2.0), v(2.0, 2.0)];
+        let surface = TriangleSurface::new(vertices, vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
+            .expect("surface");
+        if surface.normal(0)[2] > 0.0 {
+            surface.flipped()
+        } else {
+            surface
+        }
+    }
+
+    /// A concave edge rounded by a fillet: the distance is continuous with a continuous
+    /// gradient across the crease's bisector (where the faceted one jumps between the faces'
+    /// normals) and across the fillet's tangent lines, never above the faceted distance, and
+    /// `radius (1/cos(θ/2) − 1)` below it at the crease; a convex edge (the groove turned
+    /// over) and points away from the edge are unchanged.
+    #[test]
+    fn concave_fillet_is_continuous_and_below_the_faceted_distance() {
+        let radius: Real = 0.05;
+        let faceted = SurfaceObstacle::new(groove()).expect("open surface");
+        let rounded = faceted.clone().with_concave_fillet(radius).expect("fillet");
+        assert_eq!(rounded.filleted_edges(), 1);
+        let (n1, n2): (Vector3<Real>, Vector3<Real>) =
+            (Vector3::new(0.1, 0.0, 1.0).normalize(), Vector3::new(-0.25, 0.0, 1.0).normalize());
+        let half = 0.5 * n1.dot(&n2).acos();
+        assert!((rounded.fillet_deficit() - radius * (1.0 / half.cos() - 1.0)).abs() < 1e-15);
+        // at the crease: the bisector, the deficit below the faceted surface
+        let crease = Point::<3>::new(0.0, 0.3, 1.0);
+        let (d, g) = rounded.distance_and_gradient(&crease);
+        assert!((d + rounded.fillet_deficit()).abs() < 1e-14, "φ = {d:e}");
+        assert!((g + (n1 + n2).normalize()).norm() < 1e-14, "∇φ = {g:?}");
+        // along a line across the groove below the crease (free space) and one above it
+        // (inside): continuous, 1-Lipschitz, gradients turning continuously
+        for z in [0.999, 1.0005] {
+            let mut last: Option<(Real, Vector<3>)> = None;
+            let h = 1e-4;
+            for k in -400..=400 {
+                let x = Point::<3>::new(Real::from(k) * h, -0.7, z);
+                let (d, g) = rounded.distance_and_gradient(&x);
+                assert!(d <= faceted.distance(&x) + 1e-15, "above the faceted distance at {x:?}");
+                assert!((g.norm() - 1.0).abs() < 1e-12);
+                if let Some((d0, g0)) = last {
+                    assert!((d - d0).abs() <= h * (1.0 + 1e-9), "jump of φ at {x:?}");
+                    assert!((g - g0).norm() < 0.05, "jump of ∇φ at {x:?}: {g0:?} → {g:?}");
+                }
+                last = Some((d, g));
+            }
+        }
+        // the faceted gradient jumps across the bisector below the crease
+        let bisector = (n1 + n2).normalize();
+        let below = crease - bisector * 1e-3;
+        let side = Vector3::new(1.0, 0.0, 0.0) * 1e-6;
+        let (ga, gb) = (faceted.gradient(&(below + side)), faceted.gradient(&(below - side)));
+        assert!((ga - gb).norm() > 0.3, "{ga:?} {gb:?}");
+        // far from the edge: unchanged
+        for x in [Point::<3>::new(0.5, 0.0, 0.9), Point::<3>::new(-0.5, 0.2, 0.8)] {
+            assert_eq!(rounded.distance_and_gradient(&x), faceted.distance_and_gradient(&x));
+        }
+        // the same edge seen from the other side is convex: nothing rounded
+        let ridge = SurfaceObstacle::new(groove().flipped()).expect("open surface").with_concave_fillet(radius);
+        assert_eq!(ridge.expect("fillet").filleted_edges(), 0);
+        assert!(faceted.clone().with_concave_fillet(-1.0).is_err());
+        assert!(faceted.with_concave_fillet(Real::NAN).is_err());
+    }
 
     /// Bounded queries of a surface that moves a little from pose to pose (a rigid partner
     /// over a gait cycle): within the reach they equal the exact query of a fresh obstacle

@@ -168,6 +168,13 @@ pub struct Tkr3d {
     /// few degrees at each edge; two levels (0.31 mm) make it smooth on the scale of the
     /// insert's meshes (docs/tkr3d.md, "Mesh convergence"; `synovia_mesh::subdivision`).
     pub femur_subdivision: usize,
+    /// Radius (mm) of the fillets that round the femoral surface's concave edges (0: none,
+    /// the default; [`synovia_contact::SurfaceObstacle::with_concave_fillet`]). A contact node
+    /// pressed into such an edge has no fixed point of the geometry passes on the deformed
+    /// configuration with one row against the faceted surface (its normal jumps between the
+    /// two faces): the neo-Hookean cycle with friction stopped at its 14 % pose that way
+    /// (docs/tkr3d.md, "Neo-Hookean insert").
+    pub femur_fillet: Real,
     /// Young's modulus (MPa) and Poisson's ratio of the insert (default [`UHMWPE`]).
     pub insert_material: (Real, Real),
     /// The insert's law (default [`InsertLaw::Linear`]).
@@ -188,6 +195,7 @@ impl Default for Tkr3d {
             superior: Superior::IsoForce,
             control: ForceControlParams::default(),
             femur_subdivision: FEMUR_SUBDIVISION,
+            femur_fillet: 0.0,
             insert_material: UHMWPE,
             insert_law: InsertLaw::Linear,
         }
@@ -264,11 +272,10 @@ impl Tkr3d {
         // the femoral component: rigid, bounded by its closed surface (metres → mm)
         // (Loop-subdivided: its edges stay sharp where its facets meet at more than 30°)
         let femur_surface = read_stl(self.data_dir.join("femoral_component.stl"))?.scaled(1000.0)?;
-        let shape: Arc<dyn SignedDistance<3>> = Arc::new(SurfaceObstacle::smoothed_solid(
-            femur_surface,
-            self.femur_subdivision,
-            FEMUR_CREASE_ANGLE,
-        )?);
+        let shape: Arc<dyn SignedDistance<3>> = Arc::new(
+            SurfaceObstacle::smoothed_solid(femur_surface, self.femur_subdivision, FEMUR_CREASE_ANGLE)?
+                .with_concave_fillet(self.femur_fillet)?,
+        );
 
         // the pose over the cycle: time = fraction of the cycle (the table's time is in percent)
         let table = self.kinematics()?;
