@@ -455,11 +455,21 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     };
     let max = |f: &dyn Fn(&Figures) -> f64, v: &[Figures]| v.iter().map(f).fold(0.0, f64::max);
     let changes: Vec<f64> = linear.iter().zip(&nonlinear).map(|(l, n)| rel(l.peak, n.peak)).collect();
+    // the fillets of the femur's concave edges (both runs): how many, and how far the rounded
+    // surface lies from the faceted one at most
+    let (filleted, deficit) = if model.femur_fillet > 0.0 {
+        let surface = synovia::io::read_stl(model.data_dir.join("femoral_component.stl"))?.scaled(1000.0)?;
+        let femur = SurfaceObstacle::solid(surface)?.with_concave_fillet(model.femur_fillet)?;
+        (femur.filleted_edges(), femur.fillet_deficit())
+    } else {
+        (0, 0.0)
+    };
     println!(
-        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":{},\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"friction_force_linear_n\":[{}],\"friction_force_neo_hookean_n\":[{}],\"medial_force_linear_n\":[{}],\"medial_force_neo_hookean_n\":[{}],\"lateral_force_linear_n\":[{}],\"lateral_force_neo_hookean_n\":[{}],\"ml_linear_mm\":[{}],\"ml_neo_hookean_mm\":[{}],\"adduction_linear_mrad\":[{}],\"adduction_neo_hookean_mrad\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
+        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":{},\"femur_fillet_mm\":{},\"femur_filleted_edges\":{filleted},\"femur_fillet_deficit_mm\":{deficit:.3e},\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"friction_force_linear_n\":[{}],\"friction_force_neo_hookean_n\":[{}],\"medial_force_linear_n\":[{}],\"medial_force_neo_hookean_n\":[{}],\"lateral_force_linear_n\":[{}],\"lateral_force_neo_hookean_n\":[{}],\"ml_linear_mm\":[{}],\"ml_neo_hookean_mm\":[{}],\"adduction_linear_mrad\":[{}],\"adduction_neo_hookean_mrad\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
         model.mesh_file(),
         percents.iter().map(u32::to_string).collect::<Vec<_>>().join(","),
         model.friction,
+        model.femur_fillet,
         list(&|f| f.peak, &linear),
         list(&|f| f.peak, &nonlinear),
         list(&|f| f.area, &linear),

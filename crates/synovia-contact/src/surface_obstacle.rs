@@ -340,7 +340,7 @@ impl SurfaceObstacle {
             let c = n1.dot(&n2);
             // concave: each face's far vertex on the free side of the other face's plane
             let concave = n1.dot(&(v[o2] - a)) > 0.0 && n2.dot(&(v[o1] - a)) > 0.0;
-            if !concave || !(c > -1.0 + 1e-9 && c < 1.0 - 1e-12) {
+            if !(concave && c > -1.0 + 1e-9 && c < 1.0 - 1e-12) {
                 continue;
             }
             let e = b - a;
@@ -354,7 +354,7 @@ impl SurfaceObstacle {
             let height = |o: usize| (v[o] - a - u * (v[o] - a).dot(&u)).norm();
             let half_angle_tan = ((1.0 - c) / (1.0 + c)).sqrt();
             let r = radius.min(0.5 * height(o1).min(height(o2)) / half_angle_tan);
-            if !(r > 0.0) {
+            if r.is_nan() || r <= 0.0 {
                 continue;
             }
             deficit = deficit.max(r * ((2.0 / (1.0 + c)).sqrt() - 1.0));
@@ -540,8 +540,10 @@ mod tests {
     /// The groove `z = 1 − 0.1 x` (x ≥ 0), `z = 1 + 0.25 x` (x < 0), normals down: its crease
     /// at x = 0 is concave (the free space below is a convex wedge).
     fn groove() -> TriangleSurface {
-        let v = |x: Real, y: Real| Point::<3>::new(x, y, if x >= 0.0 { 1.0 - 0.1 * x } else { 1.0 + 0.25 * x });
-        let vertices = vec![v(-2.0, -2.0), v(0.0, -2.0), v(2.0, -2.0), v(-2.0, 2.0), v(0.0, 2.0), v(2.0, 2.0)];
+        let v =
+            |x: Real, y: Real| Point::<3>::new(x, y, if x >= 0.0 { 1.0 - 0.1 * x } else { 1.0 + 0.25 * x });
+        let vertices =
+            vec![v(-2.0, -2.0), v(0.0, -2.0), v(2.0, -2.0), v(-2.0, 2.0), v(0.0, 2.0), v(2.0, 2.0)];
         let surface = TriangleSurface::new(vertices, vec![[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
             .expect("surface");
         if surface.normal(0)[2] > 0.0 {
@@ -599,7 +601,8 @@ mod tests {
             assert_eq!(rounded.distance_and_gradient(&x), faceted.distance_and_gradient(&x));
         }
         // the same edge seen from the other side is convex: nothing rounded
-        let ridge = SurfaceObstacle::new(groove().flipped()).expect("open surface").with_concave_fillet(radius);
+        let ridge =
+            SurfaceObstacle::new(groove().flipped()).expect("open surface").with_concave_fillet(radius);
         assert_eq!(ridge.expect("fillet").filleted_edges(), 0);
         assert!(faceted.clone().with_concave_fillet(-1.0).is_err());
         assert!(faceted.with_concave_fillet(Real::NAN).is_err());

@@ -135,7 +135,10 @@ fn filleted_concave_edge_settles_with_the_node_in_the_corner() {
             let n = node.normal;
             let cross = |a: &Vector<3>, b: &Vector<3>| a.cross(b)[1];
             let (a, b) = (cross(&n2, &n), cross(&n, &n1));
-            eprintln!("ridge node {i}: Λ = {:.4e}, n = {n:?}, φ = {phi:.2e}, faceted φ = {phi_faceted:.2e}", lambda[r]);
+            eprintln!(
+                "ridge node {i}: Λ = {:.4e}, n = {n:?}, φ = {phi:.2e}, faceted φ = {phi_faceted:.2e}",
+                lambda[r]
+            );
             assert!(a > 1e-3 && b > 1e-3, "normal {n:?} not inside the cone of {n1:?}, {n2:?}");
             ridge += 1;
         }
