@@ -459,7 +459,8 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     // surface lies from the faceted one at most
     let (filleted, deficit) = if model.femur_fillet > 0.0 {
         let surface = synovia::io::read_stl(model.data_dir.join("femoral_component.stl"))?.scaled(1000.0)?;
-        let femur = SurfaceObstacle::solid(surface)?.with_concave_fillet(model.femur_fillet)?;
+        let femur = SurfaceObstacle::solid(surface)?
+            .with_concave_fillet(model.femur_fillet, synovia_models::tkr3d::FEMUR_FILLET_MAX_OFFSET)?;
         (femur.filleted_edges(), femur.fillet_deficit())
     } else {
         (0, 0.0)

@@ -283,22 +283,25 @@ impl SurfaceObstacle {
     /// "A node in a concave corner"). Near an edge whose faces are narrow the radius is
     /// reduced so that the fillet touches each face within half its height over the edge. The
     /// rounded surface lies within `radius (1 / cos(θ/2) − 1)` of the faceted one (`θ` the
-    /// angle between the faces' normals; [`SurfaceObstacle::fillet_deficit`]). Fillets are
-    /// per edge: at a vertex where concave edges meet, the distance is the least of theirs
-    /// (a fillet ends at the ends of its edge). Replaces any fillet set before; `radius = 0`
-    /// removes them.
+    /// angle between the faces' normals; [`SurfaceObstacle::fillet_deficit`]); the radius of
+    /// an edge is also cut so that this offset stays within `max_deficit` (a sharp inner
+    /// corner, `θ` near 90° or beyond, gets a small fillet: at `θ = 127°` a fillet of radius
+    /// `r` lies `1.2 r` off the corner). Fillets are per edge: at a vertex where concave edges
+    /// meet, the distance is the least of theirs (a fillet ends at the ends of its edge).
+    /// Replaces any fillet set before; `radius = 0` removes them.
     ///
     /// # Errors
-    /// [`ContactError::InvalidParameter`] for a radius that is negative or not finite.
-    pub fn with_concave_fillet(mut self, radius: Real) -> Result<Self, ContactError> {
-        if !(radius.is_finite() && radius >= 0.0) {
+    /// [`ContactError::InvalidParameter`] for a radius that is negative or not finite, or a
+    /// `max_deficit` that is not positive (`Real::INFINITY`: no bound).
+    pub fn with_concave_fillet(mut self, radius: Real, max_deficit: Real) -> Result<Self, ContactError> {
+        if !(radius.is_finite() && radius >= 0.0) || max_deficit.is_nan() || max_deficit <= 0.0 {
             return Err(ContactError::InvalidParameter(format!(
-                "surface obstacle: fillet radius {radius} must be finite and ≥ 0"
+                "surface obstacle: fillet radius {radius} must be finite and ≥ 0, its largest offset {max_deficit} > 0"
             )));
         }
         self.fillet = None;
         if radius > 0.0 {
-            self.fillet = Some(Arc::new(self.concave_fillets(radius)));
+            self.fillet = Some(Arc::new(self.concave_fillets(radius, max_deficit)));
         }
         // kept far answers were measured without (or with other) fillets
         self.far = Arc::default();
@@ -316,7 +319,7 @@ impl SurfaceObstacle {
         self.fillet.as_ref().map_or(0, |f| f.edges.len())
     }
 
-    fn concave_fillets(&self, radius: Real) -> Fillet {
+    fn concave_fillets(&self, radius: Real, max_deficit: Real) -> Fillet {
         let surface = &self.surface;
         let v = surface.vertices();
         let tris = surface.triangles();
@@ -353,11 +356,13 @@ impl SurfaceObstacle {
             // the face's height over the edge
             let height = |o: usize| (v[o] - a - u * (v[o] - a).dot(&u)).norm();
             let half_angle_tan = ((1.0 - c) / (1.0 + c)).sqrt();
-            let r = radius.min(0.5 * height(o1).min(height(o2)) / half_angle_tan);
+            // the fillet lies r (1/cos(θ/2) − 1) off the edge: at most max_deficit
+            let offset = (2.0 / (1.0 + c)).sqrt() - 1.0;
+            let r = radius.min(0.5 * height(o1).min(height(o2)) / half_angle_tan).min(max_deficit / offset);
             if r.is_nan() || r <= 0.0 {
                 continue;
             }
-            deficit = deficit.max(r * ((2.0 / (1.0 + c)).sqrt() - 1.0));
+            deficit = deficit.max(r * offset);
             edges.push(FilletEdge { a, u, len, n1, n2, c, radius: r, axis: (n1 + n2) * (r / (1.0 + c)) });
             ends.push(key);
         }
@@ -562,7 +567,7 @@ mod tests {
     fn concave_fillet_is_continuous_and_below_the_faceted_distance() {
         let radius: Real = 0.05;
         let faceted = SurfaceObstacle::new(groove()).expect("open surface");
-        let rounded = faceted.clone().with_concave_fillet(radius).expect("fillet");
+        let rounded = faceted.clone().with_concave_fillet(radius, Real::INFINITY).expect("fillet");
         assert_eq!(rounded.filleted_edges(), 1);
         let (n1, n2): (Vector3<Real>, Vector3<Real>) =
             (Vector3::new(0.1, 0.0, 1.0).normalize(), Vector3::new(-0.25, 0.0, 1.0).normalize());
@@ -601,11 +606,16 @@ mod tests {
             assert_eq!(rounded.distance_and_gradient(&x), faceted.distance_and_gradient(&x));
         }
         // the same edge seen from the other side is convex: nothing rounded
-        let ridge =
-            SurfaceObstacle::new(groove().flipped()).expect("open surface").with_concave_fillet(radius);
+        let ridge = SurfaceObstacle::new(groove().flipped())
+            .expect("open surface")
+            .with_concave_fillet(radius, Real::INFINITY);
         assert_eq!(ridge.expect("fillet").filleted_edges(), 0);
-        assert!(faceted.clone().with_concave_fillet(-1.0).is_err());
-        assert!(faceted.with_concave_fillet(Real::NAN).is_err());
+        // a bound on the offset cuts the radius
+        let bounded = faceted.clone().with_concave_fillet(radius, 1e-4).expect("fillet");
+        assert!((bounded.fillet_deficit() - 1e-4).abs() < 1e-15, "{}", bounded.fillet_deficit());
+        assert!(faceted.clone().with_concave_fillet(-1.0, 1.0).is_err());
+        assert!(faceted.clone().with_concave_fillet(Real::NAN, 1.0).is_err());
+        assert!(faceted.with_concave_fillet(radius, 0.0).is_err());
     }
 
     /// Bounded queries of a surface that moves a little from pose to pose (a rigid partner

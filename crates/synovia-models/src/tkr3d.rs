@@ -105,6 +105,10 @@ pub const FEMUR_SUBDIVISION: usize = 0;
 /// subdivision (30°: the rims and the box cuts of the component, not the articular surface,
 /// whose facets meet at a few degrees).
 pub const FEMUR_CREASE_ANGLE: Real = std::f64::consts::PI / 6.0;
+/// The largest offset (mm) of a fillet of the femur's concave edges from the faceted surface
+/// ([`Tkr3d::femur_fillet`]): the radius of a sharper edge is cut to it (unbounded, fillets of
+/// 0.1 mm lie up to 0.12 mm off the STL's sharpest inner corners).
+pub const FEMUR_FILLET_MAX_OFFSET: Real = 2.5e-3;
 
 /// How the femur's superior–inferior translation (degree of freedom 1) is set.
 #[derive(Debug, Clone)]
@@ -169,7 +173,8 @@ pub struct Tkr3d {
     /// insert's meshes (docs/tkr3d.md, "Mesh convergence"; `synovia_mesh::subdivision`).
     pub femur_subdivision: usize,
     /// Radius (mm) of the fillets that round the femoral surface's concave edges (0: none,
-    /// the default; [`synovia_contact::SurfaceObstacle::with_concave_fillet`]). A contact node
+    /// the default; [`synovia_contact::SurfaceObstacle::with_concave_fillet`], each within
+    /// [`FEMUR_FILLET_MAX_OFFSET`] of the STL). A contact node
     /// pressed into such an edge has no fixed point of the geometry passes on the deformed
     /// configuration with one row against the faceted surface (its normal jumps between the
     /// two faces): the neo-Hookean cycle with friction stopped at its 14 % pose that way
@@ -274,7 +279,7 @@ impl Tkr3d {
         let femur_surface = read_stl(self.data_dir.join("femoral_component.stl"))?.scaled(1000.0)?;
         let shape: Arc<dyn SignedDistance<3>> = Arc::new(
             SurfaceObstacle::smoothed_solid(femur_surface, self.femur_subdivision, FEMUR_CREASE_ANGLE)?
-                .with_concave_fillet(self.femur_fillet)?,
+                .with_concave_fillet(self.femur_fillet, FEMUR_FILLET_MAX_OFFSET)?,
         );
 
         // the pose over the cycle: time = fraction of the cycle (the table's time is in percent)

@@ -99,7 +99,7 @@ fn faceted_concave_edge_does_not_settle() {
 #[test]
 fn filleted_concave_edge_settles_with_the_node_in_the_corner() {
     let radius = 0.05;
-    let rounded = groove().with_concave_fillet(radius).unwrap();
+    let rounded = groove().with_concave_fillet(radius, Real::INFINITY).unwrap();
     assert_eq!(rounded.filleted_edges(), 1);
     let deficit = rounded.fillet_deficit();
     let shape = Arc::new(rounded);
