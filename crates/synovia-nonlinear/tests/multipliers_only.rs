@@ -45,8 +45,9 @@ fn assert_same(full: &StaticContactResult<2>, completed: &StaticContactResult<2>
     assert_eq!(full.cell_node, completed.cell_node);
 }
 
-#[test]
-fn multiplier_only_solve_and_completion_equal_the_full_solve() {
+/// The pressed block, its contact machinery on the assembled stiffness, the plain elastic
+/// solver (for the right-hand sides) and a tight PDAS.
+fn contact_setup() -> (Model<2>, StaticContact<2>, ElasticSolver<2>, Pdas) {
     let (model, pairs) = pressed_block();
     let solver = Pdas::new(ContactParams::default().with_tolerance(1e-13));
     let c0 = body_stiffnesses(&model).unwrap();
@@ -55,6 +56,12 @@ fn multiplier_only_solve_and_completion_equal_the_full_solve() {
     })
     .unwrap();
     let elastic = ElasticSolver::new(&model, ElasticParams::default()).unwrap();
+    (model, contact, elastic, solver)
+}
+
+#[test]
+fn multiplier_only_solve_and_completion_equal_the_full_solve() {
+    let (model, contact, elastic, solver) = contact_setup();
     // two loads of a search over the approach (the prescribed push at t = 0.8 and t = 1)
     let (load_a, lifts_a) = elastic.rhs(&model, 0.8).unwrap();
     let (load_b, lifts_b) = elastic.rhs(&model, 1.0).unwrap();
@@ -101,14 +108,7 @@ fn multiplier_only_solve_and_completion_equal_the_full_solve() {
 /// the load solved on its own to 1e-12; a load outside the span is solved.
 #[test]
 fn a_load_in_the_span_of_earlier_trials_is_recycled_and_equals_its_own_solve() {
-    let (model, pairs) = pressed_block();
-    let solver = Pdas::new(ContactParams::default().with_tolerance(1e-13));
-    let c0 = body_stiffnesses(&model).unwrap();
-    let contact = StaticContact::with_system_matrix(&model, &pairs, ElasticParams::default(), |dofs, a| {
-        assemble_matrix(&model, dofs, a, |b, _, geo, out| stiffness_into(geo, &c0[b], out))
-    })
-    .unwrap();
-    let elastic = ElasticSolver::new(&model, ElasticParams::default()).unwrap();
+    let (model, contact, elastic, solver) = contact_setup();
     let (load_a, lifts_a) = elastic.rhs(&model, 0.8).unwrap();
     let (load_b, lifts_b) = elastic.rhs(&model, 1.0).unwrap();
     // the trial between them: its load an affine combination of theirs (the push is linear in t)
