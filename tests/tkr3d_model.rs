@@ -76,3 +76,28 @@ fn bad_options_and_missing_data_are_typed_errors() {
     assert!(err.to_string().contains("/nonexistent/tka"), "{err}");
     assert!(matches!(missing.measured_si(), Err(Tkr3dError::Table(_))));
 }
+
+/// Fillets of the femur's concave edges (`Tkr3d::femur_fillet`, each within 2.5 µm of the STL)
+/// leave the small-strain solution of a pose where they touch nothing of consequence as it is:
+/// at the 6 % pose the peak pressure and the contact resultant with 0.1 mm fillets equal those
+/// of the faceted femur within 1 % (measured: equal to the digits printed). Without the bound on
+/// a fillet's distance — never more than the deficit below the faceted one — this failed:
+/// 1 704 against 358 MPa, normal force 1 630 against 1 312 N.
+#[test]
+fn femur_fillets_do_not_change_a_pose_beyond_their_offset() {
+    let t = 0.06;
+    let solve = |fillet: f64| {
+        let model = Tkr3d { data_dir: data_dir(), friction: 0.0, femur_fillet: fillet, ..Tkr3d::default() };
+        let joint = model.joint_model().expect("model");
+        let mut session = joint.prepare().expect("prepare");
+        let report = session.solve_static(t).expect("pose");
+        assert!(report.kkt <= 1e-8, "KKT {:e}", report.kkt);
+        let record = session.record().expect("record").clone();
+        (record.pairs[0].peak_pressure, record.pairs[0].normal_force)
+    };
+    let (p0, f0) = solve(0.0);
+    let (p1, f1) = solve(0.1);
+    eprintln!("6 %: faceted peak {p0:.3} MPa, normal force {f0:.1} N; filleted {p1:.3} MPa, {f1:.1} N");
+    assert!((p1 - p0).abs() <= 0.01 * p0, "peak {p1} vs {p0}");
+    assert!((f1 - f0).abs() <= 0.01 * f0, "normal force {f1} vs {f0}");
+}

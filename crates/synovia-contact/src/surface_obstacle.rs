@@ -446,12 +446,17 @@ impl SurfaceObstacle {
             pseudo.try_normalize(0.0).unwrap_or(self.face_normals[t])
         };
         let (mut distance, mut gradient, mut point) = (side * len, gradient_local, c);
-        // the rounded surface lies on the free side of the faceted one: the least distance
+        // the rounded surface lies on the free side of the faceted one, within the fillets'
+        // deficit of it: the least distance, never more than the deficit below the faceted
+        // one (two surfaces within δ of each other have signed distances within δ). The bound
+        // also rejects a fillet whose zone (an unbounded cone behind its edge) reaches through
+        // a thin part of the solid to points beside another face sharing a vertex with it.
         if let Some(fillet) = &self.fillet {
+            let lowest = distance - fillet.deficit * (1.0 + 1e-9) - 1e-15;
             for &e in fillet.near.get(t).map_or(&[][..], Vec::as_slice) {
                 let Some(edge) = fillet.edges.get(e as usize) else { continue };
                 if let Some((df, gf)) = edge.distance(local) {
-                    if df < distance {
+                    if df < distance && df >= lowest {
                         distance = df;
                         gradient = gf;
                         point = local - gf * df;
