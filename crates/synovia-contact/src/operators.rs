@@ -855,6 +855,13 @@ impl<const D: usize> ContactGeometry<D> {
         self.nodes.iter().map(|n| index.get(&(n.pair, n.node.0, n.node.1)).copied()).collect()
     }
 
+    /// Whether `self` has the rows of `other`, node for node in the same order (then
+    /// [`ContactGeometry::transfer`] from it is the identity).
+    pub fn same_rows(&self, other: &ContactGeometry<D>) -> bool {
+        self.nodes.len() == other.nodes.len()
+            && self.nodes.iter().zip(&other.nodes).all(|(a, b)| a.pair == b.pair && a.node == b.node)
+    }
+
     /// Nodal values of `from` (one per node of `from`) carried to the nodes of `self` through
     /// [`ContactGeometry::node_map`]; nodes new in `self` get 0.
     pub fn transfer(&self, from: &ContactGeometry<D>, values: &[Real]) -> Vec<Real> {

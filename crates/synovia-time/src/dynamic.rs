@@ -634,9 +634,7 @@ impl<const D: usize> DynamicStepper<D> {
     pub fn rebuild_geometry(&mut self, model: &Model<D>, pairs: &[ContactPair<D>]) -> Result<(), TimeError> {
         let old = self.contact.rebuild_geometry(model, pairs)?;
         let new = self.contact.geometry();
-        let same_rows = old.len() == new.len()
-            && old.nodes.iter().zip(&new.nodes).all(|(a, b)| a.pair == b.pair && a.node == b.node);
-        if !same_rows {
+        if !new.same_rows(&old) {
             self.pressure = new.transfer(&old, &self.pressure);
             self.slip_speed = new.transfer(&old, &self.slip_speed);
             self.warm = self.warm.take().map(|w| transfer_result(&old, new, &w));

@@ -388,9 +388,7 @@ impl<const D: usize> NonlinearDynamicStepper<D> {
                 partners.pose(t_new)?;
                 let old = self.nl.rebuild_geometry(model)?;
                 let new = self.nl.geometry();
-                let same_rows = old.len() == new.len()
-                    && old.nodes.iter().zip(&new.nodes).all(|(a, b)| a.pair == b.pair && a.node == b.node);
-                if !same_rows {
+                if !new.same_rows(&old) {
                     self.pressure = new.transfer(&old, &self.pressure);
                     self.slip_speed = new.transfer(&old, &self.slip_speed);
                 }
