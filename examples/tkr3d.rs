@@ -37,6 +37,9 @@
 use std::fmt::Write as _;
 use std::time::Instant;
 
+mod process_cpu;
+use process_cpu::process_cpu_s;
+
 use plotters::prelude::*;
 use synovia::io::{Encoding, TimeSeriesWriter};
 use synovia::nonlinear::GeometryUpdate;
@@ -340,6 +343,7 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     let times: Vec<f64> = percents.iter().map(|&p| f64::from(p) / 100.0).collect();
     // linear: the main job's model and solves
     let t_linear = Instant::now();
+    let c_linear = process_cpu_s();
     let linear_joint = Tkr3d { insert_law: InsertLaw::Linear, ..model.clone() }.joint_model()?;
     let mut session = linear_joint.prepare()?;
     let dofs = session.elastic_info().n_dofs;
@@ -350,8 +354,10 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         linear.push(Figures::of(session.record().ok_or("no record")?, report.kkt)?);
     }
     let linear_s = t_linear.elapsed().as_secs_f64();
+    let linear_cpu_s = process_cpu_s() - c_linear;
     // neo-Hookean, finite strain
     let t_nonlinear = Instant::now();
+    let c_nonlinear = process_cpu_s();
     let mut nh_joint = Tkr3d { insert_law: InsertLaw::NeoHookean, ..model.clone() }.joint_model()?;
     // `--nh-geometry converged|per-level|reference`: the contact geometry of the Newton
     // iteration (docs/nonlinear.md); `--tangent-reuse ρ`: modified Newton
@@ -367,7 +373,8 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
     if let Some(v) = std::env::args().skip_while(|a| a != "--tangent-reuse").nth(1) {
         newton = newton.with_tangent_reuse(Some(v.parse()?));
     }
-    // `--nh-aitken on|off`: Aitken's relaxation of the geometry passes (default off)
+    // `--nh-aitken on|off`: Aitken's relaxation of the geometry passes (default: the model's,
+    // on with friction; off: the fixed relaxation 0.5)
     if let Some(v) = std::env::args().skip_while(|a| a != "--nh-aitken").nth(1) {
         newton = newton.with_geometry_aitken(match v.as_str() {
             "on" => true,
@@ -415,6 +422,7 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         Ok(())
     })?;
     let nonlinear_s = t_nonlinear.elapsed().as_secs_f64();
+    let nonlinear_cpu_s = process_cpu_s() - c_nonlinear;
     println!("| cycle % | SI lin / NH (mm) | ML lin / NH (mm) | adduction lin / NH (mrad) | force (N) | medial force lin / NH (N) | lateral force lin / NH (N) | area lin / NH (mm²) | peak p lin / NH (MPa) | Δ peak | medial peak lin / NH | lateral peak lin / NH | friction lin / NH (N) | balance NH | KKT NH | Newton it. | solves | s |");
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let rel = |a: f64, b: f64| if a > 0.0 { (b - a) / a } else { 0.0 };
@@ -466,7 +474,7 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         (0, 0.0)
     };
     println!(
-        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":{},\"femur_fillet_mm\":{},\"femur_filleted_edges\":{filleted},\"femur_fillet_deficit_mm\":{deficit:.3e},\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"friction_force_linear_n\":[{}],\"friction_force_neo_hookean_n\":[{}],\"medial_force_linear_n\":[{}],\"medial_force_neo_hookean_n\":[{}],\"lateral_force_linear_n\":[{}],\"lateral_force_neo_hookean_n\":[{}],\"ml_linear_mm\":[{}],\"ml_neo_hookean_mm\":[{}],\"adduction_linear_mrad\":[{}],\"adduction_neo_hookean_mrad\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"total_s\":{:.2}}}",
+        "{{\"example\":\"tkr3d\",\"comparison\":\"linear_vs_neo_hookean\",\"mesh\":\"{}\",\"poses\":[{}],\"dofs\":{dofs},\"friction\":{},\"femur_fillet_mm\":{},\"femur_filleted_edges\":{filleted},\"femur_fillet_deficit_mm\":{deficit:.3e},\"peak_pressure_linear_mpa\":[{}],\"peak_pressure_neo_hookean_mpa\":[{}],\"contact_area_linear_mm2\":[{}],\"contact_area_neo_hookean_mm2\":[{}],\"friction_force_linear_n\":[{}],\"friction_force_neo_hookean_n\":[{}],\"medial_force_linear_n\":[{}],\"medial_force_neo_hookean_n\":[{}],\"lateral_force_linear_n\":[{}],\"lateral_force_neo_hookean_n\":[{}],\"ml_linear_mm\":[{}],\"ml_neo_hookean_mm\":[{}],\"adduction_linear_mrad\":[{}],\"adduction_neo_hookean_mrad\":[{}],\"peak_change_min\":{:.4},\"peak_change_max\":{:.4},\"max_force_balance_error_neo_hookean\":{:.3e},\"max_kkt_neo_hookean\":{:.3e},\"newton_iterations\":{},\"linear_s\":{linear_s:.2},\"nonlinear_s\":{nonlinear_s:.2},\"cost_ratio\":{:.2},\"linear_cpu_s\":{linear_cpu_s:.2},\"nonlinear_cpu_s\":{nonlinear_cpu_s:.2},\"cpu_ratio\":{:.2},\"total_s\":{:.2}}}",
         model.mesh_file(),
         percents.iter().map(u32::to_string).collect::<Vec<_>>().join(","),
         model.friction,
@@ -491,6 +499,7 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
         max(&|f| f.kkt, &nonlinear),
         newton_steps.iter().map(|n| n.0).sum::<usize>(),
         nonlinear_s / linear_s,
+        nonlinear_cpu_s / linear_cpu_s,
         start.elapsed().as_secs_f64()
     );
     Ok(())

@@ -167,6 +167,19 @@ impl SolveContext {
         *lock(&self.load) = None;
         self.row_solves.set_unit_solves(true);
     }
+    /// Forgets the kept columns of `S`, the load solve and the row solves of directions on
+    /// more than one dof, keeping the unit solves and the recycled load solves, and keeps unit
+    /// solves from now on ([`BlockSolveStore::set_unit_solves`]): rows rebuilt on a deformed
+    /// configuration with the factorisation kept (the geometry passes of a finite-strain Newton
+    /// iteration while its tangent is kept, re-pairing between time levels). A node's rows,
+    /// whatever their new normal and tangents, combine its kept unit solves; solves of other
+    /// directions are dropped, as they would not recur.
+    pub fn clear_deformed_rows(&self) {
+        *lock(&self.columns) = None;
+        *lock(&self.load) = None;
+        self.row_solves.retain_unit_solves();
+        self.row_solves.set_unit_solves(true);
+    }
     /// Number of columns of `S` kept.
     pub fn kept_columns(&self) -> usize {
         lock(&self.columns).as_ref().map_or(0, |(_, c)| c.iter().filter(|c| c.is_some()).count())

@@ -316,6 +316,10 @@ impl<const D: usize> StaticContact<D> {
     /// [`ContactGeometry::new_deformed`] by default: re-pairing of node-to-segment pairs, normals
     /// and weights of the pose, gaps in total form), keeping the factorisation of `A`. Returns the
     /// previous geometry, e.g. to carry contact data over with [`ContactGeometry::transfer`].
+    /// The kept Schur columns are dropped (the rows changed); the unit solves of the contact
+    /// nodes' dofs on this factorisation are kept ([`SolveContext::clear_deformed_rows`]), so
+    /// a rebuild without a refactorisation in between (the geometry passes of a finite-strain
+    /// Newton iteration under modified Newton) costs no solve for the nodes already seen.
     pub fn update_geometry(
         &mut self,
         model: &Model<D>,
@@ -323,7 +327,7 @@ impl<const D: usize> StaticContact<D> {
         displacement: &[Vec<Vector<D>>],
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = self.geometry.updated(model, pairs, displacement)?;
-        self.context.clear_rows();
+        self.context.clear_deformed_rows();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 

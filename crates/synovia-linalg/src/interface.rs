@@ -138,6 +138,16 @@ impl BlockSolveStore {
     pub fn budget_bytes(&self) -> usize {
         self.budget_bytes
     }
+    /// Forgets the kept solves of row directions on more than one dof and the kept row
+    /// positions, keeping the unit solves `x_p` (single-dof directions) and their support:
+    /// for rows rebuilt with new directions on the same factor, which combine the unit solves
+    /// of their nodes while the other directions would not recur.
+    pub fn retain_unit_solves(&self) {
+        let mut store = self.lock();
+        store.solves.retain(|_, s| s.direction.len() == 1);
+        store.bytes = store.solves.values().map(StoredSolve::bytes).sum();
+        store.row_positions = None;
+    }
     /// Bytes held now.
     pub fn bytes(&self) -> usize {
         self.lock().bytes

@@ -262,10 +262,17 @@ impl Tkr3d {
         })?;
         if self.insert_law == InsertLaw::NeoHookean {
             joint.set_kinematics("insert", Kinematics::FiniteStrain)?;
-            // modified Newton: the factorised tangent (and the Schur columns of the contact rows
-            // solved on it) kept while full steps contract the residual by half, also from pose
-            // to pose (docs/tkr3d.md, "Neo-Hookean insert": 2–3 × less time than fresh tangents)
-            joint.newton_params(NewtonParams::default().with_tangent_reuse(Some(NH_TANGENT_REUSE)));
+            // modified Newton: the factorised tangent (and the unit solves of the contact nodes
+            // on it) kept while full steps contract the residual by half, also from pose to pose
+            // (docs/tkr3d.md, "Neo-Hookean insert": 2–3 × less time than fresh tangents); the
+            // geometry passes relaxed by Aitken's rule with friction (half the Newton iterations of
+            // the fixed relaxation 0.5 over the cycle; frictionless the fixed one needs fewer,
+            // docs/nonlinear.md "Friction and the geometry passes")
+            joint.newton_params(
+                NewtonParams::default()
+                    .with_tangent_reuse(Some(NH_TANGENT_REUSE))
+                    .with_geometry_aitken(self.friction > 0.0),
+            );
         }
         joint.clamp("insert", "tray")?;
         // the contact candidates: every upward-facing facet above the tray (the meshes'

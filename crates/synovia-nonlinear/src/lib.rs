@@ -1696,6 +1696,7 @@ impl<const D: usize> NonlinearContact<D> {
                             }
                             previous_lag = Some(lag);
                         }
+                        tracing::debug!(omega, passes, "geometry rebuilt, relaxed toward the iterate");
                         g.iter()
                             .zip(&disp)
                             .map(|(gb, db)| gb.iter().zip(db).map(|(x, y)| x + (y - x) * omega).collect())
@@ -2001,6 +2002,7 @@ impl<const D: usize> NonlinearContact<D> {
             if first_of_pass {
                 pass_increment = increment;
                 first_of_pass = false;
+                tracing::debug!(pass_increment, omega, passes, "first step of a geometry pass");
             }
             iterations.push(NewtonIteration {
                 residual: relative,
