@@ -28,6 +28,7 @@ use synovia::mesh::generators::{
 };
 use synovia::mesh::math::{Point, Vector};
 use synovia::mesh::{BoundaryKind, Mesh};
+use synovia::nonlinear::{ActiveSetStrategy, GeometryUpdate};
 use synovia::time::dynamic::{DynamicParams, MassKind};
 use synovia::time::history::{Constant, LoadHistory, Periodic, PiecewiseLinear, RigidMotion};
 use synovia::time::quasistatic::QuasiStaticParams;
@@ -382,6 +383,9 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
     }
     if let Some(s) = &doc.solver {
         solver(&cx, &mut joint, s)?;
+    }
+    if let Some(n) = &doc.newton {
+        newton(&cx, &mut joint, n)?;
     }
     quasi_and_dynamic_params(&cx, &mut joint, &doc.analysis)?;
     // missing data for Prescribed / Traction parts (e.g. Gmsh parts named `prescribed_*`)
@@ -1603,7 +1607,8 @@ fn obstacle<const D: usize>(
     let why = why.as_str();
     let present = present!(s; "point" => point, "normal" => normal, "center" => center, "radius" => radius,
         "axis" => axis, "cavity" => cavity, "file" => file, "scale" => scale, "solid" => solid,
-        "subdivide" => subdivide, "crease_angle_deg" => crease_angle_deg);
+        "subdivide" => subdivide, "crease_angle_deg" => crease_angle_deg, "fillet" => fillet,
+        "fillet_max_offset" => fillet_max_offset);
     let cavity = s.cavity.as_ref().is_some_and(|c| *c.get_ref());
     let any: Box<dyn Any> = match kind {
         "plane" => {
@@ -1644,7 +1649,12 @@ fn obstacle<const D: usize>(
             if D != 3 {
                 return Err(cx.err(key(k, "type"), s.kind.span(), "an `stl` surface is 3D"));
             }
-            cx.only(k, &present, &["file", "scale", "solid", "subdivide", "crease_angle_deg"], why)?;
+            cx.only(
+                k,
+                &present,
+                &["file", "scale", "solid", "subdivide", "crease_angle_deg", "fillet", "fillet_max_offset"],
+                why,
+            )?;
             let f = cx.req(&s.file, k, "file", &span, why)?;
             let fk = key(k, "file");
             let path = cx.src.resolve(f.get_ref());
@@ -1703,6 +1713,28 @@ fn obstacle<const D: usize>(
                     ),
                 )
             })?;
+            // `fillet`: the concave edges rounded (continuous normals where a node is pressed
+            // into a groove of the surface; docs/nonlinear.md "A node in a concave corner")
+            let obstacle = match (&s.fillet, &s.fillet_max_offset) {
+                (Some(r), offset) => {
+                    let radius = cx.non_negative(r, &key(k, "fillet"))?;
+                    let max_offset = match offset {
+                        Some(o) => cx.positive(o, &key(k, "fillet_max_offset"))?,
+                        None => f64::INFINITY,
+                    };
+                    obstacle
+                        .with_concave_fillet(radius, max_offset)
+                        .map_err(|e| cx.err(key(k, "fillet"), r.span(), e.to_string()))?
+                }
+                (None, Some(o)) => {
+                    return Err(cx.err(
+                        key(k, "fillet_max_offset"),
+                        o.span(),
+                        "`fillet_max_offset` needs `fillet`",
+                    ))
+                }
+                (None, None) => obstacle,
+            };
             let d: Arc<dyn synovia::contact_ops::operators::SignedDistance<3>> = Arc::new(obstacle);
             Box::new(d)
         }
@@ -1783,6 +1815,82 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
         elastic.memory_limit = Some((mb * 1024.0 * 1024.0).min(u64::MAX as f64) as u64);
     }
     joint.elastic_params(elastic);
+    Ok(())
+}
+
+/// `[newton]`: the parameters of the Newton iteration of a nonlinear model.
+fn newton<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, n: &Sp<NewtonSpec>) -> R<()> {
+    let k = "newton";
+    if !joint.is_nonlinear() {
+        return Err(cx.err(
+            k,
+            n.span(),
+            "`[newton]` sets the Newton iteration of nonlinear models, but every body is linear with small strain (a `neo_hookean` or `mooney_rivlin` material or `kinematics = \"finite\"` makes a body nonlinear)",
+        ));
+    }
+    let s = n.get_ref();
+    let fraction = |v: &Sp<f64>, name: &str, closed: bool| -> R<f64> {
+        let x = *v.get_ref();
+        if x.is_finite() && x > 0.0 && (x < 1.0 || (closed && x == 1.0)) {
+            Ok(x)
+        } else {
+            let range = if closed { "(0, 1]" } else { "(0, 1)" };
+            Err(cx.err(key(k, name), v.span(), format!("must lie in {range}, got {x}")))
+        }
+    };
+    let mut p = joint.newton_parameters();
+    if let Some(v) = &s.tolerance {
+        p = p.with_tolerance(cx.positive(v, "newton.tolerance")?);
+    }
+    if let Some(v) = &s.max_iterations {
+        p = p.with_max_iterations(cx.at_least(v, "newton.max_iterations", 1)?);
+    }
+    if let Some(v) = &s.line_search {
+        p = p.with_line_search(*v.get_ref());
+    }
+    if let Some(v) = &s.max_cutbacks {
+        p = p.with_max_cutbacks(*v.get_ref());
+    }
+    if let Some(v) = &s.tangent_reuse {
+        p = p.with_tangent_reuse(Some(fraction(v, "tangent_reuse", false)?));
+    }
+    if let Some(v) = &s.geometry {
+        p = p.with_geometry_update(cx.keyword(
+            v,
+            "newton.geometry",
+            "the geometry update",
+            &[
+                ("converged", GeometryUpdate::Converged),
+                ("per_level", GeometryUpdate::PerLevel),
+                ("reference", GeometryUpdate::Reference),
+            ],
+        )?);
+    }
+    if let Some(v) = &s.geometry_tolerance {
+        p = p.with_geometry_tolerance(cx.positive(v, "newton.geometry_tolerance")?);
+    }
+    if let Some(v) = &s.max_geometry_passes {
+        p = p.with_max_geometry_passes(cx.at_least(v, "newton.max_geometry_passes", 1)?);
+    }
+    if let Some(v) = &s.geometry_relaxation {
+        p = p.with_geometry_relaxation(fraction(v, "geometry_relaxation", true)?);
+    }
+    if let Some(v) = &s.geometry_aitken {
+        p = p.with_geometry_aitken(*v.get_ref());
+    }
+    if let Some(v) = &s.active_sets {
+        p = p.with_active_sets(cx.keyword(
+            v,
+            "newton.active_sets",
+            "the active-set strategy",
+            &[
+                ("nested", ActiveSetStrategy::Nested),
+                ("combined", ActiveSetStrategy::Combined),
+                ("outer", ActiveSetStrategy::Outer),
+            ],
+        )?);
+    }
+    joint.newton_params(p);
     Ok(())
 }
 

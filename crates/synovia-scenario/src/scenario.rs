@@ -310,6 +310,9 @@ pub struct ScenarioDoc {
     pub rigid_bodies: Vec<Sp<RigidBodySpec>>,
     /// The contact solver.
     pub solver: Option<Sp<SolverSpec>>,
+    /// The Newton iteration of nonlinear models (`[newton]`: a nonlinear material or finite
+    /// strain in some body).
+    pub newton: Option<Sp<NewtonSpec>>,
     /// The analysis.
     pub analysis: Sp<AnalysisSpec>,
     /// Output options.
@@ -595,12 +598,51 @@ pub struct ObstacleSpec {
     /// `stl` with `subdivide`: edges whose facets meet at more than this angle (degrees,
     /// default 30) stay sharp.
     pub crease_angle_deg: Option<Sp<f64>>,
+    /// `stl`: radius (model length unit) of the cylindrical fillets that round the surface's
+    /// concave edges (`SurfaceObstacle::with_concave_fillet`; default 0: none).
+    pub fillet: Option<Sp<f64>>,
+    /// `stl` with `fillet`: the largest offset of a fillet from the faceted surface (the
+    /// radius of a sharper edge is cut to it; default: no bound).
+    pub fillet_max_offset: Option<Sp<f64>>,
     pub point: Option<Sp<Vec<f64>>>,
     pub normal: Option<Sp<Vec<f64>>>,
     pub center: Option<Sp<Vec<f64>>>,
     pub radius: Option<Sp<f64>>,
     pub axis: Option<Sp<Vec<f64>>>,
     pub cavity: Option<Sp<bool>>,
+}
+
+/// `[newton]`: the Newton iteration of nonlinear models (`synovia::nonlinear::NewtonParams`;
+/// every key optional, the defaults those of `NewtonParams::default()`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NewtonSpec {
+    /// Relative equilibrium residual to reach (default 1e-10).
+    pub tolerance: Option<Sp<f64>>,
+    /// Newton iterations per level (default 30).
+    pub max_iterations: Option<Sp<usize>>,
+    /// Backtracking line search (default true).
+    pub line_search: Option<Sp<bool>>,
+    /// Halvings of a level after a failure (default 8).
+    pub max_cutbacks: Option<Sp<usize>>,
+    /// Modified Newton: keep the factorised tangent while full steps reduce the residual by
+    /// this factor, in (0, 1) (default: a fresh tangent at every iteration).
+    pub tangent_reuse: Option<Sp<f64>>,
+    /// Finite strain: when the contact geometry is rebuilt on the deformed configuration:
+    /// `converged` (default), `per_level`, `reference`.
+    pub geometry: Option<Sp<String>>,
+    /// Finite strain: change of the solution below which a rebuild counts as settled
+    /// (default 1e-8).
+    pub geometry_tolerance: Option<Sp<f64>>,
+    /// Finite strain: rebuilds per level (default 20).
+    pub max_geometry_passes: Option<Sp<usize>>,
+    /// Finite strain: relaxation ω in (0, 1] of the rebuilds (default 0.5).
+    pub geometry_relaxation: Option<Sp<f64>>,
+    /// Finite strain: Aitken's dynamic relaxation of the rebuilds (default false).
+    pub geometry_aitken: Option<Sp<bool>>,
+    /// The contact's active sets against the Newton iteration: `nested` (default),
+    /// `combined`, `outer`.
+    pub active_sets: Option<Sp<String>>,
 }
 
 /// The exponential static-to-kinetic friction law (dynamic runs).
