@@ -772,6 +772,59 @@ impl PyModel {
         };
         with_joint_mut!(self, j => { let id = body_id(j, body)?; j.set_kinematics(id, k).map_err(err)?; Ok(()) })
     }
+    /// Parameters of the Newton iteration of nonlinear models (a `neo_hookean` or
+    /// `mooney_rivlin` material, or finite strain; docs/nonlinear.md): only the given ones
+    /// change. `tangent_reuse=ρ` in (0, 1): modified Newton, the factorised tangent kept while
+    /// each full step reduces the residual by `ρ`; `fresh_tangent=True`: Newton's method, a
+    /// fresh tangent at every iteration (the default); `geometry`: `"converged"`, `"per_level"` or
+    /// `"reference"`; `geometry_aitken`: Aitken's relaxation of the geometry passes. Checked
+    /// as a whole (SynoviaError naming the parameter out of range).
+    #[pyo3(signature = (*, tolerance = None, max_iterations = None, line_search = None, max_cutbacks = None, tangent_reuse = None, fresh_tangent = false, geometry = None, geometry_tolerance = None, max_geometry_passes = None, geometry_relaxation = None, geometry_aitken = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn newton_params(
+        &mut self,
+        tolerance: Option<f64>,
+        max_iterations: Option<usize>,
+        line_search: Option<bool>,
+        max_cutbacks: Option<usize>,
+        tangent_reuse: Option<f64>,
+        fresh_tangent: bool,
+        geometry: Option<&str>,
+        geometry_tolerance: Option<f64>,
+        max_geometry_passes: Option<usize>,
+        geometry_relaxation: Option<f64>,
+        geometry_aitken: Option<bool>,
+    ) -> PyResult<()> {
+        use synovia::nonlinear::GeometryUpdate;
+        let update = match geometry {
+            None => None,
+            Some("converged") => Some(GeometryUpdate::Converged),
+            Some("per_level") => Some(GeometryUpdate::PerLevel),
+            Some("reference") => Some(GeometryUpdate::Reference),
+            Some(other) => {
+                return Err(msg(format!(
+                    "geometry is \"converged\", \"per_level\" or \"reference\", got \"{other}\""
+                )))
+            }
+        };
+        with_joint_mut!(self, j => {
+            let mut p = j.newton_parameters();
+            if let Some(v) = tolerance { p = p.with_tolerance(v); }
+            if let Some(v) = max_iterations { p = p.with_max_iterations(v); }
+            if let Some(v) = line_search { p = p.with_line_search(v); }
+            if let Some(v) = max_cutbacks { p = p.with_max_cutbacks(v); }
+            if let Some(v) = tangent_reuse { p = p.with_tangent_reuse(Some(v)); }
+            if fresh_tangent { p = p.with_tangent_reuse(None); }
+            if let Some(v) = update { p = p.with_geometry_update(v); }
+            if let Some(v) = geometry_tolerance { p = p.with_geometry_tolerance(v); }
+            if let Some(v) = max_geometry_passes { p = p.with_max_geometry_passes(v); }
+            if let Some(v) = geometry_relaxation { p = p.with_geometry_relaxation(v); }
+            if let Some(v) = geometry_aitken { p = p.with_geometry_aitken(v); }
+            p.check().map_err(err)?;
+            j.newton_params(p);
+            Ok(())
+        })
+    }
     /// Sets the density of a body (dynamic runs).
     fn set_density(&mut self, body: &Bound<'_, PyAny>, density: f64) -> PyResult<()> {
         with_joint_mut!(self, j => { let id = body_id(j, body)?; j.set_density(id, density).map_err(err)?; Ok(()) })

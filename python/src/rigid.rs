@@ -170,22 +170,29 @@ impl PyShape {
     /// faceted surface by `n` levels of Loop subdivision, edges whose facets meet at more
     /// than `crease_angle_deg` (default 30) kept sharp (a solid keeps its control surface for
     /// queries beyond a pair's search distance: `SurfaceObstacle::smoothed_solid`).
+    /// `fillet=r` rounds the concave edges by cylinders of radius `r` tangent to both faces,
+    /// each within `fillet_max_offset` of the faceted surface (default: no bound;
+    /// `SurfaceObstacle::with_concave_fillet`, docs/nonlinear.md "A node in a concave corner").
     #[staticmethod]
-    #[pyo3(signature = (surface, solid = true, subdivide = 0, crease_angle_deg = 30.0))]
+    #[pyo3(signature = (surface, solid = true, subdivide = 0, crease_angle_deg = 30.0, fillet = 0.0, fillet_max_offset = None))]
     fn surface(
         py: Python<'_>,
         surface: PyRef<'_, PySurface>,
         solid: bool,
         subdivide: usize,
         crease_angle_deg: f64,
+        fillet: f64,
+        fillet_max_offset: Option<f64>,
     ) -> PyResult<Self> {
         let smoothing = (subdivide, crease_angle_deg.to_radians());
-        surface_shape(py, TriangleSurface::clone(&surface.surface), solid, smoothing, None)
+        let fillet = (fillet, fillet_max_offset.unwrap_or(f64::INFINITY));
+        surface_shape(py, TriangleSurface::clone(&surface.surface), solid, smoothing, fillet, None)
     }
-    /// `Shape.surface(read_stl(path, scale), solid, subdivide, crease_angle_deg)`: the rigid
-    /// body bounded by the surface of an STL file.
+    /// `Shape.surface(read_stl(path, scale), solid, subdivide, crease_angle_deg, fillet,
+    /// fillet_max_offset)`: the rigid body bounded by the surface of an STL file.
     #[staticmethod]
-    #[pyo3(signature = (path, scale = None, solid = true, subdivide = 0, crease_angle_deg = 30.0))]
+    #[pyo3(signature = (path, scale = None, solid = true, subdivide = 0, crease_angle_deg = 30.0, fillet = 0.0, fillet_max_offset = None))]
+    #[allow(clippy::too_many_arguments)]
     fn stl(
         py: Python<'_>,
         path: PathBuf,
@@ -193,10 +200,13 @@ impl PyShape {
         solid: bool,
         subdivide: usize,
         crease_angle_deg: f64,
+        fillet: f64,
+        fillet_max_offset: Option<f64>,
     ) -> PyResult<Self> {
         let s = read_stl(py, path.clone(), scale)?;
         let smoothing = (subdivide, crease_angle_deg.to_radians());
-        surface_shape(py, TriangleSurface::clone(&s.surface), solid, smoothing, Some(&path))
+        let fillet = (fillet, fillet_max_offset.unwrap_or(f64::INFINITY));
+        surface_shape(py, TriangleSurface::clone(&s.surface), solid, smoothing, fillet, Some(&path))
     }
     /// The signed distance `φ(x)` of points `x` (`(n, D)` or one point) to the shape
     /// (positive on the elastic body's side), in the shape's own frame.
@@ -234,17 +244,19 @@ fn surface_shape(
     surface: TriangleSurface,
     solid: bool,
     (levels, crease_angle): (usize, f64),
+    (fillet, fillet_max_offset): (f64, f64),
     file: Option<&std::path::Path>,
 ) -> PyResult<PyShape> {
     let built = py.allow_threads(move || {
-        if solid {
+        let obstacle = if solid {
             SurfaceObstacle::smoothed_solid(surface, levels, crease_angle).map_err(|e| {
                 format!("{e} (a solid surface must be closed; solid=False accepts an open patch)")
             })
         } else {
             let smooth = surface.loop_subdivided(levels, crease_angle).map_err(|e| e.to_string())?;
             SurfaceObstacle::new(smooth).map_err(|e| e.to_string())
-        }
+        }?;
+        obstacle.with_concave_fillet(fillet, fillet_max_offset).map_err(|e| format!("fillet: {e}"))
     });
     let obstacle = built.map_err(|e| match file {
         Some(f) => msg(format!("{}: {e}", f.display())),

@@ -101,12 +101,18 @@ class Shape:
         """Cylinder (3D)."""
     @staticmethod
     def surface(
-        surface: Surface, solid: bool = True, subdivide: int = 0, crease_angle_deg: float = 30.0
+        surface: Surface,
+        solid: bool = True,
+        subdivide: int = 0,
+        crease_angle_deg: float = 30.0,
+        fillet: float = 0.0,
+        fillet_max_offset: Optional[float] = None,
     ) -> "Shape":
         """Bounded by a triangle surface (3D): solid=True needs a closed surface with outward
         normals (else SynoviaError), solid=False accepts an oriented open patch. subdivide=n
         (0-4) smooths a faceted surface by n levels of Loop subdivision, keeping edges whose
-        facets meet at more than crease_angle_deg sharp."""
+        facets meet at more than crease_angle_deg sharp. fillet=r rounds the concave edges by
+        cylinders of radius r, each within fillet_max_offset of the faceted surface."""
     @staticmethod
     def stl(
         path: PathLike,
@@ -114,8 +120,11 @@ class Shape:
         solid: bool = True,
         subdivide: int = 0,
         crease_angle_deg: float = 30.0,
+        fillet: float = 0.0,
+        fillet_max_offset: Optional[float] = None,
     ) -> "Shape":
-        """Shape.surface(read_stl(path, scale), solid, subdivide, crease_angle_deg)."""
+        """Shape.surface(read_stl(path, scale), solid, subdivide, crease_angle_deg, fillet,
+        fillet_max_offset)."""
     def distance(self, x: ArrayLike) -> FloatArray:
         """Signed distance of points (n, D) in the shape's own frame."""
 
@@ -295,6 +304,25 @@ class Model:
     def tie(self, body_a: BodyRef, part_a: str, body_b: BodyRef, part_b: str) -> None: ...
     def set_kinematics(self, body: BodyRef, kinematics: str) -> None:
         """"small" (default) or "finite" (total Lagrangian; solved by the Newton iteration)."""
+    def newton_params(
+        self,
+        *,
+        tolerance: Optional[float] = None,
+        max_iterations: Optional[int] = None,
+        line_search: Optional[bool] = None,
+        max_cutbacks: Optional[int] = None,
+        tangent_reuse: Optional[float] = None,
+        fresh_tangent: bool = False,
+        geometry: Optional[str] = None,
+        geometry_tolerance: Optional[float] = None,
+        max_geometry_passes: Optional[int] = None,
+        geometry_relaxation: Optional[float] = None,
+        geometry_aitken: Optional[bool] = None,
+    ) -> None:
+        """The Newton iteration of nonlinear models (only the given parameters change):
+        tangent_reuse=rho in (0, 1) for modified Newton, fresh_tangent=True for Newton's method,
+        geometry "converged" / "per_level" / "reference", geometry_aitken for Aitken's
+        relaxation of the geometry passes. SynoviaError for a parameter out of range."""
     def set_density(self, body: BodyRef, density: float) -> None: ...
     def initial_velocity(self, body: BodyRef, velocity: ArrayLike) -> None: ...
     def contact(

@@ -292,3 +292,36 @@ def test_neo_hookean_finite_strain_equals_linear_at_small_load_and_differs_at_la
     assert f_mr == pytest.approx(f_nh, rel=1e-7)  # c2 = 0: the neo-Hookean law with μ = 2c1
     with pytest.raises(synovia.SynoviaError, match="kinematics"):
         synovia.Model(2).set_kinematics(0, "large")
+
+
+def test_newton_params_modified_newton_solves_the_same_problem():
+    """Model.newton_params: modified Newton with Aitken's relaxation gives the neo-Hookean
+    block's force of the default Newton iteration; parameters out of range are refused."""
+
+    def floor_force(**newton):
+        nodes, cells, parts = rectangle(0.0, 2.0, 0.0, 1.0, 8, 4)
+        m = synovia.Model(2)
+        m.add_body("block", nodes, cells, synovia.Material.neo_hookean(E, NU), parts=parts)
+        m.set_kinematics("block", "finite")
+        if newton:
+            m.newton_params(**newton)
+        m.symmetry("block", "left")
+        m.prescribe("block", "top", [0.0, -0.2], components=[1])
+        m.contact_plane("floor", "block", "bottom", point=[0.0, 0.0], normal=[0.0, 1.0])
+        r = m.run_static()
+        assert r.kkt["max"] < 1e-8
+        return r.pairs()["floor"]["normal_force"]
+
+    default = floor_force()
+    modified = floor_force(tangent_reuse=0.5, geometry_aitken=True, tolerance=1e-11, max_iterations=60)
+    assert modified == pytest.approx(default, rel=1e-7)
+    m = synovia.Model(2)
+    for bad in (
+        dict(tangent_reuse=1.0),
+        dict(geometry_relaxation=0.0),
+        dict(tolerance=2.0),
+        dict(max_iterations=0),
+        dict(geometry="always"),
+    ):
+        with pytest.raises(synovia.SynoviaError):
+            m.newton_params(**bad)

@@ -240,6 +240,37 @@ def test_smoothed_stl_rigid_body_equals_scenario(ball_files):
         synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0, subdivide=5)
 
 
+def test_stl_fillet_rounds_a_concave_edge(tmp_path):
+    """Shape.stl(..., fillet=r): the concave crease of an open groove (faces z = 1 - 0.1 x and
+    z = 1 + 0.25 x, free space below) rounded by a circle of radius r tangent to both faces.
+    Below the crease the faceted distance is that of the steeper face, the filleted one
+    r - |p - c| with c the circle's centre (both analytic); away from the crease both equal the
+    face's distance; a negative radius raises SynoviaError."""
+    f = lambda x: 1.0 - 0.1 * x if x >= 0.0 else 1.0 + 0.25 * x  # noqa: E731
+    verts = np.array([[x, y, f(x)] for y in (-2.0, 2.0) for x in (-2.0, 0.0, 2.0)])
+    # vertices 0-2 at y = -2, 3-5 at y = 2; triangles oriented with their normals down
+    tris = np.array([[0, 4, 1], [0, 3, 4], [1, 5, 2], [1, 4, 5]])
+    write_stl(tmp_path / "groove.stl", verts, tris)
+    r = 0.05
+    faceted = synovia.Shape.stl(tmp_path / "groove.stl", solid=False)
+    rounded = synovia.Shape.stl(tmp_path / "groove.stl", solid=False, fillet=r, fillet_max_offset=0.01)
+    below = np.array([0.0, 0.0, 0.99])
+    sa, sb = np.sqrt(1.0 + 0.1**2), np.sqrt(1.0 + 0.25**2)
+    # the centre: r below both faces, (c_z + 0.1 c_x - 1) / sa = -r = (c_z - 0.25 c_x - 1) / sb
+    cx = r * (sb - sa) / 0.35
+    cz = 1.0 - r * sa - 0.1 * cx
+    # (STL stores single-precision coordinates: face x >= 0 ends at z = 0.8 in f32, 1.2e-8 off,
+    # hence 1e-7 where that face enters; face x < 0 has exact f32 vertices)
+    assert faceted.distance(below)[0] == pytest.approx(0.01 / sb, rel=1e-12)
+    assert rounded.distance(below)[0] == pytest.approx(r - np.hypot(cx, 0.99 - cz), rel=1e-7)
+    assert rounded.distance(below)[0] < faceted.distance(below)[0] - 4e-4
+    away = np.array([1.0, 0.3, 0.8])
+    assert rounded.distance(away)[0] == pytest.approx((f(1.0) - 0.8) / sa, rel=1e-7)
+    assert faceted.distance(away)[0] == rounded.distance(away)[0]
+    with pytest.raises(synovia.SynoviaError, match="fillet"):
+        synovia.Shape.stl(tmp_path / "groove.stl", solid=False, fillet=-0.1)
+
+
 def test_fixed_stl_obstacle_equals_sphere_and_open_patch(ball_files):
     """A fixed STL ball and an analytic ball of the same radius give close contact forces; an
     open patch needs solid=False."""

@@ -301,7 +301,24 @@ impl NewtonParams {
         self
     }
 
-    fn check(&self) -> Result<(), NonlinearError> {
+    /// Checks the parameters: tolerances in (0, 1), at least one iteration, the relaxation in
+    /// (0, 1], the contraction bound of tangent reuse in (0, 1), a positive geometry tolerance.
+    ///
+    /// # Errors
+    /// [`NonlinearError::InvalidParameter`] naming the first parameter out of its range.
+    pub fn check(&self) -> Result<(), NonlinearError> {
+        if !(self.geometry_relaxation > 0.0 && self.geometry_relaxation <= 1.0) {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "the relaxation of the geometry rebuilds must lie in (0, 1], got {}",
+                self.geometry_relaxation
+            )));
+        }
+        if !(self.geometry_tolerance > 0.0 && self.geometry_tolerance.is_finite()) {
+            return Err(NonlinearError::InvalidParameter(format!(
+                "the geometry tolerance must be positive and finite, got {}",
+                self.geometry_tolerance
+            )));
+        }
         if let Some(p) = self.geometry_pass_tolerance {
             if !(p > 0.0 && p < 1.0) {
                 return Err(NonlinearError::InvalidParameter(format!(

@@ -1890,6 +1890,7 @@ fn newton<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, n: &Sp<NewtonS
             ],
         )?);
     }
+    p.check().map_err(|e| cx.err(k, n.span(), e.to_string()))?;
     joint.newton_params(p);
     Ok(())
 }
