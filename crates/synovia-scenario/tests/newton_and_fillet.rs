@@ -120,21 +120,6 @@ fn groove() -> TriangleSurface {
     }
 }
 
-fn write_ascii_stl(path: &Path, surface: &TriangleSurface) {
-    let mut text = String::from("solid groove\n");
-    for (t, tri) in surface.triangles().iter().enumerate() {
-        let n = surface.normal(t);
-        text += &format!("facet normal {} {} {}\nouter loop\n", n[0], n[1], n[2]);
-        for &i in tri {
-            let p = surface.vertices()[i];
-            text += &format!("vertex {} {} {}\n", p[0], p[1], p[2]);
-        }
-        text += "endloop\nendfacet\n";
-    }
-    text += "endsolid groove\n";
-    std::fs::write(path, text).unwrap();
-}
-
 /// A linear block under the groove, its top 0.01 below the crease (a row of nodes under the
 /// crease line, within the fillet's reach), its bottom pushed up by 0.3 (static, small strain:
 /// a test of the shape, not of the material), with the groove as given.
@@ -169,7 +154,7 @@ fn stl_fillet_rounds_the_concave_edge_as_the_rust_api() {
     let dir = std::env::temp_dir().join(format!("synovia_fillet_{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let stl = dir.join("groove.stl");
-    write_ascii_stl(&stl, &groove());
+    synovia::io::write_stl(&stl, &groove()).unwrap();
     let path = dir.join("groove.toml");
     let run = |keys: &str| -> RunResult<3> {
         let text = groove_scenario("groove.stl", keys);
