@@ -798,14 +798,14 @@ impl PyModel {
         use synovia::nonlinear::GeometryUpdate;
         let update = match geometry {
             None => None,
-            Some("converged") => Some(GeometryUpdate::Converged),
-            Some("per_level") => Some(GeometryUpdate::PerLevel),
-            Some("reference") => Some(GeometryUpdate::Reference),
-            Some(other) => {
-                return Err(msg(format!(
-                    "geometry is \"converged\", \"per_level\" or \"reference\", got \"{other}\""
-                )))
-            }
+            Some(name) => match GeometryUpdate::NAMES.iter().find(|(n, _)| *n == name) {
+                Some(&(_, g)) => Some(g),
+                None => {
+                    let names: Vec<String> =
+                        GeometryUpdate::NAMES.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+                    return Err(msg(format!("geometry is one of {}, got \"{name}\"", names.join(", "))));
+                }
+            },
         };
         with_joint_mut!(self, j => {
             let mut p = j.newton_parameters();

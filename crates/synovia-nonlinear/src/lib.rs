@@ -207,6 +207,15 @@ pub enum GeometryUpdate {
     Reference,
 }
 
+impl GeometryUpdate {
+    /// The names of the variants in scenario files and the Python package.
+    pub const NAMES: [(&'static str, GeometryUpdate); 3] = [
+        ("converged", GeometryUpdate::Converged),
+        ("per_level", GeometryUpdate::PerLevel),
+        ("reference", GeometryUpdate::Reference),
+    ];
+}
+
 impl Default for NewtonParams {
     fn default() -> Self {
         Self {

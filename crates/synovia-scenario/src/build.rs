@@ -1859,11 +1859,7 @@ fn newton<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, n: &Sp<NewtonS
             v,
             "newton.geometry",
             "the geometry update",
-            &[
-                ("converged", GeometryUpdate::Converged),
-                ("per_level", GeometryUpdate::PerLevel),
-                ("reference", GeometryUpdate::Reference),
-            ],
+            &GeometryUpdate::NAMES,
         )?);
     }
     if let Some(v) = &s.geometry_tolerance {
