@@ -122,6 +122,11 @@ impl ContactSolver for PdasFallback {
         context: &SolveContext,
     ) -> Result<ContactSolution, ContactError> {
         let trace = self.pdas.solve_traced(problem, context, true);
+        // the fallback does not take a rigid border: PDAS's own result (the caller's
+        // force-control iteration falls back to trial solves)
+        if problem.border.is_some() {
+            return trace.result;
+        }
         let failure = match trace.result {
             Ok(sol) => return Ok(sol),
             Err(e @ (ContactError::NoConvergence { .. } | ContactError::Singular { .. })) => e,
@@ -138,5 +143,9 @@ impl ContactSolver for PdasFallback {
         sol.report.fallback =
             Some(format!("pdas failed ({why}); dual-mprgp warm-started from its last iterate"));
         Ok(sol)
+    }
+
+    fn solves_border(&self) -> bool {
+        true
     }
 }

@@ -49,8 +49,8 @@ pub use friction::{
     project_on_disc, slip_speeds, ConstantFriction, ExponentialFriction, FrictionLaw, PairFrictionLaws,
 };
 pub use kkt::{check_kkt, KktReport};
-pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints};
+pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints, RigidBorder};
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};
-pub use static_contact::{StaticContact, StaticContactResult};
+pub use static_contact::{CoordinateBorder, StaticContact, StaticContactResult};
 pub use surface_obstacle::{SurfaceObstacle, SurfacePoint};
 pub use synovia_linalg::SparseRows;

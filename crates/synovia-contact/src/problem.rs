@@ -52,6 +52,28 @@ impl FrictionConstraints {
     }
 }
 
+/// A rigid partner's force-controlled coordinate `z` solved together with the contact
+/// conditions (docs/model.md §10, "the coordinate in the contact solve"): the offsets of the
+/// interface rows move with it to first order,
+///
+/// ```text
+/// g(ζ) = g + σ ζ,        ζ = z − z₀ (z₀: the coordinate the rows were built at),
+/// ```
+///
+/// and its equilibrium closes the system, `σᵀ ν = target` (`σ_r = ∂g_r/∂z`; with the
+/// generalised contact force `Q = σᵀ ν` on the partner, `target = −F` for the applied force
+/// `F`). It is the stationarity in `z` of the Lagrangian of the contact problem with the work
+/// `F z` of the applied force added. A solver that takes it ([`crate::ContactSolver::solves_border`])
+/// returns `ζ` in [`crate::SolverReport::border_value`]; the solution is that of the problem
+/// with the offsets `g(ζ)`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidBorder {
+    /// `σ`, one entry per interface row (the normal rows, then the tangential ones).
+    pub sensitivity: Vec<f64>,
+    /// The equilibrium's right-hand side `σᵀ ν = target`.
+    pub target: f64,
+}
+
 /// One contact problem of docs/model.md §5: the operator `A` (factorised), the load `F`, and
 /// the contact rows with their gaps and bounds — the mathematics only. What a sequence of
 /// solves reuses (warm start, kept columns of `S`, recycled load solves) lives in the
@@ -67,6 +89,9 @@ pub struct ContactProblem<'a> {
     pub normal: &'a NormalConstraints,
     /// Friction constraints (`None`: frictionless).
     pub friction: Option<&'a FrictionConstraints>,
+    /// A rigid partner's force-controlled coordinate solved with the contact conditions
+    /// (`None`: every offset given).
+    pub border: Option<&'a RigidBorder>,
 }
 
 impl<'a> ContactProblem<'a> {
@@ -134,7 +159,49 @@ impl<'a> ContactProblem<'a> {
                 ));
             }
         }
+        if let Some(b) = self.border {
+            if b.sensitivity.len() != self.n_rows() {
+                return bad(format!(
+                    "the rigid border has {} sensitivities for {} interface rows",
+                    b.sensitivity.len(),
+                    self.n_rows()
+                ));
+            }
+            if !b.target.is_finite() || b.sensitivity.iter().any(|s| !s.is_finite()) {
+                return bad("the rigid border's sensitivities or target are not finite".into());
+            }
+        }
         Ok(())
+    }
+
+    /// [`ContactError::InvalidParameter`] if the problem has a [`RigidBorder`]: for the
+    /// solvers that do not take one (a border left out would solve another problem).
+    pub fn refuse_border(&self, solver: &str) -> Result<(), ContactError> {
+        match self.border {
+            Some(_) => Err(ContactError::InvalidParameter(format!(
+                "solver `{solver}` does not solve a rigid partner's force-controlled coordinate with the contact conditions (a RigidBorder); use `pdas` or `pdas-fallback`"
+            ))),
+            None => Ok(()),
+        }
+    }
+
+    /// The offsets `g(ζ) = g + σ ζ` of a bordered problem at `ζ` (docs/model.md §10), as
+    /// constraints to check a solution against; `None` without a border.
+    pub fn shifted_constraints(&self, zeta: f64) -> Option<(NormalConstraints, Option<FrictionConstraints>)> {
+        let b = self.border?;
+        let m = self.n_normal();
+        let mut normal = self.normal.clone();
+        for (d, s) in normal.gap.iter_mut().zip(&b.sensitivity[..m]) {
+            *d += s * zeta;
+        }
+        let friction = self.friction.map(|f| {
+            let mut f = f.clone();
+            for (v, s) in f.shift.iter_mut().zip(&b.sensitivity[m..]) {
+                *v += s * zeta;
+            }
+            f
+        });
+        Some((normal, friction))
     }
 
     /// Number of normal rows `m_n`.

@@ -72,6 +72,9 @@ pub struct SolverReport {
     /// The fallback that produced this solution, if any (e.g. the `pdas-fallback` solver of
     /// the `synovia` facade hands a cycling PDAS iteration over to `dual-mprgp`).
     pub fallback: Option<String>,
+    /// The rigid partner's coordinate increment `ζ` of a problem with a
+    /// [`crate::RigidBorder`] (`None` without one).
+    pub border_value: Option<f64>,
 }
 
 /// A solution of the contact problem of docs/model.md §5.
@@ -114,5 +117,12 @@ pub trait ContactSolver {
     /// `Pdas` returns its `PdasStep`.
     fn active_set_step(&self) -> Option<Box<dyn ContactSolver>> {
         None
+    }
+
+    /// Whether the solver takes a problem with a [`crate::RigidBorder`] (a rigid partner's
+    /// force-controlled coordinate solved with the contact conditions). `false` (the
+    /// default): such a problem is refused with [`ContactError::InvalidParameter`].
+    fn solves_border(&self) -> bool {
+        false
     }
 }

@@ -14,7 +14,7 @@ use crate::context::SolveContext;
 use crate::error::ContactError;
 use crate::kkt::{check_kkt, inf_norm, KktReport};
 use crate::operators::{BodyPlacement, ContactGeometry, ContactPair, GeometryCache};
-use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints};
+use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints, RigidBorder};
 use crate::solver::{ContactSolution, ContactSolver, SolverReport};
 use synovia_linalg::SparseRows;
 
@@ -43,6 +43,27 @@ pub struct StaticContact<const D: usize> {
     caller_matrix: bool,
     /// The pose-independent geometry data kept by [`StaticContact::rebuild_geometry`].
     geometry_cache: GeometryCache<D>,
+    /// A rigid partner's force-controlled coordinate solved with the contact conditions
+    /// ([`StaticContact::set_coordinate_border`]); dropped when the geometry changes.
+    border: Option<CoordinateBorder<D>>,
+}
+
+/// A rigid partner's force-controlled coordinate `z` solved together with the contact
+/// conditions (docs/model.md §10, "the coordinate in the contact solve";
+/// [`crate::RigidBorder`]): per contact node `r` of the geometry the rate `∂d_r/∂z` of its
+/// gap and the rate `∂w_r/∂z` of the partner's motion there (the slip origin of friction), and
+/// the equilibrium `Q(ν) = Σ_r (∂d_r/∂z) κ_r Λ_n,r + Σ_c (∂s_c/∂z) Λ_t,c = target`
+/// (`target = −F` for the force `F` applied along `z`). The gaps and shifts are taken at
+/// `z₀` (the coordinate they were built or set at); the solve returns `ζ = z − z₀` in
+/// [`crate::SolverReport::border_value`], and its solution is that of the gaps `d + (∂d/∂z) ζ`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoordinateBorder<const D: usize> {
+    /// `∂d_r/∂z` per contact node.
+    pub gap_rate: Vec<Real>,
+    /// `∂w_r/∂z` per contact node (zero where the partner is not the moving body).
+    pub motion_rate: Vec<Vector<D>>,
+    /// The right-hand side of the equilibrium.
+    pub target: Real,
 }
 
 /// The result of one static contact solve.
@@ -103,6 +124,7 @@ impl<const D: usize> StaticContact<D> {
             context: SolveContext::new(),
             caller_matrix: false,
             geometry_cache: GeometryCache::default(),
+            border: None,
         })
     }
 
@@ -186,6 +208,7 @@ impl<const D: usize> StaticContact<D> {
             context: SolveContext::new(),
             caller_matrix: true,
             geometry_cache: GeometryCache::default(),
+            border: None,
         })
     }
 
@@ -328,6 +351,7 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = self.geometry.updated(model, pairs, displacement)?;
         self.context.clear_deformed_rows();
+        self.border = None;
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -352,6 +376,7 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new_placed(model, pairs, placements)?;
         self.context.clear_rows();
+        self.border = None;
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -374,6 +399,7 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new_cached(model, pairs, &mut self.geometry_cache)?;
         self.context.clear_moved_rows();
+        self.border = None;
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -405,6 +431,38 @@ impl<const D: usize> StaticContact<D> {
     /// As [`ContactGeometry::set_partner_motion`].
     pub fn set_partner_motion(&mut self, motion: Vec<Vector<D>>) -> Result<(), ContactError> {
         self.geometry.set_partner_motion(motion)
+    }
+
+    /// Solves the next contact problems with a rigid partner's force-controlled coordinate as
+    /// an unknown ([`CoordinateBorder`]; `None`: the gaps as given). Kept until the geometry
+    /// changes (a rebuild, update or placement drops it). Only solvers that take a border
+    /// ([`ContactSolver::solves_border`]) solve such a problem; a semi-coercive model refuses
+    /// it.
+    ///
+    /// # Errors
+    /// [`ContactError::InvalidParameter`] for rates that do not fit the contact nodes or are
+    /// not finite.
+    pub fn set_coordinate_border(&mut self, border: Option<CoordinateBorder<D>>) -> Result<(), ContactError> {
+        if let Some(b) = &border {
+            let n = self.geometry.nodes.len();
+            if b.gap_rate.len() != n || b.motion_rate.len() != n {
+                return Err(ContactError::InvalidParameter(format!(
+                    "a coordinate border needs one gap rate and one motion rate per contact node ({n}), got {} and {}",
+                    b.gap_rate.len(),
+                    b.motion_rate.len()
+                )));
+            }
+            let finite = b.gap_rate.iter().all(|v| v.is_finite())
+                && b.motion_rate.iter().all(|v| v.iter().all(|x| x.is_finite()))
+                && b.target.is_finite();
+            if !finite {
+                return Err(ContactError::InvalidParameter(
+                    "a coordinate border's rates and target must be finite".into(),
+                ));
+            }
+        }
+        self.border = border;
+        Ok(())
     }
 
     /// Nested iteration for cold starts ([`crate::nested`]): coarsen the contact rows
@@ -559,7 +617,7 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         solution: ContactSolution,
     ) -> Result<StaticContactResult<D>, ContactError> {
-        let Assembled { load, lifts, normal, friction_op } = self.assemble(source, slip_bound, previous)?;
+        let Assembled { load, lifts, normal, friction_op, border } = self.assemble(source, slip_bound, previous)?;
         let friction = active_friction(friction_op.as_ref());
         let n_tangential = friction.map_or(0, |f| f.rows.nrows());
         if solution.lambda_n.len() != normal.rows.nrows() || solution.lambda_t.len() != n_tangential {
@@ -576,7 +634,8 @@ impl<const D: usize> StaticContact<D> {
         // loads on a caller's matrix) or from the recycled load solves
         let mut context = self.context.with_start(None, false);
         context.set_load_solution(self.recycled_load_solution(&operator, &load)?);
-        let problem = ContactProblem { operator: &operator, load: &load, normal: &normal, friction };
+        let problem =
+            ContactProblem { operator: &operator, load: &load, normal: &normal, friction, border: border.as_ref() };
         let mut solution = solution;
         if solution.u.is_empty() {
             let mut nu: Vec<f64> =
@@ -584,7 +643,7 @@ impl<const D: usize> StaticContact<D> {
             nu.extend_from_slice(&solution.lambda_t);
             solution.u = crate::problem::Interface::new(problem, &context)?.displacement(&nu)?;
         }
-        let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
+        let kkt = check_kkt_at_border(&problem, &solution);
         self.finish(solution, kkt, &lifts, friction_op, 0, 0)
     }
 
@@ -599,7 +658,7 @@ impl<const D: usize> StaticContact<D> {
         warm_start: Option<&ContactSolution>,
         multipliers_only: bool,
     ) -> Result<Solved<D>, ContactError> {
-        let Assembled { load, lifts, normal, friction_op } = self.assemble(source, slip_bound, previous)?;
+        let Assembled { load, lifts, normal, friction_op, border } = self.assemble(source, slip_bound, previous)?;
         let friction = active_friction(friction_op.as_ref());
         let stabilisation = self.elastic.stabilisation();
         if let Some(st) = stabilisation {
@@ -624,21 +683,32 @@ impl<const D: usize> StaticContact<D> {
         let context = context;
         macro_rules! problem_with {
             ($rhs:expr) => {
-                ContactProblem { operator: &operator, load: $rhs, normal: &normal, friction }
+                ContactProblem { operator: &operator, load: $rhs, normal: &normal, friction, border: border.as_ref() }
             };
         }
         let cell_node = friction_op.as_ref().map_or(&[][..], |f| &f.cell_node[..]);
         let mut coarse_iterations = 0;
         let mut warm = warm_start.cloned();
+        if border.is_some() && !solver.solves_border() {
+            return Err(ContactError::InvalidParameter(format!(
+                "solver `{}` does not solve a rigid partner's force-controlled coordinate with the contact conditions; use `pdas` or `pdas-fallback`",
+                solver.name()
+            )));
+        }
         let Some(st) = stabilisation else {
             let problem = problem_with!(&load);
             let (solution, it) = self.run(&problem, solver, &context, warm.as_ref(), cell_node)?;
             if multipliers_only {
                 return Ok(Solved::Multipliers(Box::new(solution), it));
             }
-            let kkt = check_kkt(&problem, &solution.u, &solution.lambda_n, &solution.lambda_t);
+            let kkt = check_kkt_at_border(&problem, &solution);
             return self.finish(solution, kkt, &lifts, friction_op, it, 0).map(Solved::full);
         };
+        if border.is_some() {
+            return Err(ContactError::InvalidParameter(
+                "a rigid partner's force-controlled coordinate is not solved with the contact conditions of a body held only by contact (semi-coercive model)".into(),
+            ));
+        }
         // Proximal-point iteration (crate::floating): A + S with load F + S U_k.
         let mut u_k = match &warm {
             Some(w) if w.u.len() == load.len() => w.u.clone(),
@@ -713,7 +783,21 @@ impl<const D: usize> StaticContact<D> {
             Some(g) => Some(self.geometry.friction_constraints(dofs, &lifts, g, previous)?),
             None => None,
         };
-        Ok(Assembled { load, lifts, normal, friction_op })
+        let border = self.border.as_ref().map(|b| {
+            // σ: the gap rates of the normal rows, then `g_c κ_r t · ∂w_r/∂z` of each friction
+            // row (its shift is `g_c κ_r t · ([u_{i−1}] + w_r) − lift`)
+            let mut sensitivity = b.gap_rate.clone();
+            if let Some(f) = active_friction(friction_op.as_ref()).and(friction_op.as_ref()) {
+                for (&r, &g) in f.cell_node.iter().zip(&f.slip_bound) {
+                    let node = &self.geometry.nodes[r];
+                    for t in node.tangents.iter().take(D - 1) {
+                        sensitivity.push(g * node.weight * t.dot(&b.motion_rate[r]));
+                    }
+                }
+            }
+            RigidBorder { sensitivity, target: b.target }
+        });
+        Ok(Assembled { load, lifts, normal, friction_op, border })
     }
 
     /// The factorised operator `A` (or `A + S` of a semi-coercive model).
@@ -758,8 +842,9 @@ impl<const D: usize> StaticContact<D> {
         warm: Option<&ContactSolution>,
         cell_node: &[usize],
     ) -> Result<(ContactSolution, usize), ContactError> {
+        // (a bordered problem is solved whole: its coarse levels would need the border too)
         let nested = |p: &ContactProblem<'_>, adjacency: &[Vec<usize>]| match (warm, self.nested_min_rows) {
-            (None, Some(min_rows)) => {
+            (None, Some(min_rows)) if p.border.is_none() => {
                 crate::nested::nested_warm_start(p, solver, context, adjacency, min_rows)
             }
             _ => Ok(None),
@@ -803,8 +888,16 @@ impl<const D: usize> StaticContact<D> {
         loop {
             let rows: Vec<usize> = (0..m).filter(|&r| candidate[r]).collect();
             let normal = restrict_rows(problem.normal, &rows);
+            let border = problem.border.map(|b| crate::problem::RigidBorder {
+                sensitivity: rows
+                    .iter()
+                    .map(|&r| b.sensitivity[r])
+                    .chain(b.sensitivity[m..].iter().copied())
+                    .collect(),
+                target: b.target,
+            });
             // the screening check below needs U, whatever the caller asked for
-            let sub = ContactProblem { normal: &normal, ..*problem };
+            let sub = ContactProblem { normal: &normal, border: border.as_ref(), ..*problem };
             let start = match &current {
                 Some(w) if w.lambda_n.len() == m => Some(ContactSolution {
                     u: w.u.clone(),
@@ -831,11 +924,13 @@ impl<const D: usize> StaticContact<D> {
             let full =
                 ContactSolution { u: solution.u, lambda_n, lambda_t: solution.lambda_t, report: merged };
             let scale = inf_norm(&full.u).max(inf_norm(&problem.normal.gap)).max(f64::MIN_POSITIVE);
+            // the gaps at the coordinate the bordered solve found
+            let zeta = full.report.border_value.unwrap_or(0.0);
+            let gap = |r: usize| problem.normal.gap[r] + problem.border.map_or(0.0, |b| b.sensitivity[r] * zeta);
             let penetrating: Vec<usize> = (0..m)
                 .filter(|&r| {
                     !candidate[r]
-                        && problem.normal.rows.row_dot(r, &full.u) - problem.normal.gap[r]
-                            > SCREENING_TOLERANCE * scale
+                        && problem.normal.rows.row_dot(r, &full.u) - gap(r) > SCREENING_TOLERANCE * scale
                 })
                 .collect();
             if penetrating.is_empty() {
@@ -902,6 +997,8 @@ struct Assembled<const D: usize> {
     lifts: Vec<Vector<D>>,
     normal: NormalConstraints,
     friction_op: Option<crate::operators::FrictionOperator>,
+    /// The coordinate border on these rows ([`StaticContact::set_coordinate_border`]).
+    border: Option<RigidBorder>,
 }
 
 /// The friction constraints of `op`, if it has any cell.
@@ -1017,6 +1114,19 @@ fn restrict_adjacency(adjacency: &[Vec<usize>], rows: &[usize], m: usize) -> Vec
             })
         })
         .collect()
+}
+
+/// [`check_kkt`] of a solution; for a bordered problem at the offsets of the coordinate the
+/// solve found, `g + σ ζ` ([`ContactProblem::shifted_constraints`]).
+fn check_kkt_at_border(problem: &ContactProblem<'_>, solution: &ContactSolution) -> KktReport {
+    let shifted = solution.report.border_value.and_then(|zeta| problem.shifted_constraints(zeta));
+    match &shifted {
+        Some((normal, friction)) => {
+            let p = ContactProblem { normal, friction: friction.as_ref(), border: None, ..*problem };
+            check_kkt(&p, &solution.u, &solution.lambda_n, &solution.lambda_t)
+        }
+        None => check_kkt(problem, &solution.u, &solution.lambda_n, &solution.lambda_t),
+    }
 }
 
 /// The report of a screened solve: counts and times of all passes, states of the last one.

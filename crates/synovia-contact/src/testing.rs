@@ -39,6 +39,7 @@ impl OwnedProblem {
             load: &self.load,
             normal: &self.normal,
             friction: self.friction.as_ref(),
+            border: None,
         }
     }
 }

@@ -164,6 +164,7 @@ fn kkt(model: &Model<3>, problem: &ModelProblem<3>, s: &TfetiSolution) -> Res<Kk
         load: &problem.load,
         normal: &problem.normal,
         friction: problem.friction.as_ref(),
+        border: None,
     };
     Ok(check_kkt(&cp, &s.u, &s.lambda_n, &s.lambda_t))
 }

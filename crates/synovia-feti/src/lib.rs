@@ -107,6 +107,7 @@ impl Tfeti {
             });
         }
         problem.validate()?;
+        problem.refuse_border("tfeti")?;
         solve(
             &self.decomposition,
             &SingleProcess,

@@ -71,6 +71,7 @@ impl ContactSolver for AuPdas {
     ) -> Result<ContactSolution, ContactError> {
         let start = Instant::now();
         let name = self.name();
+        problem.refuse_border(name)?;
         let mut st = State::new(problem, context, &self.params)?;
         // a convergent step length for the projected-gradient update of the slipping cells
         st.bound_tangential_rho()?;

@@ -338,6 +338,10 @@ impl ContactSolver for PdasStep {
     fn active_set_step(&self) -> Option<Box<dyn ContactSolver>> {
         Some(Box::new(*self))
     }
+
+    fn solves_border(&self) -> bool {
+        true
+    }
 }
 
 impl PdasTrace {
@@ -371,5 +375,9 @@ impl ContactSolver for Pdas {
 
     fn active_set_step(&self) -> Option<Box<dyn ContactSolver>> {
         Some(Box::new(PdasStep::new(self.params)))
+    }
+
+    fn solves_border(&self) -> bool {
+        true
     }
 }

@@ -109,6 +109,19 @@ pub(crate) struct State<'p> {
     pub rho_scale: f64,
     /// Whether `ρ` of the normal rows has been scaled to the interface (see `update_rho`).
     pub rho_initialised: bool,
+    /// A rigid partner's coordinate solved with the contact conditions
+    /// ([`synovia_contact::RigidBorder`]): `g = g₀ + σ ζ` with `ζ` from the last step.
+    pub border: Option<Border>,
+}
+
+/// The bordered unknown of a [`State`]: `σ`, the target of `σᵀ ν = target`, the offsets
+/// `g₀` at `ζ = 0` and the current `ζ`.
+#[derive(Debug, Clone)]
+pub(crate) struct Border {
+    pub sensitivity: Vec<f64>,
+    pub target: f64,
+    pub g0: Vec<f64>,
+    pub zeta: f64,
 }
 
 /// `ζ / max(1, ‖ζ‖)`: the projection `π` onto `[−1, 1]` (2D) or the unit disc (3D).
@@ -205,11 +218,17 @@ impl<'p> State<'p> {
             comps,
             n_cells,
             rho,
-            g,
             normal_empty,
             pinned,
             rho_scale: params.rho_scale,
             rho_initialised: false,
+            border: problem.border.map(|b| Border {
+                sensitivity: b.sensitivity.clone(),
+                target: b.target,
+                g0: g.clone(),
+                zeta: 0.0,
+            }),
+            g,
         })
     }
 
@@ -431,7 +450,20 @@ impl<'p> State<'p> {
                 norm2(e)
             })
             .fold(0.0, f64::max);
-        (rn, rt)
+        (rn.max(self.border_residual(nu)), rt)
+    }
+
+    /// `|σᵀ ν − target| / max(|target|, Σ |σ_r ν_r|)`: the relative residual of the bordered
+    /// coordinate's equilibrium (0 without a border).
+    pub fn border_residual(&self, nu: &[f64]) -> f64 {
+        let Some(b) = &self.border else { return 0.0 };
+        let q: f64 = b.sensitivity.iter().zip(nu).map(|(s, v)| s * v).sum();
+        let scale: f64 = b.sensitivity.iter().zip(nu).map(|(s, v)| (s * v).abs()).sum::<f64>().max(b.target.abs());
+        if scale > 0.0 {
+            (q - b.target).abs() / scale
+        } else {
+            0.0
+        }
     }
 
     /// `y = w − S ν`.
@@ -491,12 +523,19 @@ impl<'p> State<'p> {
             }
         }
         self.iface.ensure_columns(&need)?;
+        let singular = || ContactError::Singular { solver: solver.to_string(), iteration, size: n };
         if n == 0 {
+            if self.border.is_some() {
+                // nothing in contact holds the rigid partner's coordinate
+                return Err(singular());
+            }
             return Ok(nu);
         }
         let s_fixed = self.iface.apply_s(&nu)?;
         let w = self.iface.w();
-        let rhs_full: Vec<f64> = (0..nu.len()).map(|i| w[i] - self.g[i] - s_fixed[i]).collect();
+        // the offsets at ζ = 0 for a bordered step (ζ is one of its unknowns)
+        let g = self.border.as_ref().map_or(&self.g, |b| &b.g0);
+        let rhs_full: Vec<f64> = (0..nu.len()).map(|i| w[i] - g[i] - s_fixed[i]).collect();
         // sparse representation of the q_a
         let q: Vec<([usize; 2], [f64; 2], usize, f64)> = unknowns
             .iter()
@@ -536,7 +575,6 @@ impl<'p> State<'p> {
             (0..*l).map(|i| t[i] * rhs_full[r[i]]).sum::<f64>()
         });
         let diag: Vec<f64> = (0..n).map(|a| k_mat[(a, a)]).collect();
-        let singular = || ContactError::Singular { solver: solver.to_string(), iteration, size: n };
         if diag.iter().any(|d| !(d.is_finite() && *d > 0.0)) {
             return Err(singular());
         }
@@ -546,7 +584,32 @@ impl<'p> State<'p> {
         if (0..n).any(|a| l[(a, a)] * l[(a, a)] <= PIVOT_TOL * diag[a]) {
             return Err(singular());
         }
-        let x = chol.solve(&rhs);
+        let mut x = chol.solve(&rhs);
+        if let Some(border) = &mut self.border {
+            // the bordered system [K b; bᵀ 0] [x; ζ] = [rhs; c], b = Qᵀσ, c = target − σᵀν_fixed:
+            // x = K⁻¹ rhs − ζ K⁻¹ b, ζ = (bᵀ K⁻¹ rhs − c) / (bᵀ K⁻¹ b)
+            let sigma = &border.sensitivity;
+            let b = faer::Mat::<f64>::from_fn(n, 1, |a, _| {
+                let (r, t, l, _) = &q[a];
+                (0..*l).map(|i| t[i] * sigma[r[i]]).sum::<f64>()
+            });
+            let c = border.target - sigma.iter().zip(&nu).map(|(s, v)| s * v).sum::<f64>();
+            let kb = chol.solve(&b);
+            let bkb: f64 = (0..n).map(|a| b[(a, 0)] * kb[(a, 0)]).sum();
+            let bb: f64 = (0..n).map(|a| b[(a, 0)] * b[(a, 0)] / diag[a]).sum();
+            // no unknown that the coordinate moves (nothing in contact holds it)
+            if !(bkb.is_finite() && bkb > PIVOT_TOL * bb && bb > 0.0) {
+                return Err(singular());
+            }
+            let zeta = ((0..n).map(|a| b[(a, 0)] * x[(a, 0)]).sum::<f64>() - c) / bkb;
+            for a in 0..n {
+                x[(a, 0)] -= zeta * kb[(a, 0)];
+            }
+            border.zeta = zeta;
+            for (gi, (g0, s)) in self.g.iter_mut().zip(border.g0.iter().zip(sigma)) {
+                *gi = g0 + s * zeta;
+            }
+        }
         if (0..n).any(|a| !x[(a, 0)].is_finite()) {
             return Err(singular());
         }
@@ -648,6 +711,7 @@ pub(crate) fn finish(
     report.stick = stick;
     report.slip = slip;
     report.linear_solves = state.iface.solves();
+    report.border_value = state.border.as_ref().map(|b| b.zeta);
     report.time_s = start.elapsed().as_secs_f64();
     tracing::debug!(
         solves = report.linear_solves,
@@ -705,5 +769,16 @@ pub(crate) fn stalled_but_kkt_converged(
     }
     let u = state.iface.displacement(nu)?;
     let (lambda_n, lambda_t) = problem.split_multipliers(nu);
-    Ok(synovia_contact::check_kkt(problem, &u, &lambda_n, &lambda_t).max() <= tolerance)
+    if state.border_residual(nu) > tolerance {
+        return Ok(false);
+    }
+    let shifted = state.border.as_ref().and_then(|b| problem.shifted_constraints(b.zeta));
+    let kkt = match &shifted {
+        Some((normal, friction)) => {
+            let p = ContactProblem { normal, friction: friction.as_ref(), border: None, ..*problem };
+            synovia_contact::check_kkt(&p, &u, &lambda_n, &lambda_t)
+        }
+        None => synovia_contact::check_kkt(problem, &u, &lambda_n, &lambda_t),
+    };
+    Ok(kkt.max() <= tolerance)
 }

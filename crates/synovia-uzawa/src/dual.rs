@@ -62,6 +62,7 @@ impl ContactSolver for DualMprgp {
     ) -> Result<ContactSolution, ContactError> {
         let t0 = Instant::now();
         check_params(&self.params)?;
+        problem.refuse_border(self.name())?;
         let mut op = SchurOperator::new(*problem, context)?;
         let (mn, m, c) = (problem.n_normal(), problem.n_rows(), problem.components());
         let nu0 = initial_multipliers(problem, context.warm_start())?;

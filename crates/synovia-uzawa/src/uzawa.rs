@@ -119,6 +119,7 @@ impl ContactSolver for UzawaMprgp {
     ) -> Result<ContactSolution, ContactError> {
         let t0 = Instant::now();
         check_params(&self.params)?;
+        problem.refuse_border(self.name())?;
         if !(self.inner_tolerance.is_finite() && self.inner_tolerance > 0.0) || self.max_inner == 0 {
             return Err(ContactError::InvalidParameter(format!(
                 "inner tolerance {} must be positive and max_inner {} at least 1",
