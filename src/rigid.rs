@@ -63,7 +63,7 @@ use synovia_mesh::math::{Point, Real, Tensor, Vector};
 use synovia_time::history::LoadHistory;
 
 use synovia_contact::operators::ContactGeometry;
-use synovia_contact::{ContactSolver, StaticContactResult};
+use synovia_contact::{ContactSolver, CoordinateBorder, StaticContactResult};
 use synovia_nonlinear::{GapControl, GapFriction, NonlinearContact, NonlinearResult};
 use synovia_time::quasistatic::{QuasiStaticStepper, StepperCheckpoint};
 use synovia_time::results::StepRecord;
@@ -734,13 +734,30 @@ pub struct ForceControlParams {
     /// iterate (`true`) instead of Broyden updates with a fresh one when a step did not reduce
     /// the error fourfold (`false`, default).
     pub fresh_jacobian: bool,
+    /// One force-controlled coordinate (of a body without tied parts) with a solver that takes
+    /// it (`pdas`, `pdas-fallback`): the coordinate solved with the contact conditions
+    /// (`true`, default; docs/model.md §10, "the coordinate in the contact solve"), one solve
+    /// per geometry built; `false`: the search over trial solves of the given coordinate
+    /// (secant and bracket). The bordered solve falls back to the search when nothing in
+    /// contact holds the body yet or its solve fails.
+    pub bordered: bool,
 }
 
 impl Default for ForceControlParams {
     fn default() -> Self {
-        Self { tolerance: 1e-10, max_solves: 60, geometry_tolerance: 1e-6, fresh_jacobian: false }
+        Self {
+            tolerance: 1e-10,
+            max_solves: 60,
+            geometry_tolerance: 1e-6,
+            fresh_jacobian: false,
+            bordered: true,
+        }
     }
 }
+
+/// Largest number of geometries built by the bordered force control of one level before it
+/// hands over to the search over trial solves.
+const BORDERED_PASSES: usize = 8;
 
 /// The state of a rigid body at one level, reported in [`StepRecord::rigid`](synovia_time::results::StepRecord).
 pub use synovia_time::results::RigidRecord;
@@ -976,6 +993,14 @@ impl RigidDriver {
             return Ok((record, result));
         }
         let params = joint.force_control_params();
+        if let &[(b, k)] = unknowns.as_slice() {
+            let tied = joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b);
+            if params.bordered && posed_pairs && !tied && solver.solves_border() {
+                if let Some(level) = self.bordered_level(&cx, stepper, &values, (b, k), &mut solves)? {
+                    return Ok(level);
+                }
+            }
+        }
         let target: Vec<Real> = unknowns.iter().map(|&(b, k)| values[b][k]).collect();
         let scales = force_scales(bodies, &values, &unknowns, length);
         let mut best: Option<(Real, Level<D>)> = None;
@@ -1161,6 +1186,120 @@ impl RigidDriver {
         let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
         self.accepted = Some(self.q.clone());
         Ok((record, result))
+    }
+
+    /// One level with the single force-controlled coordinate `(b, k)` solved with the contact
+    /// conditions (docs/model.md §10, "the coordinate in the contact solve"): the geometry
+    /// built at `z`, the rates of the gaps `∂d_r/∂z = n_r · v_k(x_r)` and of the partner's
+    /// motion `∂w_r/∂z = v_k(x_r)` handed to the solve with the target `Q = −F`
+    /// ([`CoordinateBorder`]), which returns `ζ`; then the same at `z + ζ` until `ζ` is within
+    /// the geometry tolerance. `None` (the search over trial solves takes over from the
+    /// coordinate reached) when nothing in contact holds the body at a geometry built, a solve
+    /// fails, the passes do not settle or the accepted level's balance misses the tolerance.
+    fn bordered_level<const D: usize>(
+        &mut self,
+        cx: &LevelContext<'_, D>,
+        stepper: &mut QuasiStaticStepper<D>,
+        values: &[Vec<Real>],
+        (b, k): (usize, usize),
+        solves: &mut usize,
+    ) -> Result<Option<Level<D>>, JointError> {
+        let joint = cx.joint;
+        let length = joint.model_size();
+        let params = joint.force_control_params();
+        // a rotation moves the body's points by ≈ its angle × the model size
+        let unit = if k < D { 1.0 } else { length };
+        let scale = force_scales(joint.rigid_bodies(), values, cx.unknowns, length)[0];
+        let mut z = self.q[b][k];
+        stepper.set_record_strain_energy(false);
+        let mut accepted = None;
+        let mut approached = false;
+        for pass in 0..BORDERED_PASSES {
+            let (geometry, linear) = self.linearise(joint, stepper, cx.unknowns, &[z], true)?;
+            if let Some(c) = &cx.checkpoint {
+                stepper.rollback(c.clone());
+            }
+            self.set_partner_motion(joint, stepper, cx.mode)?;
+            let owner = joint.pair_rigid_owner(&geometry);
+            let body = &joint.rigid_bodies()[b];
+            let motion_rate = geometry
+                .nodes
+                .iter()
+                .map(|node| match owner.get(node.pair).copied().flatten() {
+                    Some(ob) if ob == b => body.velocity(&self.q[b], k, &node.position),
+                    _ => Vector::<D>::zeros(),
+                })
+                .collect();
+            let border = CoordinateBorder {
+                gap_rate: linear.sens.iter().map(|s| s[0]).collect(),
+                motion_rate,
+                target: -values[b][k],
+            };
+            stepper.contact_mut().set_coordinate_border(Some(border))?;
+            let solved = self.solve_once(joint, stepper, cx.t, cx.solver, cx.mode, solves);
+            stepper.contact_mut().set_coordinate_border(None)?;
+            let (record, result) = match solved {
+                Ok(level) => level,
+                Err(e) => {
+                    // apart: move to first contact along the force once, as the search does
+                    let apart = linear.gaps0.iter().zip(&linear.sens).all(|(g, s)| s[0] == 0.0 || *g >= 0.0);
+                    if apart && !approached {
+                        approached = true;
+                        z = self.approach(joint, cx.unknowns, &[values[b][k]], &[z], &linear, length)?[0];
+                        tracing::debug!(
+                            t = cx.t,
+                            pass,
+                            z,
+                            "bordered force control: apart, moved to first contact"
+                        );
+                        continue;
+                    }
+                    tracing::debug!(t = cx.t, pass, z, error = %e, "bordered force control: solve failed, trial solves take over");
+                    break;
+                }
+            };
+            let zeta = result.solution.report.border_value.unwrap_or(0.0);
+            tracing::debug!(t = cx.t, pass, z, zeta, "bordered force control");
+            if !zeta.is_finite() {
+                break;
+            }
+            if (zeta * unit).abs() <= params.geometry_tolerance * length {
+                let reactions = self.reactions(joint, &geometry, &record, &result, cx.t)?;
+                let error = (reactions[b][k] + values[b][k]).abs() / scale;
+                if error <= params.tolerance {
+                    // the solution is that of the gaps followed to first order to `z + ζ`
+                    // (within the geometry tolerance of the geometry built, as an accepted
+                    // trial of the search): the body is there
+                    self.q[b][k] = z + zeta;
+                    self.set_poses(joint);
+                    stepper.contact_mut().set_gaps(&linear.at(&[z + zeta]))?;
+                    accepted = Some((geometry, record, result));
+                } else {
+                    tracing::debug!(
+                        t = cx.t,
+                        error,
+                        "bordered force control: balance missed, trial solves take over"
+                    );
+                }
+                break;
+            }
+            z += zeta;
+        }
+        stepper.set_record_strain_energy(true);
+        let Some((geometry, mut record, result)) = accepted else {
+            return Ok(None);
+        };
+        for (bi, body) in joint.rigid_bodies().iter().enumerate() {
+            for (kk, c) in body.controls.iter().enumerate() {
+                if let DofControl::Force { guess: Some(g), .. } = c {
+                    self.offset[bi][kk] = self.q[bi][kk] - g.value(cx.t);
+                }
+            }
+        }
+        record.strain_energy = synovia_fem::post::total_strain_energy(joint.model(), &result.displacement)?;
+        let record = self.finish(joint, &geometry, record, &result, values, cx.t, *solves)?;
+        self.accepted = Some(self.q.clone());
+        Ok(Some((record, result)))
     }
 
     /// The level's start: the control values `h_k(t)`, `F_k(t)` of every rigid body, the

@@ -36,7 +36,13 @@ impl Synthetic {
         Self { system, load, normal: NormalConstraints { rows, weights: vec![1.0; m], gap } }
     }
     fn problem(&self) -> ContactProblem<'_> {
-        ContactProblem { operator: &self.system, load: &self.load, normal: &self.normal, friction: None, border: None }
+        ContactProblem {
+            operator: &self.system,
+            load: &self.load,
+            normal: &self.normal,
+            friction: None,
+            border: None,
+        }
     }
 }
 

@@ -325,3 +325,111 @@ fn rigid_bodies_in_dynamic_runs_press_as_in_quasistatic_runs() -> Result<(), Box
     }
     Ok(())
 }
+
+/// One force-controlled coordinate solved with the contact conditions (the default,
+/// `ForceControlParams::bordered`; docs/model.md §10) gives the equilibrium the search over
+/// trial solves finds, with fewer solves: a frictionless indenter (translation), the cylinder
+/// dragged with friction against its motion (translation, slip relative to the moving body) and
+/// two condyles turned by a moment (rotation). Both searches to a geometry tolerance of 1e-10
+/// of the model size, so that they stop at the same pose.
+#[test]
+fn the_coordinate_solved_in_the_contact_solve_equals_the_trial_search(
+) -> Result<(), Box<dyn std::error::Error>> {
+    use synovia::rigid::ForceControlParams;
+    type Build = fn() -> Result<JointModel<2>, Box<dyn std::error::Error>>;
+    /// Per level the rigid body's coordinates and the pair's resultant; the solves of the run.
+    type Run = (Vec<Vec<f64>>, Vec<[f64; 3]>, usize);
+    fn indenter() -> Result<JointModel<2>, Box<dyn std::error::Error>> {
+        let mut joint = block2d()?;
+        joint.clamp("block", "bottom")?;
+        let centre = Point::<2>::new(0.1, 1.5);
+        joint.add_rigid_body(RigidBody::<2>::new("indenter", centre)?.force(1, Constant(-4.0))?)?;
+        let shape = Arc::new(SphereObstacle::new(centre, 0.5, false)?);
+        joint.contact_rigid_body("indent", "block", "top", "indenter", shape, 0.0)?;
+        Ok(joint)
+    }
+    fn dragged() -> Result<JointModel<2>, Box<dyn std::error::Error>> {
+        let mut joint = block2d()?;
+        joint.clamp("block", "bottom")?;
+        let centre = Point::<2>::new(0.0, 3.0);
+        let drag = synovia::time::history::FnHistory::new(drag_at);
+        joint.add_rigid_body(
+            RigidBody::<2>::new("cylinder", centre)?.prescribe(0, drag)?.force(1, Constant(-20.0))?,
+        )?;
+        let shape = Arc::new(SphereObstacle::new(centre, 2.0, false)?);
+        joint.contact_rigid_body("drag", "block", "top", "cylinder", shape, 0.2)?;
+        Ok(joint)
+    }
+    fn turned() -> Result<JointModel<2>, Box<dyn std::error::Error>> {
+        let mut joint = block2d()?;
+        joint.clamp("block", "bottom")?;
+        let centre = Point::<2>::new(0.0, 1.5);
+        let rz = RigidBody::<2>::dof_index("rz")?;
+        // pressed 0.01 into the block and held against the turn of the contact force about
+        // the centre by a moment (1.5 then 2.0, clockwise)
+        let femur = RigidBody::<2>::new("femur", centre)?
+            .prescribe(1, Constant(-0.01))?
+            .force(rz, synovia::time::history::FnHistory::new(|t: f64| -(1.5 + 0.5 * t)))?;
+        joint.add_rigid_body(femur)?;
+        let shape = Arc::new(SphereObstacle::new(Point::<2>::new(0.5, 1.3), 0.3, false)?);
+        joint.contact_rigid_body("condyle", "block", "top", "femur", shape, 0.0)?;
+        joint.search_distance("condyle", 0.5)?;
+        Ok(joint)
+    }
+    let cases: [(&str, Build, &[f64]); 3] = [
+        ("indenter", indenter, &[0.0, 1.0]),
+        ("dragged", dragged, &[0.0, 1.0, 2.0, 3.0]),
+        ("turned", turned, &[0.0, 1.0]),
+    ];
+    for (name, build, times) in cases {
+        let run = |bordered: bool| -> Result<Run, Box<dyn std::error::Error>> {
+            let mut joint = build()?;
+            joint.force_control(ForceControlParams {
+                bordered,
+                geometry_tolerance: 1e-10,
+                ..ForceControlParams::default()
+            });
+            let mut session = joint.prepare()?;
+            let (mut dofs, mut forces, mut solves) = (Vec::new(), Vec::new(), 0);
+            for (i, &t) in times.iter().enumerate() {
+                let report = if i == 0 { session.solve_static(t)? } else { session.step(t)? };
+                assert!(report.kkt < 1e-8, "{name}, t = {t}: KKT {}", report.kkt);
+                let rec = session.record().ok_or("no record")?;
+                let rigid = &rec.rigid[0];
+                assert!(rigid.balance_error < 1e-9, "{name}, t = {t}, bordered {bordered}: {rigid:?}");
+                dofs.push(rigid.dofs.clone());
+                forces.push(rec.pairs[0].force);
+                println!(
+                    "  {name} t = {t} bordered {bordered}: {} solves, dofs {:?}",
+                    rigid.solves, rigid.dofs
+                );
+                solves += rigid.solves;
+            }
+            Ok((dofs, forces, solves))
+        };
+        let (dofs_b, forces_b, solves_b) = run(true)?;
+        let (dofs_t, forces_t, solves_t) = run(false)?;
+        println!("{name}: {solves_b} solves bordered, {solves_t} by trial solves");
+        for (i, t) in times.iter().enumerate() {
+            for (a, b) in dofs_b[i].iter().zip(&dofs_t[i]) {
+                assert!(
+                    (a - b).abs() <= 1e-9,
+                    "{name}, t = {t}: coordinates {:?} vs {:?}",
+                    dofs_b[i],
+                    dofs_t[i]
+                );
+            }
+            let scale = forces_t[i].iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            for (a, b) in forces_b[i].iter().zip(&forces_t[i]) {
+                assert!(
+                    (a - b).abs() <= 1e-7 * scale,
+                    "{name}, t = {t}: forces {:?} vs {:?}",
+                    forces_b[i],
+                    forces_t[i]
+                );
+            }
+        }
+        assert!(solves_b < solves_t, "{name}: {solves_b} solves bordered against {solves_t}");
+    }
+    Ok(())
+}

@@ -220,8 +220,13 @@ impl<const D: usize> Runner<'_, D> {
             stiffness: self.stiffness.clone(),
             zero_lifts: vec![Vector::<D>::zeros(); self.dofs.groups().len()],
         };
-        let problem =
-            ContactProblem { operator: &operator, load: &level.load, normal: &level.normal, friction, border: None };
+        let problem = ContactProblem {
+            operator: &operator,
+            load: &level.load,
+            normal: &level.normal,
+            friction,
+            border: None,
+        };
         let kkt = check_kkt(&problem, &s.u, &s.lambda_n, &s.lambda_t);
         let components = friction.map_or(1, |f| f.components.max(1));
         let (active, stick, slip) = contact_counts(&s.lambda_n, &s.lambda_t, components);

@@ -617,7 +617,8 @@ impl<const D: usize> StaticContact<D> {
         previous: Option<&[Vec<Vector<D>>]>,
         solution: ContactSolution,
     ) -> Result<StaticContactResult<D>, ContactError> {
-        let Assembled { load, lifts, normal, friction_op, border } = self.assemble(source, slip_bound, previous)?;
+        let Assembled { load, lifts, normal, friction_op, border } =
+            self.assemble(source, slip_bound, previous)?;
         let friction = active_friction(friction_op.as_ref());
         let n_tangential = friction.map_or(0, |f| f.rows.nrows());
         if solution.lambda_n.len() != normal.rows.nrows() || solution.lambda_t.len() != n_tangential {
@@ -634,8 +635,13 @@ impl<const D: usize> StaticContact<D> {
         // loads on a caller's matrix) or from the recycled load solves
         let mut context = self.context.with_start(None, false);
         context.set_load_solution(self.recycled_load_solution(&operator, &load)?);
-        let problem =
-            ContactProblem { operator: &operator, load: &load, normal: &normal, friction, border: border.as_ref() };
+        let problem = ContactProblem {
+            operator: &operator,
+            load: &load,
+            normal: &normal,
+            friction,
+            border: border.as_ref(),
+        };
         let mut solution = solution;
         if solution.u.is_empty() {
             let mut nu: Vec<f64> =
@@ -658,7 +664,8 @@ impl<const D: usize> StaticContact<D> {
         warm_start: Option<&ContactSolution>,
         multipliers_only: bool,
     ) -> Result<Solved<D>, ContactError> {
-        let Assembled { load, lifts, normal, friction_op, border } = self.assemble(source, slip_bound, previous)?;
+        let Assembled { load, lifts, normal, friction_op, border } =
+            self.assemble(source, slip_bound, previous)?;
         let friction = active_friction(friction_op.as_ref());
         let stabilisation = self.elastic.stabilisation();
         if let Some(st) = stabilisation {
@@ -683,7 +690,13 @@ impl<const D: usize> StaticContact<D> {
         let context = context;
         macro_rules! problem_with {
             ($rhs:expr) => {
-                ContactProblem { operator: &operator, load: $rhs, normal: &normal, friction, border: border.as_ref() }
+                ContactProblem {
+                    operator: &operator,
+                    load: $rhs,
+                    normal: &normal,
+                    friction,
+                    border: border.as_ref(),
+                }
             };
         }
         let cell_node = friction_op.as_ref().map_or(&[][..], |f| &f.cell_node[..]);
@@ -926,7 +939,8 @@ impl<const D: usize> StaticContact<D> {
             let scale = inf_norm(&full.u).max(inf_norm(&problem.normal.gap)).max(f64::MIN_POSITIVE);
             // the gaps at the coordinate the bordered solve found
             let zeta = full.report.border_value.unwrap_or(0.0);
-            let gap = |r: usize| problem.normal.gap[r] + problem.border.map_or(0.0, |b| b.sensitivity[r] * zeta);
+            let gap =
+                |r: usize| problem.normal.gap[r] + problem.border.map_or(0.0, |b| b.sensitivity[r] * zeta);
             let penetrating: Vec<usize> = (0..m)
                 .filter(|&r| {
                     !candidate[r]

@@ -458,7 +458,8 @@ impl<'p> State<'p> {
     pub fn border_residual(&self, nu: &[f64]) -> f64 {
         let Some(b) = &self.border else { return 0.0 };
         let q: f64 = b.sensitivity.iter().zip(nu).map(|(s, v)| s * v).sum();
-        let scale: f64 = b.sensitivity.iter().zip(nu).map(|(s, v)| (s * v).abs()).sum::<f64>().max(b.target.abs());
+        let scale: f64 =
+            b.sensitivity.iter().zip(nu).map(|(s, v)| (s * v).abs()).sum::<f64>().max(b.target.abs());
         if scale > 0.0 {
             (q - b.target).abs() / scale
         } else {

@@ -42,7 +42,10 @@ fn bordered_equals_shifted(owned: &OwnedProblem, tangential: f64, fraction: f64,
     let mut nu: Vec<f64> = sol.lambda_n.iter().zip(&plain.normal.weights).map(|(l, k)| l * k).collect();
     nu.extend_from_slice(&sol.lambda_t);
     let q: f64 = border.sensitivity.iter().zip(&nu).map(|(s, v)| s * v).sum();
-    println!("{label}: ζ = {zeta:.6e}, σᵀν = {q:.12e}, target {:.12e}, {} iterations", border.target, sol.report.iterations);
+    println!(
+        "{label}: ζ = {zeta:.6e}, σᵀν = {q:.12e}, target {:.12e}, {} iterations",
+        border.target, sol.report.iterations
+    );
     assert!((q - border.target).abs() <= 1e-10 * border.target.abs(), "{label}: σᵀν {q} ≠ {}", border.target);
     // the plain problem at the offsets g + σ ζ has the same solution, and it satisfies its KKT
     let (normal, friction) = bordered_problem.shifted_constraints(zeta).expect("shifted");
@@ -86,6 +89,9 @@ fn a_border_that_nothing_holds_or_that_does_not_fit_is_refused() {
     // a solver without the border refuses it instead of solving another problem
     let ok = RigidBorder { sensitivity: vec![1.0; p.n_rows()], target: 1.0 };
     let r = AuPdas::default().solve(&ContactProblem { border: Some(&ok), ..p }, &SolveContext::new());
-    assert!(matches!(r, Err(ContactError::InvalidParameter(ref m)) if m.contains("force-controlled")), "{r:?}");
+    assert!(
+        matches!(r, Err(ContactError::InvalidParameter(ref m)) if m.contains("force-controlled")),
+        "{r:?}"
+    );
     assert!(Pdas::default().solves_border() && !AuPdas::default().solves_border());
 }
