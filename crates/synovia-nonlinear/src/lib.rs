@@ -1043,6 +1043,28 @@ impl<const D: usize> NonlinearContact<D> {
         let mut hi: Option<(Real, Real)> = None;
         let mut last: Option<(Real, Real)> = None;
         let mut warm_trial = warm.filter(|s| s.lambda_n.len() == rows).cloned();
+        // the first trial with `w` solved with the contact conditions (a solver that takes a
+        // border, docs/model.md §10): its `R` is the target when the resultant is the
+        // generalised contact force `−σᵀ ν` of the first-order gaps (a rigid partner's force
+        // along its travel); otherwise, or when nothing in contact holds the partner, the
+        // search below goes on from there
+        if solver.solves_border() {
+            if let Some((wb, solution, r)) =
+                self.bordered_gap_trial(g, gaps, load, lifts, solver, warm_trial.as_ref(), friction.as_ref())?
+            {
+                if (r - g.target).abs() <= inner {
+                    return Ok((wb, solution));
+                }
+                tracing::debug!(
+                    w = wb,
+                    r,
+                    target = g.target,
+                    "gap control: the bordered trial missed the target"
+                );
+                warm_trial = Some(solution);
+                w = wb;
+            }
+        }
         let mut overlap = 0.5 * g.overlap.abs();
         // trials running that kept the lower / upper end of the bracket, and `|R − target|` of
         // every trial (Illinois and the bisection safeguard below)
@@ -1161,6 +1183,69 @@ impl<const D: usize> NonlinearContact<D> {
             w = next;
         }
         Err(fail(w, format!("gap control: no w balanced the resultant to {} in 60 contact solves", inner)))
+    }
+
+    /// One trial of [`Self::search_gap_control`] with `w` an unknown of the contact solve
+    /// ([`synovia_contact::CoordinateBorder`]: the gap rates `∂d_r/∂w` of `gaps`, the partner's
+    /// motion rates by a difference of `GapFriction::motion`, the target `−R*`): returns the
+    /// `w` found, its multipliers and its resultant `R` by the caller's functions, with the
+    /// contact's gaps and partner motion left at that `w`; `None` when the solve fails (e.g.
+    /// nothing in contact holds the partner).
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn bordered_gap_trial(
+        &mut self,
+        g: &mut GapControl<'_, D>,
+        gaps: &FirstOrderGaps,
+        load: &[Real],
+        lifts: &[Vector<D>],
+        solver: &dyn ContactSolver,
+        warm: Option<&ContactSolution>,
+        friction: Option<&(GapFriction<'_, D>, &[Real], &[Vec<Vector<D>>], Vec<usize>, Vec<Real>)>,
+    ) -> Result<Option<(Real, ContactSolution, Real)>, NonlinearError> {
+        let w0 = g.w;
+        self.contact.set_gaps(&gaps.at(w0))?;
+        let rows = self.contact.geometry().len();
+        let motion_rate = match friction {
+            Some((f, _, prev, _, _)) => {
+                // (the motion is affine in a translation: a long step keeps the rounding small)
+                let step = if g.max_step.abs() > 0.0 { g.max_step.abs() } else { 1e-3 };
+                let m0 = (f.motion)(self.contact.geometry(), prev, w0);
+                let m1 = (f.motion)(self.contact.geometry(), prev, w0 + step);
+                self.contact.set_partner_motion(m0.clone())?;
+                m0.iter().zip(&m1).map(|(a, b)| (b - a) / step).collect()
+            }
+            None => vec![Vector::<D>::zeros(); rows],
+        };
+        let border =
+            synovia_contact::CoordinateBorder { gap_rate: gaps.sens.clone(), motion_rate, target: -g.target };
+        self.contact.set_coordinate_border(Some(border))?;
+        let solved = match friction {
+            Some((_, bound, prev, _, _)) => {
+                self.contact.solve_load_multipliers(load, lifts, solver, Some(bound), Some(prev), warm)
+            }
+            None => self.contact.solve_load_multipliers(load, lifts, solver, None, None, warm),
+        };
+        self.contact.set_coordinate_border(None)?;
+        g.trials += 1;
+        let solution = match solved {
+            Ok((solution, _)) => solution,
+            Err(e) => {
+                tracing::debug!(w = w0, error = %e, "gap control: bordered trial failed");
+                return Ok(None);
+            }
+        };
+        let Some(zeta) = solution.report.border_value.filter(|z| z.is_finite()) else {
+            return Ok(None);
+        };
+        let w = w0 + zeta;
+        self.contact.set_gaps(&gaps.at(w))?;
+        let mut r = (g.resultant)(self.contact.geometry(), &solution.lambda_n);
+        if let Some((f, _, prev, cells, bounds)) = friction {
+            self.contact.set_partner_motion((f.motion)(self.contact.geometry(), prev, w))?;
+            r += (f.resultant)(self.contact.geometry(), cells, bounds, &solution.lambda_t);
+        }
+        tracing::debug!(w0, w, r, target = g.target, "gap-control bordered trial");
+        Ok(Some((w, solution, r)))
     }
 
     fn finite_strain(&self) -> bool {
