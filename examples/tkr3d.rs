@@ -370,6 +370,19 @@ fn compare_neo_hookean(model: &Tkr3d, percents: &[u32], start: Instant) -> Resul
             _ => return Err("--nh-geometry takes converged, per-level or reference".into()),
         });
     }
+    // `--nh-pass-tolerance τ`: a geometry pass whose geometry still moves ends at this
+    // relative residual (`none`: each pass converges to the Newton tolerance)
+    if let Some(v) = std::env::args().skip_while(|a| a != "--nh-pass-tolerance").nth(1) {
+        newton = newton.with_geometry_pass_tolerance(if v == "none" { None } else { Some(v.parse()?) });
+    }
+    // `--nh-tolerance τ`: the Newton iteration's relative residual tolerance
+    if let Some(v) = std::env::args().skip_while(|a| a != "--nh-tolerance").nth(1) {
+        newton = newton.with_tolerance(v.parse()?);
+    }
+    // `--nh-geometry-tolerance τ`: the relative change at which the geometry passes settle
+    if let Some(v) = std::env::args().skip_while(|a| a != "--nh-geometry-tolerance").nth(1) {
+        newton = newton.with_geometry_tolerance(v.parse()?);
+    }
     if let Some(v) = std::env::args().skip_while(|a| a != "--tangent-reuse").nth(1) {
         newton = newton.with_tangent_reuse(Some(v.parse()?));
     }

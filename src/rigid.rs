@@ -734,12 +734,13 @@ pub struct ForceControlParams {
     /// iterate (`true`) instead of Broyden updates with a fresh one when a step did not reduce
     /// the error fourfold (`false`, default).
     pub fresh_jacobian: bool,
-    /// One force-controlled coordinate (of a body without tied parts) with a solver that takes
-    /// it (`pdas`, `pdas-fallback`): the coordinate solved with the contact conditions
-    /// (`true`, default; docs/model.md §10, "the coordinate in the contact solve"), one solve
-    /// per geometry built; `false`: the search over trial solves of the given coordinate
-    /// (secant and bracket). The bordered solve falls back to the search when nothing in
-    /// contact holds the body yet or its solve fails.
+    /// The force-controlled coordinates (of bodies without tied parts) with a solver that takes
+    /// them (`pdas`, `pdas-fallback`): solved with the contact conditions (`true`, default;
+    /// docs/model.md §10, "The coordinate in the contact solve"), one solve per geometry built;
+    /// `false`: the search over trial solves of given coordinates (secant and bracket for one,
+    /// line searches for several). The bordered solve hands over to the search when nothing in
+    /// contact holds a body yet (after one move to first contact), its solve fails or its
+    /// passes do not settle.
     pub bordered: bool,
 }
 
@@ -993,12 +994,10 @@ impl RigidDriver {
             return Ok((record, result));
         }
         let params = joint.force_control_params();
-        if let &[(b, k)] = unknowns.as_slice() {
-            let tied = joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b);
-            if params.bordered && posed_pairs && !tied && solver.solves_border() {
-                if let Some(level) = self.bordered_level(&cx, stepper, &values, (b, k), &mut solves)? {
-                    return Ok(level);
-                }
+        let tied = unknowns.iter().any(|&(b, _)| joint.rigid_ties().iter().any(|(_, _, rb)| *rb == b));
+        if params.bordered && posed_pairs && !tied && solver.solves_border() {
+            if let Some(level) = self.bordered_level(&cx, stepper, &values, &mut solves)? {
+                return Ok(level);
             }
         }
         let target: Vec<Real> = unknowns.iter().map(|&(b, k)| values[b][k]).collect();
@@ -1188,91 +1187,109 @@ impl RigidDriver {
         Ok((record, result))
     }
 
-    /// One level with the single force-controlled coordinate `(b, k)` solved with the contact
-    /// conditions (docs/model.md §10, "the coordinate in the contact solve"): the geometry
-    /// built at `z`, the rates of the gaps `∂d_r/∂z = n_r · v_k(x_r)` and of the partner's
-    /// motion `∂w_r/∂z = v_k(x_r)` handed to the solve with the target `Q = −F`
+    /// One level with the force-controlled coordinates `z` solved with the contact conditions
+    /// (docs/model.md §10, "The coordinate in the contact solve"): the geometry built at `z`,
+    /// per coordinate `(b, k)` the rates of the gaps `∂d_r/∂z = n_r · v_k(x_r)` and of the
+    /// partner's motion `∂w_r/∂z = v_k(x_r)` handed to the solve with the target `Q = −F`
     /// ([`CoordinateBorder`]), which returns `ζ`; then the same at `z + ζ` until `ζ` is within
     /// the geometry tolerance. `None` (the search over trial solves takes over from the
-    /// coordinate reached) when nothing in contact holds the body at a geometry built, a solve
+    /// coordinates reached) when nothing in contact holds a body at a geometry built, a solve
     /// fails, the passes do not settle or the accepted level's balance misses the tolerance.
     fn bordered_level<const D: usize>(
         &mut self,
         cx: &LevelContext<'_, D>,
         stepper: &mut QuasiStaticStepper<D>,
         values: &[Vec<Real>],
-        (b, k): (usize, usize),
         solves: &mut usize,
     ) -> Result<Option<Level<D>>, JointError> {
         let joint = cx.joint;
+        let unknowns = cx.unknowns;
         let length = joint.model_size();
         let params = joint.force_control_params();
         // a rotation moves the body's points by ≈ its angle × the model size
-        let unit = if k < D { 1.0 } else { length };
-        let scale = force_scales(joint.rigid_bodies(), values, cx.unknowns, length)[0];
-        let mut z = self.q[b][k];
+        let unit: Vec<Real> = unknowns.iter().map(|&(_, k)| if k < D { 1.0 } else { length }).collect();
+        let scales = force_scales(joint.rigid_bodies(), values, unknowns, length);
+        let target: Vec<Real> = unknowns.iter().map(|&(b, k)| values[b][k]).collect();
+        let mut z: Vec<Real> = unknowns.iter().map(|&(b, k)| self.q[b][k]).collect();
         stepper.set_record_strain_energy(false);
         let mut accepted = None;
         let mut approached = false;
         for pass in 0..BORDERED_PASSES {
-            let (geometry, linear) = self.linearise(joint, stepper, cx.unknowns, &[z], true)?;
+            let (geometry, linear) = self.linearise(joint, stepper, unknowns, &z, true)?;
             if let Some(c) = &cx.checkpoint {
                 stepper.rollback(c.clone());
             }
             self.set_partner_motion(joint, stepper, cx.mode)?;
             let owner = joint.pair_rigid_owner(&geometry);
-            let body = &joint.rigid_bodies()[b];
-            let motion_rate = geometry
-                .nodes
+            let borders: Vec<CoordinateBorder<D>> = unknowns
                 .iter()
-                .map(|node| match owner.get(node.pair).copied().flatten() {
-                    Some(ob) if ob == b => body.velocity(&self.q[b], k, &node.position),
-                    _ => Vector::<D>::zeros(),
+                .enumerate()
+                .map(|(j, &(b, k))| {
+                    let body = &joint.rigid_bodies()[b];
+                    CoordinateBorder {
+                        gap_rate: linear.sens.iter().map(|s| s[j]).collect(),
+                        motion_rate: geometry
+                            .nodes
+                            .iter()
+                            .map(|node| match owner.get(node.pair).copied().flatten() {
+                                Some(ob) if ob == b => body.velocity(&self.q[b], k, &node.position),
+                                _ => Vector::<D>::zeros(),
+                            })
+                            .collect(),
+                        target: -values[b][k],
+                    }
                 })
                 .collect();
-            let border = CoordinateBorder {
-                gap_rate: linear.sens.iter().map(|s| s[0]).collect(),
-                motion_rate,
-                target: -values[b][k],
-            };
-            stepper.contact_mut().set_coordinate_border(Some(border))?;
+            stepper.contact_mut().set_coordinate_borders(borders)?;
             let solved = self.solve_once(joint, stepper, cx.t, cx.solver, cx.mode, solves);
-            stepper.contact_mut().set_coordinate_border(None)?;
+            stepper.contact_mut().set_coordinate_borders(Vec::new())?;
             let (record, result) = match solved {
                 Ok(level) => level,
                 Err(e) => {
-                    // apart: move to first contact along the force once, as the search does
-                    let apart = linear.gaps0.iter().zip(&linear.sens).all(|(g, s)| s[0] == 0.0 || *g >= 0.0);
+                    // apart: move to first contact along the forces once, as the search does
+                    let apart = linear
+                        .gaps0
+                        .iter()
+                        .zip(&linear.sens)
+                        .all(|(g, s)| s.iter().all(|v| *v == 0.0) || *g >= 0.0);
                     if apart && !approached {
                         approached = true;
-                        z = self.approach(joint, cx.unknowns, &[values[b][k]], &[z], &linear, length)?[0];
+                        z = self.approach(joint, unknowns, &target, &z, &linear, length)?;
                         tracing::debug!(
                             t = cx.t,
                             pass,
-                            z,
+                            ?z,
                             "bordered force control: apart, moved to first contact"
                         );
                         continue;
                     }
-                    tracing::debug!(t = cx.t, pass, z, error = %e, "bordered force control: solve failed, trial solves take over");
+                    tracing::debug!(t = cx.t, pass, ?z, error = %e, "bordered force control: solve failed, trial solves take over");
                     break;
                 }
             };
-            let zeta = result.solution.report.border_value.unwrap_or(0.0);
-            tracing::debug!(t = cx.t, pass, z, zeta, "bordered force control");
-            if !zeta.is_finite() {
+            let zeta = result.solution.report.border_values.clone();
+            tracing::debug!(t = cx.t, pass, ?z, ?zeta, "bordered force control");
+            if zeta.len() != z.len() || zeta.iter().any(|v| !v.is_finite()) {
                 break;
             }
-            if (zeta * unit).abs() <= params.geometry_tolerance * length {
+            let moved = zeta.iter().zip(&unit).map(|(d, u)| (d * u).abs()).fold(0.0, Real::max);
+            let next: Vec<Real> = z.iter().zip(&zeta).map(|(a, d)| a + d).collect();
+            if moved <= params.geometry_tolerance * length {
                 let reactions = self.reactions(joint, &geometry, &record, &result, cx.t)?;
-                let error = (reactions[b][k] + values[b][k]).abs() / scale;
+                let error = unknowns
+                    .iter()
+                    .zip(&scales)
+                    .map(|(&(b, k), s)| (reactions[b][k] + values[b][k]).abs() / s)
+                    .fold(0.0, Real::max);
                 if error <= params.tolerance {
                     // the solution is that of the gaps followed to first order to `z + ζ`
                     // (within the geometry tolerance of the geometry built, as an accepted
-                    // trial of the search): the body is there
-                    self.q[b][k] = z + zeta;
+                    // trial of the search): the bodies are there
+                    for (&(b, k), &v) in unknowns.iter().zip(&next) {
+                        self.q[b][k] = v;
+                    }
                     self.set_poses(joint);
-                    stepper.contact_mut().set_gaps(&linear.at(&[z + zeta]))?;
+                    stepper.contact_mut().set_gaps(&linear.at(&next))?;
                     accepted = Some((geometry, record, result));
                 } else {
                     tracing::debug!(
@@ -1283,7 +1300,7 @@ impl RigidDriver {
                 }
                 break;
             }
-            z += zeta;
+            z = next;
         }
         stepper.set_record_strain_energy(true);
         let Some((geometry, mut record, result)) = accepted else {

@@ -109,6 +109,34 @@ fn unresisted_force_is_refused() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
+/// Two discs of one rigid body (two condyles).
+#[derive(Debug)]
+struct TwoDiscs {
+    centres: [Point<2>; 2],
+    radius: f64,
+}
+impl TwoDiscs {
+    fn nearest(&self, x: &Point<2>) -> (f64, Vector<2>) {
+        let [a, b] = self.centres.map(|c| {
+            let d = x - c;
+            (d.norm() - self.radius, d / d.norm())
+        });
+        if a.0 <= b.0 {
+            a
+        } else {
+            b
+        }
+    }
+}
+impl synovia::contact_ops::operators::SignedDistance<2> for TwoDiscs {
+    fn distance(&self, x: &Point<2>) -> f64 {
+        self.nearest(x).0
+    }
+    fn gradient(&self, x: &Point<2>) -> Vector<2> {
+        self.nearest(x).1
+    }
+}
+
 /// Two discs of one rigid body (a 2D "femur" with two condyles), pushed down with a force and
 /// free to rotate under zero moment, start tilted so that one disc alone touches: one contact
 /// region resists only one combination of translation and rotation (the Jacobian is of rank
@@ -117,32 +145,6 @@ fn unresisted_force_is_refused() -> Result<(), Box<dyn std::error::Error>> {
 /// have their diagonal the same way: not mirror-symmetric).
 #[test]
 fn two_condyles_free_to_rotate_share_the_force() -> Result<(), Box<dyn std::error::Error>> {
-    #[derive(Debug)]
-    struct TwoDiscs {
-        centres: [Point<2>; 2],
-        radius: f64,
-    }
-    impl TwoDiscs {
-        fn nearest(&self, x: &Point<2>) -> (f64, Vector<2>) {
-            let [a, b] = self.centres.map(|c| {
-                let d = x - c;
-                (d.norm() - self.radius, d / d.norm())
-            });
-            if a.0 <= b.0 {
-                a
-            } else {
-                b
-            }
-        }
-    }
-    impl synovia::contact_ops::operators::SignedDistance<2> for TwoDiscs {
-        fn distance(&self, x: &Point<2>) -> f64 {
-            self.nearest(x).0
-        }
-        fn gradient(&self, x: &Point<2>) -> Vector<2> {
-            self.nearest(x).1
-        }
-    }
     let mesh = rectangle(-1.0, 1.0, 0.0, 1.0, 32, 8, Grading::Uniform, Grading::Uniform)?;
     let mut joint = JointModel::<2>::new();
     joint.add_body("block", mesh, plane_strain(1.0e3, 0.3)?)?;
@@ -376,10 +378,33 @@ fn the_coordinate_solved_in_the_contact_solve_equals_the_trial_search(
         joint.search_distance("condyle", 0.5)?;
         Ok(joint)
     }
-    let cases: [(&str, Build, &[f64]); 3] = [
+    /// Two condyles pressed by a force and free to turn under a moment (two coordinates).
+    fn condyles() -> Result<JointModel<2>, Box<dyn std::error::Error>> {
+        let mesh = rectangle(-1.0, 1.0, 0.0, 1.0, 32, 8, Grading::Uniform, Grading::Uniform)?;
+        let mut joint = JointModel::<2>::new();
+        joint.add_body("block", mesh, plane_strain(1.0e3, 0.3)?)?;
+        joint.clamp("block", "bottom")?;
+        let centre = Point::<2>::new(0.0, 1.5);
+        let rz = RigidBody::<2>::dof_index("rz")?;
+        let femur = RigidBody::<2>::new("femur", centre)?.force(1, Constant(-4.0))?.force_with_guess(
+            rz,
+            synovia::time::history::FnHistory::new(|t: f64| 0.2 * t),
+            Constant(-0.02),
+        )?;
+        joint.add_rigid_body(femur)?;
+        let shape = Arc::new(TwoDiscs {
+            centres: [Point::<2>::new(-0.5, 1.3), Point::<2>::new(0.5, 1.3)],
+            radius: 0.3,
+        });
+        joint.contact_rigid_body("condyles", "block", "top", "femur", shape, 0.0)?;
+        joint.search_distance("condyles", 0.5)?;
+        Ok(joint)
+    }
+    let cases: [(&str, Build, &[f64]); 4] = [
         ("indenter", indenter, &[0.0, 1.0]),
         ("dragged", dragged, &[0.0, 1.0, 2.0, 3.0]),
         ("turned", turned, &[0.0, 1.0]),
+        ("condyles", condyles, &[0.0, 1.0]),
     ];
     for (name, build, times) in cases {
         let run = |bordered: bool| -> Result<Run, Box<dyn std::error::Error>> {

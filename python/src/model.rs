@@ -777,9 +777,10 @@ impl PyModel {
     /// change. `tangent_reuse=ρ` in (0, 1): modified Newton, the factorised tangent kept while
     /// each full step reduces the residual by `ρ`; `fresh_tangent=True`: Newton's method, a
     /// fresh tangent at every iteration (the default); `geometry`: `"converged"`, `"per_level"` or
-    /// `"reference"`; `geometry_aitken`: Aitken's relaxation of the geometry passes. Checked
-    /// as a whole (SynoviaError naming the parameter out of range).
-    #[pyo3(signature = (*, tolerance = None, max_iterations = None, line_search = None, max_cutbacks = None, tangent_reuse = None, fresh_tangent = false, geometry = None, geometry_tolerance = None, max_geometry_passes = None, geometry_relaxation = None, geometry_aitken = None))]
+    /// `"reference"`; `geometry_aitken`: Aitken's relaxation of the geometry passes;
+    /// `geometry_pass_tolerance`: the relative residual at which a pass ends while its geometry
+    /// still moves. Checked as a whole (SynoviaError naming the parameter out of range).
+    #[pyo3(signature = (*, tolerance = None, max_iterations = None, line_search = None, max_cutbacks = None, tangent_reuse = None, fresh_tangent = false, geometry = None, geometry_tolerance = None, max_geometry_passes = None, geometry_relaxation = None, geometry_aitken = None, geometry_pass_tolerance = None))]
     #[allow(clippy::too_many_arguments)]
     fn newton_params(
         &mut self,
@@ -794,6 +795,7 @@ impl PyModel {
         max_geometry_passes: Option<usize>,
         geometry_relaxation: Option<f64>,
         geometry_aitken: Option<bool>,
+        geometry_pass_tolerance: Option<f64>,
     ) -> PyResult<()> {
         use synovia::nonlinear::GeometryUpdate;
         let update = match geometry {
@@ -820,6 +822,7 @@ impl PyModel {
             if let Some(v) = max_geometry_passes { p = p.with_max_geometry_passes(v); }
             if let Some(v) = geometry_relaxation { p = p.with_geometry_relaxation(v); }
             if let Some(v) = geometry_aitken { p = p.with_geometry_aitken(v); }
+            if let Some(v) = geometry_pass_tolerance { p = p.with_geometry_pass_tolerance(Some(v)); }
             p.check().map_err(err)?;
             j.newton_params(p);
             Ok(())

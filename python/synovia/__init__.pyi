@@ -318,11 +318,14 @@ class Model:
         max_geometry_passes: Optional[int] = None,
         geometry_relaxation: Optional[float] = None,
         geometry_aitken: Optional[bool] = None,
+        geometry_pass_tolerance: Optional[float] = None,
     ) -> None:
         """The Newton iteration of nonlinear models (only the given parameters change):
         tangent_reuse=rho in (0, 1) for modified Newton, fresh_tangent=True for Newton's method,
         geometry "converged" / "per_level" / "reference", geometry_aitken for Aitken's
-        relaxation of the geometry passes. SynoviaError for a parameter out of range."""
+        relaxation of the geometry passes, geometry_pass_tolerance for the relative residual at
+        which a pass ends while its geometry still moves. SynoviaError for a parameter out of
+        range."""
     def set_density(self, body: BodyRef, density: float) -> None: ...
     def initial_velocity(self, body: BodyRef, velocity: ArrayLike) -> None: ...
     def contact(

@@ -315,6 +315,8 @@ def test_newton_params_modified_newton_solves_the_same_problem():
     default = floor_force()
     modified = floor_force(tangent_reuse=0.5, geometry_aitken=True, tolerance=1e-11, max_iterations=60)
     assert modified == pytest.approx(default, rel=1e-7)
+    passes = floor_force(geometry_pass_tolerance=1e-3, tolerance=1e-11)
+    assert passes == pytest.approx(default, rel=1e-7)
     m = synovia.Model(2)
     for bad in (
         dict(tangent_reuse=1.0),
@@ -322,6 +324,7 @@ def test_newton_params_modified_newton_solves_the_same_problem():
         dict(tolerance=2.0),
         dict(max_iterations=0),
         dict(geometry="always"),
+        dict(geometry_pass_tolerance=-1.0),
     ):
         with pytest.raises(synovia.SynoviaError):
             m.newton_params(**bad)

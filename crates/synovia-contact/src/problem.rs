@@ -52,26 +52,40 @@ impl FrictionConstraints {
     }
 }
 
-/// A rigid partner's force-controlled coordinate `z` solved together with the contact
-/// conditions (docs/model.md §10, "the coordinate in the contact solve"): the offsets of the
-/// interface rows move with it to first order,
+/// Force-controlled coordinates `z_j` of rigid partners solved together with the contact
+/// conditions (docs/model.md §10, "The coordinate in the contact solve"): the offsets of the
+/// interface rows move with them to first order,
 ///
 /// ```text
-/// g(ζ) = g + σ ζ,        ζ = z − z₀ (z₀: the coordinate the rows were built at),
+/// g(ζ) = g + Σ_j σ_j ζ_j,        ζ_j = z_j − z₀_j (z₀: the coordinates the rows were built at),
 /// ```
 ///
-/// and its equilibrium closes the system, `σᵀ ν = target` (`σ_r = ∂g_r/∂z`; with the
-/// generalised contact force `Q = σᵀ ν` on the partner, `target = −F` for the applied force
-/// `F`). It is the stationarity in `z` of the Lagrangian of the contact problem with the work
-/// `F z` of the applied force added. A solver that takes it ([`crate::ContactSolver::solves_border`])
-/// returns `ζ` in [`crate::SolverReport::border_value`]; the solution is that of the problem
-/// with the offsets `g(ζ)`.
+/// and their equilibria close the system, `σ_jᵀ ν = target_j` (`σ_j = ∂g/∂z_j`; with the
+/// generalised contact force `Q_j = σ_jᵀ ν` on the partner, `target_j = −F_j` for the applied
+/// generalised force `F_j`). They are the stationarity in `z` of the Lagrangian of the contact
+/// problem with the work `F · z` of the applied forces added. A solver that takes them
+/// ([`crate::ContactSolver::solves_border`]) returns `ζ` in
+/// [`crate::SolverReport::border_values`]; the solution is that of the problem with the offsets
+/// `g(ζ)`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RigidBorder {
-    /// `σ`, one entry per interface row (the normal rows, then the tangential ones).
-    pub sensitivity: Vec<f64>,
-    /// The equilibrium's right-hand side `σᵀ ν = target`.
-    pub target: f64,
+    /// `σ_j`, one column per coordinate, each with one entry per interface row (the normal
+    /// rows, then the tangential ones).
+    pub columns: Vec<Vec<f64>>,
+    /// The equilibria's right-hand sides `σ_jᵀ ν = target_j`, one per column.
+    pub targets: Vec<f64>,
+}
+
+impl RigidBorder {
+    /// A border of one coordinate.
+    pub fn single(column: Vec<f64>, target: f64) -> Self {
+        Self { columns: vec![column], targets: vec![target] }
+    }
+
+    /// `g(ζ)_r − g_r = Σ_j σ_j,r ζ_j` for interface row `r`.
+    pub fn shift(&self, r: usize, zeta: &[f64]) -> f64 {
+        self.columns.iter().zip(zeta).map(|(c, z)| c[r] * z).sum()
+    }
 }
 
 /// One contact problem of docs/model.md §5: the operator `A` (factorised), the load `F`, and
@@ -160,15 +174,22 @@ impl<'a> ContactProblem<'a> {
             }
         }
         if let Some(b) = self.border {
-            if b.sensitivity.len() != self.n_rows() {
+            if b.columns.is_empty() || b.columns.len() != b.targets.len() {
                 return bad(format!(
-                    "the rigid border has {} sensitivities for {} interface rows",
-                    b.sensitivity.len(),
+                    "the rigid border has {} columns and {} targets (one each per coordinate, at least one)",
+                    b.columns.len(),
+                    b.targets.len()
+                ));
+            }
+            if let Some(c) = b.columns.iter().find(|c| c.len() != self.n_rows()) {
+                return bad(format!(
+                    "a rigid border column has {} sensitivities for {} interface rows",
+                    c.len(),
                     self.n_rows()
                 ));
             }
-            if !b.target.is_finite() || b.sensitivity.iter().any(|s| !s.is_finite()) {
-                return bad("the rigid border's sensitivities or target are not finite".into());
+            if b.targets.iter().chain(b.columns.iter().flatten()).any(|v| !v.is_finite()) {
+                return bad("the rigid border's sensitivities or targets are not finite".into());
             }
         }
         Ok(())
@@ -185,19 +206,22 @@ impl<'a> ContactProblem<'a> {
         }
     }
 
-    /// The offsets `g(ζ) = g + σ ζ` of a bordered problem at `ζ` (docs/model.md §10), as
-    /// constraints to check a solution against; `None` without a border.
-    pub fn shifted_constraints(&self, zeta: f64) -> Option<(NormalConstraints, Option<FrictionConstraints>)> {
+    /// The offsets `g(ζ) = g + Σ_j σ_j ζ_j` of a bordered problem at `ζ` (docs/model.md §10),
+    /// as constraints to check a solution against; `None` without a border.
+    pub fn shifted_constraints(
+        &self,
+        zeta: &[f64],
+    ) -> Option<(NormalConstraints, Option<FrictionConstraints>)> {
         let b = self.border?;
         let m = self.n_normal();
         let mut normal = self.normal.clone();
-        for (d, s) in normal.gap.iter_mut().zip(&b.sensitivity[..m]) {
-            *d += s * zeta;
+        for (r, d) in normal.gap.iter_mut().enumerate() {
+            *d += b.shift(r, zeta);
         }
         let friction = self.friction.map(|f| {
             let mut f = f.clone();
-            for (v, s) in f.shift.iter_mut().zip(&b.sensitivity[m..]) {
-                *v += s * zeta;
+            for (i, v) in f.shift.iter_mut().enumerate() {
+                *v += b.shift(m + i, zeta);
             }
             f
         });

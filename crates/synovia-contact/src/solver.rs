@@ -72,9 +72,9 @@ pub struct SolverReport {
     /// The fallback that produced this solution, if any (e.g. the `pdas-fallback` solver of
     /// the `synovia` facade hands a cycling PDAS iteration over to `dual-mprgp`).
     pub fallback: Option<String>,
-    /// The rigid partner's coordinate increment `ζ` of a problem with a
-    /// [`crate::RigidBorder`] (`None` without one).
-    pub border_value: Option<f64>,
+    /// The increments `ζ_j` of the rigid partners' coordinates of a problem with a
+    /// [`crate::RigidBorder`] (empty without one).
+    pub border_values: Vec<f64>,
 }
 
 /// A solution of the contact problem of docs/model.md §5.

@@ -43,13 +43,13 @@ pub struct StaticContact<const D: usize> {
     caller_matrix: bool,
     /// The pose-independent geometry data kept by [`StaticContact::rebuild_geometry`].
     geometry_cache: GeometryCache<D>,
-    /// A rigid partner's force-controlled coordinate solved with the contact conditions
-    /// ([`StaticContact::set_coordinate_border`]); dropped when the geometry changes.
-    border: Option<CoordinateBorder<D>>,
+    /// Rigid partners' force-controlled coordinates solved with the contact conditions
+    /// ([`StaticContact::set_coordinate_borders`]); dropped when the geometry changes.
+    borders: Vec<CoordinateBorder<D>>,
 }
 
 /// A rigid partner's force-controlled coordinate `z` solved together with the contact
-/// conditions (docs/model.md §10, "the coordinate in the contact solve";
+/// conditions (docs/model.md §10, "The coordinate in the contact solve";
 /// [`crate::RigidBorder`]): per contact node `r` of the geometry the rate `∂d_r/∂z` of its
 /// gap and the rate `∂w_r/∂z` of the partner's motion there (the slip origin of friction), and
 /// the equilibrium `Q(ν) = Σ_r (∂d_r/∂z) κ_r Λ_n,r + Σ_c (∂s_c/∂z) Λ_t,c = target`
@@ -124,7 +124,7 @@ impl<const D: usize> StaticContact<D> {
             context: SolveContext::new(),
             caller_matrix: false,
             geometry_cache: GeometryCache::default(),
-            border: None,
+            borders: Vec::new(),
         })
     }
 
@@ -208,7 +208,7 @@ impl<const D: usize> StaticContact<D> {
             context: SolveContext::new(),
             caller_matrix: true,
             geometry_cache: GeometryCache::default(),
-            border: None,
+            borders: Vec::new(),
         })
     }
 
@@ -351,7 +351,7 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = self.geometry.updated(model, pairs, displacement)?;
         self.context.clear_deformed_rows();
-        self.border = None;
+        self.borders.clear();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -376,7 +376,7 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new_placed(model, pairs, placements)?;
         self.context.clear_rows();
-        self.border = None;
+        self.borders.clear();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -399,7 +399,7 @@ impl<const D: usize> StaticContact<D> {
     ) -> Result<ContactGeometry<D>, ContactError> {
         let geometry = ContactGeometry::new_cached(model, pairs, &mut self.geometry_cache)?;
         self.context.clear_moved_rows();
-        self.border = None;
+        self.borders.clear();
         Ok(std::mem::replace(&mut self.geometry, geometry))
     }
 
@@ -433,17 +433,17 @@ impl<const D: usize> StaticContact<D> {
         self.geometry.set_partner_motion(motion)
     }
 
-    /// Solves the next contact problems with a rigid partner's force-controlled coordinate as
-    /// an unknown ([`CoordinateBorder`]; `None`: the gaps as given). Kept until the geometry
-    /// changes (a rebuild, update or placement drops it). Only solvers that take a border
-    /// ([`ContactSolver::solves_border`]) solve such a problem; a semi-coercive model refuses
-    /// it.
+    /// Solves the next contact problems with rigid partners' force-controlled coordinates as
+    /// unknowns, one [`CoordinateBorder`] each (empty: the gaps as given). Kept until the
+    /// geometry changes (a rebuild, update or placement drops them). Only solvers that take a
+    /// border ([`ContactSolver::solves_border`]) solve such a problem; a semi-coercive model
+    /// refuses it.
     ///
     /// # Errors
     /// [`ContactError::InvalidParameter`] for rates that do not fit the contact nodes or are
     /// not finite.
-    pub fn set_coordinate_border(&mut self, border: Option<CoordinateBorder<D>>) -> Result<(), ContactError> {
-        if let Some(b) = &border {
+    pub fn set_coordinate_borders(&mut self, borders: Vec<CoordinateBorder<D>>) -> Result<(), ContactError> {
+        for b in &borders {
             let n = self.geometry.nodes.len();
             if b.gap_rate.len() != n || b.motion_rate.len() != n {
                 return Err(ContactError::InvalidParameter(format!(
@@ -461,7 +461,7 @@ impl<const D: usize> StaticContact<D> {
                 ));
             }
         }
-        self.border = border;
+        self.borders = borders;
         Ok(())
     }
 
@@ -796,19 +796,25 @@ impl<const D: usize> StaticContact<D> {
             Some(g) => Some(self.geometry.friction_constraints(dofs, &lifts, g, previous)?),
             None => None,
         };
-        let border = self.border.as_ref().map(|b| {
-            // σ: the gap rates of the normal rows, then `g_c κ_r t · ∂w_r/∂z` of each friction
-            // row (its shift is `g_c κ_r t · ([u_{i−1}] + w_r) − lift`)
-            let mut sensitivity = b.gap_rate.clone();
-            if let Some(f) = active_friction(friction_op.as_ref()).and(friction_op.as_ref()) {
-                for (&r, &g) in f.cell_node.iter().zip(&f.slip_bound) {
-                    let node = &self.geometry.nodes[r];
-                    for t in node.tangents.iter().take(D - 1) {
-                        sensitivity.push(g * node.weight * t.dot(&b.motion_rate[r]));
+        let border = (!self.borders.is_empty()).then(|| {
+            // σ_j: the gap rates of the normal rows, then `g_c κ_r t · ∂w_r/∂z_j` of each
+            // friction row (its shift is `g_c κ_r t · ([u_{i−1}] + w_r) − lift`)
+            let column = |b: &CoordinateBorder<D>| {
+                let mut sensitivity = b.gap_rate.clone();
+                if let Some(f) = active_friction(friction_op.as_ref()).and(friction_op.as_ref()) {
+                    for (&r, &g) in f.cell_node.iter().zip(&f.slip_bound) {
+                        let node = &self.geometry.nodes[r];
+                        for t in node.tangents.iter().take(D - 1) {
+                            sensitivity.push(g * node.weight * t.dot(&b.motion_rate[r]));
+                        }
                     }
                 }
+                sensitivity
+            };
+            RigidBorder {
+                columns: self.borders.iter().map(column).collect(),
+                targets: self.borders.iter().map(|b| b.target).collect(),
             }
-            RigidBorder { sensitivity, target: b.target }
         });
         Ok(Assembled { load, lifts, normal, friction_op, border })
     }
@@ -902,12 +908,12 @@ impl<const D: usize> StaticContact<D> {
             let rows: Vec<usize> = (0..m).filter(|&r| candidate[r]).collect();
             let normal = restrict_rows(problem.normal, &rows);
             let border = problem.border.map(|b| crate::problem::RigidBorder {
-                sensitivity: rows
+                columns: b
+                    .columns
                     .iter()
-                    .map(|&r| b.sensitivity[r])
-                    .chain(b.sensitivity[m..].iter().copied())
+                    .map(|c| rows.iter().map(|&r| c[r]).chain(c[m..].iter().copied()).collect())
                     .collect(),
-                target: b.target,
+                targets: b.targets.clone(),
             });
             // the screening check below needs U, whatever the caller asked for
             let sub = ContactProblem { normal: &normal, border: border.as_ref(), ..*problem };
@@ -938,9 +944,8 @@ impl<const D: usize> StaticContact<D> {
                 ContactSolution { u: solution.u, lambda_n, lambda_t: solution.lambda_t, report: merged };
             let scale = inf_norm(&full.u).max(inf_norm(&problem.normal.gap)).max(f64::MIN_POSITIVE);
             // the gaps at the coordinate the bordered solve found
-            let zeta = full.report.border_value.unwrap_or(0.0);
-            let gap =
-                |r: usize| problem.normal.gap[r] + problem.border.map_or(0.0, |b| b.sensitivity[r] * zeta);
+            let zeta = &full.report.border_values;
+            let gap = |r: usize| problem.normal.gap[r] + problem.border.map_or(0.0, |b| b.shift(r, zeta));
             let penetrating: Vec<usize> = (0..m)
                 .filter(|&r| {
                     !candidate[r]
@@ -1133,7 +1138,11 @@ fn restrict_adjacency(adjacency: &[Vec<usize>], rows: &[usize], m: usize) -> Vec
 /// [`check_kkt`] of a solution; for a bordered problem at the offsets of the coordinate the
 /// solve found, `g + σ ζ` ([`ContactProblem::shifted_constraints`]).
 fn check_kkt_at_border(problem: &ContactProblem<'_>, solution: &ContactSolution) -> KktReport {
-    let shifted = solution.report.border_value.and_then(|zeta| problem.shifted_constraints(zeta));
+    let shifted = if solution.report.border_values.is_empty() {
+        None
+    } else {
+        problem.shifted_constraints(&solution.report.border_values)
+    };
     match &shifted {
         Some((normal, friction)) => {
             let p = ContactProblem { normal, friction: friction.as_ref(), border: None, ..*problem };

@@ -1218,14 +1218,14 @@ impl<const D: usize> NonlinearContact<D> {
         };
         let border =
             synovia_contact::CoordinateBorder { gap_rate: gaps.sens.clone(), motion_rate, target: -g.target };
-        self.contact.set_coordinate_border(Some(border))?;
+        self.contact.set_coordinate_borders(vec![border])?;
         let solved = match friction {
             Some((_, bound, prev, _, _)) => {
                 self.contact.solve_load_multipliers(load, lifts, solver, Some(bound), Some(prev), warm)
             }
             None => self.contact.solve_load_multipliers(load, lifts, solver, None, None, warm),
         };
-        self.contact.set_coordinate_border(None)?;
+        self.contact.set_coordinate_borders(Vec::new())?;
         g.trials += 1;
         let solution = match solved {
             Ok((solution, _)) => solution,
@@ -1234,7 +1234,7 @@ impl<const D: usize> NonlinearContact<D> {
                 return Ok(None);
             }
         };
-        let Some(zeta) = solution.report.border_value.filter(|z| z.is_finite()) else {
+        let Some(zeta) = solution.report.border_values.first().copied().filter(|z| z.is_finite()) else {
             return Ok(None);
         };
         let w = w0 + zeta;

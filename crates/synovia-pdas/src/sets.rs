@@ -114,14 +114,14 @@ pub(crate) struct State<'p> {
     pub border: Option<Border>,
 }
 
-/// The bordered unknown of a [`State`]: `σ`, the target of `σᵀ ν = target`, the offsets
-/// `g₀` at `ζ = 0` and the current `ζ`.
+/// The bordered unknowns of a [`State`]: the columns `σ_j`, the targets of `σ_jᵀ ν =
+/// target_j`, the offsets `g₀` at `ζ = 0` and the current `ζ`.
 #[derive(Debug, Clone)]
 pub(crate) struct Border {
-    pub sensitivity: Vec<f64>,
-    pub target: f64,
+    pub columns: Vec<Vec<f64>>,
+    pub targets: Vec<f64>,
     pub g0: Vec<f64>,
-    pub zeta: f64,
+    pub zeta: Vec<f64>,
 }
 
 /// `ζ / max(1, ‖ζ‖)`: the projection `π` onto `[−1, 1]` (2D) or the unit disc (3D).
@@ -223,10 +223,10 @@ impl<'p> State<'p> {
             rho_scale: params.rho_scale,
             rho_initialised: false,
             border: problem.border.map(|b| Border {
-                sensitivity: b.sensitivity.clone(),
-                target: b.target,
+                columns: b.columns.clone(),
+                targets: b.targets.clone(),
                 g0: g.clone(),
-                zeta: 0.0,
+                zeta: vec![0.0; b.columns.len()],
             }),
             g,
         })
@@ -453,18 +453,23 @@ impl<'p> State<'p> {
         (rn.max(self.border_residual(nu)), rt)
     }
 
-    /// `|σᵀ ν − target| / max(|target|, Σ |σ_r ν_r|)`: the relative residual of the bordered
-    /// coordinate's equilibrium (0 without a border).
+    /// `max_j |σ_jᵀ ν − target_j| / max(|target_j|, Σ_r |σ_j,r ν_r|)`: the relative residual of
+    /// the bordered coordinates' equilibria (0 without a border).
     pub fn border_residual(&self, nu: &[f64]) -> f64 {
         let Some(b) = &self.border else { return 0.0 };
-        let q: f64 = b.sensitivity.iter().zip(nu).map(|(s, v)| s * v).sum();
-        let scale: f64 =
-            b.sensitivity.iter().zip(nu).map(|(s, v)| (s * v).abs()).sum::<f64>().max(b.target.abs());
-        if scale > 0.0 {
-            (q - b.target).abs() / scale
-        } else {
-            0.0
-        }
+        b.columns
+            .iter()
+            .zip(&b.targets)
+            .map(|(col, &target)| {
+                let q: f64 = col.iter().zip(nu).map(|(s, v)| s * v).sum();
+                let scale = col.iter().zip(nu).map(|(s, v)| (s * v).abs()).sum::<f64>().max(target.abs());
+                if scale > 0.0 {
+                    (q - target).abs() / scale
+                } else {
+                    0.0
+                }
+            })
+            .fold(0.0, f64::max)
     }
 
     /// `y = w − S ν`.
@@ -587,28 +592,44 @@ impl<'p> State<'p> {
         }
         let mut x = chol.solve(&rhs);
         if let Some(border) = &mut self.border {
-            // the bordered system [K b; bᵀ 0] [x; ζ] = [rhs; c], b = Qᵀσ, c = target − σᵀν_fixed:
-            // x = K⁻¹ rhs − ζ K⁻¹ b, ζ = (bᵀ K⁻¹ rhs − c) / (bᵀ K⁻¹ b)
-            let sigma = &border.sensitivity;
-            let b = faer::Mat::<f64>::from_fn(n, 1, |a, _| {
+            // the bordered system [K B; Bᵀ 0] [x; ζ] = [rhs; c], B = Qᵀ [σ_j],
+            // c_j = target_j − σ_jᵀ ν_fixed: with M = Bᵀ K⁻¹ B,
+            // ζ = M⁻¹ (Bᵀ K⁻¹ rhs − c), x = K⁻¹ rhs − K⁻¹ B ζ
+            let m = border.columns.len();
+            let b = faer::Mat::<f64>::from_fn(n, m, |a, j| {
                 let (r, t, l, _) = &q[a];
-                (0..*l).map(|i| t[i] * sigma[r[i]]).sum::<f64>()
+                (0..*l).map(|i| t[i] * border.columns[j][r[i]]).sum::<f64>()
             });
-            let c = border.target - sigma.iter().zip(&nu).map(|(s, v)| s * v).sum::<f64>();
             let kb = chol.solve(&b);
-            let bkb: f64 = (0..n).map(|a| b[(a, 0)] * kb[(a, 0)]).sum();
-            let bb: f64 = (0..n).map(|a| b[(a, 0)] * b[(a, 0)] / diag[a]).sum();
-            // no unknown that the coordinate moves (nothing in contact holds it)
-            if !(bkb.is_finite() && bkb > PIVOT_TOL * bb && bb > 0.0) {
+            let mut mm = faer::Mat::<f64>::zeros(m, m);
+            let mut rz = faer::Mat::<f64>::zeros(m, 1);
+            for i in 0..m {
+                for j in 0..m {
+                    mm[(i, j)] = (0..n).map(|a| b[(a, i)] * kb[(a, j)]).sum::<f64>();
+                }
+                let c =
+                    border.targets[i] - border.columns[i].iter().zip(&nu).map(|(s, v)| s * v).sum::<f64>();
+                rz[(i, 0)] = (0..n).map(|a| b[(a, i)] * x[(a, 0)]).sum::<f64>() - c;
+            }
+            // a coordinate that no unknown of the step moves (nothing in contact holds it), or
+            // two that move the same rows alike
+            let scale: Vec<f64> =
+                (0..m).map(|j| (0..n).map(|a| b[(a, j)] * b[(a, j)] / diag[a]).sum::<f64>()).collect();
+            if scale.iter().any(|v| !(v.is_finite() && *v > 0.0)) {
                 return Err(singular());
             }
-            let zeta = ((0..n).map(|a| b[(a, 0)] * x[(a, 0)]).sum::<f64>() - c) / bkb;
-            for a in 0..n {
-                x[(a, 0)] -= zeta * kb[(a, 0)];
+            let mchol = mm.llt(faer::Side::Lower).map_err(|_| singular())?;
+            let lm = mchol.L();
+            if (0..m).any(|j| lm[(j, j)] * lm[(j, j)] <= PIVOT_TOL * scale[j]) {
+                return Err(singular());
             }
-            border.zeta = zeta;
-            for (gi, (g0, s)) in self.g.iter_mut().zip(border.g0.iter().zip(sigma)) {
-                *gi = g0 + s * zeta;
+            let zeta = mchol.solve(&rz);
+            for a in 0..n {
+                x[(a, 0)] -= (0..m).map(|j| kb[(a, j)] * zeta[(j, 0)]).sum::<f64>();
+            }
+            border.zeta = (0..m).map(|j| zeta[(j, 0)]).collect();
+            for (r, (gi, g0)) in self.g.iter_mut().zip(&border.g0).enumerate() {
+                *gi = g0 + border.columns.iter().zip(&border.zeta).map(|(c, z)| c[r] * z).sum::<f64>();
             }
         }
         if (0..n).any(|a| !x[(a, 0)].is_finite()) {
@@ -712,7 +733,7 @@ pub(crate) fn finish(
     report.stick = stick;
     report.slip = slip;
     report.linear_solves = state.iface.solves();
-    report.border_value = state.border.as_ref().map(|b| b.zeta);
+    report.border_values = state.border.as_ref().map_or_else(Vec::new, |b| b.zeta.clone());
     report.time_s = start.elapsed().as_secs_f64();
     tracing::debug!(
         solves = report.linear_solves,
@@ -773,7 +794,7 @@ pub(crate) fn stalled_but_kkt_converged(
     if state.border_residual(nu) > tolerance {
         return Ok(false);
     }
-    let shifted = state.border.as_ref().and_then(|b| problem.shifted_constraints(b.zeta));
+    let shifted = state.border.as_ref().and_then(|b| problem.shifted_constraints(&b.zeta));
     let kkt = match &shifted {
         Some((normal, friction)) => {
             let p = ContactProblem { normal, friction: friction.as_ref(), border: None, ..*problem };

@@ -640,6 +640,9 @@ pub struct NewtonSpec {
     pub geometry_relaxation: Option<Sp<f64>>,
     /// Finite strain: Aitken's dynamic relaxation of the rebuilds (default false).
     pub geometry_aitken: Option<Sp<bool>>,
+    /// Finite strain: the relative residual at which a pass ends while its geometry still
+    /// moves (default: each pass converges to `tolerance`).
+    pub geometry_pass_tolerance: Option<Sp<f64>>,
     /// The contact's active sets against the Newton iteration: `nested` (default),
     /// `combined`, `outer`.
     pub active_sets: Option<Sp<String>>,
