@@ -1275,6 +1275,13 @@ impl RigidDriver {
             let moved = zeta.iter().zip(&unit).map(|(d, u)| (d * u).abs()).fold(0.0, Real::max);
             let next: Vec<Real> = z.iter().zip(&zeta).map(|(a, d)| a + d).collect();
             if moved <= params.geometry_tolerance * length {
+                // the solution is that of the gaps followed to first order to `z + ζ` (within
+                // the geometry tolerance of the geometry built, as an accepted trial of the
+                // search): the bodies are there, and their balance is checked there (a
+                // rotation's axes and the moment's point move with the coordinates)
+                for (&(b, k), &v) in unknowns.iter().zip(&next) {
+                    self.q[b][k] = v;
+                }
                 let reactions = self.reactions(joint, &geometry, &record, &result, cx.t)?;
                 let error = unknowns
                     .iter()
@@ -1282,23 +1289,12 @@ impl RigidDriver {
                     .map(|(&(b, k), s)| (reactions[b][k] + values[b][k]).abs() / s)
                     .fold(0.0, Real::max);
                 if error <= params.tolerance {
-                    // the solution is that of the gaps followed to first order to `z + ζ`
-                    // (within the geometry tolerance of the geometry built, as an accepted
-                    // trial of the search): the bodies are there
-                    for (&(b, k), &v) in unknowns.iter().zip(&next) {
-                        self.q[b][k] = v;
-                    }
                     self.set_poses(joint);
                     stepper.contact_mut().set_gaps(&linear.at(&next))?;
                     accepted = Some((geometry, record, result));
-                } else {
-                    tracing::debug!(
-                        t = cx.t,
-                        error,
-                        "bordered force control: balance missed, trial solves take over"
-                    );
+                    break;
                 }
-                break;
+                tracing::debug!(t = cx.t, pass, error, "bordered force control: balance above the tolerance, another pass");
             }
             z = next;
         }
