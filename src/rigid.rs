@@ -1294,7 +1294,12 @@ impl RigidDriver {
                     accepted = Some((geometry, record, result));
                     break;
                 }
-                tracing::debug!(t = cx.t, pass, error, "bordered force control: balance above the tolerance, another pass");
+                tracing::debug!(
+                    t = cx.t,
+                    pass,
+                    error,
+                    "bordered force control: balance above the tolerance, another pass"
+                );
             }
             z = next;
         }
