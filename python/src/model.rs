@@ -828,6 +828,42 @@ impl PyModel {
             Ok(())
         })
     }
+    /// Parameters of the iteration that finds the force-controlled coordinates of rigid bodies
+    /// (docs/model.md §10): only the given ones change. `tolerance` in (0, 1): the relative
+    /// balance; `max_solves`: contact solves per level; `geometry_tolerance`: motion (relative to
+    /// the model size) before the contact geometry is rebuilt; `bordered=False`: the search over
+    /// trial solves instead of the coordinates solved inside the contact solve (the default);
+    /// `fresh_jacobian`: a fresh finite-difference Jacobian at every iterate of that search.
+    /// SynoviaError for a parameter out of range.
+    #[pyo3(signature = (*, tolerance = None, max_solves = None, geometry_tolerance = None, bordered = None, fresh_jacobian = None))]
+    fn force_control(
+        &mut self,
+        tolerance: Option<f64>,
+        max_solves: Option<usize>,
+        geometry_tolerance: Option<f64>,
+        bordered: Option<bool>,
+        fresh_jacobian: Option<bool>,
+    ) -> PyResult<()> {
+        if let Some(v) = tolerance.filter(|v| !(v.is_finite() && *v > 0.0 && *v < 1.0)) {
+            return Err(msg(format!("tolerance must lie in (0, 1), got {v}")));
+        }
+        if max_solves == Some(0) {
+            return Err(msg("max_solves must be at least 1".to_string()));
+        }
+        if let Some(v) = geometry_tolerance.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(msg(format!("geometry_tolerance must be positive and finite, got {v}")));
+        }
+        with_joint_mut!(self, j => {
+            let mut p = j.force_control_params();
+            if let Some(v) = tolerance { p.tolerance = v; }
+            if let Some(v) = max_solves { p.max_solves = v; }
+            if let Some(v) = geometry_tolerance { p.geometry_tolerance = v; }
+            if let Some(v) = bordered { p.bordered = v; }
+            if let Some(v) = fresh_jacobian { p.fresh_jacobian = v; }
+            j.force_control(p);
+            Ok(())
+        })
+    }
     /// Sets the density of a body (dynamic runs).
     fn set_density(&mut self, body: &Bound<'_, PyAny>, density: f64) -> PyResult<()> {
         with_joint_mut!(self, j => { let id = body_id(j, body)?; j.set_density(id, density).map_err(err)?; Ok(()) })

@@ -326,6 +326,21 @@ class Model:
         relaxation of the geometry passes, geometry_pass_tolerance for the relative residual at
         which a pass ends while its geometry still moves. SynoviaError for a parameter out of
         range."""
+    def force_control(
+        self,
+        *,
+        tolerance: Optional[float] = None,
+        max_solves: Optional[int] = None,
+        geometry_tolerance: Optional[float] = None,
+        bordered: Optional[bool] = None,
+        fresh_jacobian: Optional[bool] = None,
+    ) -> None:
+        """The iteration that finds the force-controlled coordinates of rigid bodies (only the
+        given parameters change): tolerance in (0, 1) for the relative balance, max_solves per
+        level, geometry_tolerance (relative to the model size) before the contact geometry is
+        rebuilt, bordered=False for the search over trial solves instead of the coordinates
+        solved inside the contact solve, fresh_jacobian for that search. SynoviaError for a
+        parameter out of range."""
     def set_density(self, body: BodyRef, density: float) -> None: ...
     def initial_velocity(self, body: BodyRef, velocity: ArrayLike) -> None: ...
     def contact(

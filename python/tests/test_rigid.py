@@ -222,6 +222,33 @@ def test_stl_rigid_body_with_friction_equals_scenario(ball_files):
     assert got.rigid_bodies()["ball"]["dofs"][0] == pytest.approx(0.02, abs=1e-15)
 
 
+def test_force_control_bordered_and_search_agree(ball_files):
+    """Model.force_control: the coordinate solved inside the contact solve (the default) and
+    the search over trial solves balance the 50 N at the same pose, the first in fewer solves;
+    bad parameters raise."""
+    sc = synovia.Model.from_scenario(ball_files / "ball.toml")
+
+    def run(**params):
+        m = copy_bodies(sc, {"block": MAT(1000.0, 0.3)})
+        m.clamp("block", "bottom")
+        m.add_rigid_body("ball", center=[0.0, 0.0, 1.5], force={"tz": -50.0})
+        shape = synovia.Shape.stl(ball_files / "ball_m.stl", scale=1000.0)
+        m.contact_rigid_body("ball-block", "block", "top", "ball", shape, friction=0.2, search_distance=0.3)
+        m.solver("pdas")
+        m.force_control(geometry_tolerance=1e-10, **params)
+        r = m.run_quasistatic([0.0, 0.5, 1.0])
+        return [(rec["rigid"][0]["dofs"][2], rec["rigid"][0]["solves"]) for rec in r.records]
+
+    bordered, search = run(), run(bordered=False)
+    for (zb, _), (zs, _) in zip(bordered, search):
+        assert zb == pytest.approx(zs, abs=1e-9)
+    assert sum(n for _, n in bordered) < sum(n for _, n in search)
+    m = synovia.Model(3)
+    for bad in (dict(tolerance=0.0), dict(tolerance=1.5), dict(max_solves=0), dict(geometry_tolerance=-1.0)):
+        with pytest.raises(synovia.SynoviaError):
+            m.force_control(**bad)
+
+
 def test_smoothed_stl_rigid_body_equals_scenario(ball_files):
     """subdivide / crease_angle_deg of Shape.stl equal the scenario keys (Loop-subdivided
     surface), and the smoothing changes the figures; bad levels raise SynoviaError."""

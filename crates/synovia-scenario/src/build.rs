@@ -387,6 +387,9 @@ pub fn build<const D: usize>(sc: &Scenario) -> R<Built<D>> {
     if let Some(n) = &doc.newton {
         newton(&cx, &mut joint, n)?;
     }
+    if let Some(f) = &doc.force_control {
+        force_control(&cx, &mut joint, f)?;
+    }
     quasi_and_dynamic_params(&cx, &mut joint, &doc.analysis)?;
     // missing data for Prescribed / Traction parts (e.g. Gmsh parts named `prescribed_*`)
     if let Err(e) = joint.model().validate() {
@@ -1815,6 +1818,41 @@ fn solver<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, s: &Sp<SolverS
         elastic.memory_limit = Some((mb * 1024.0 * 1024.0).min(u64::MAX as f64) as u64);
     }
     joint.elastic_params(elastic);
+    Ok(())
+}
+
+/// `[force_control]`: the parameters of the force-control iteration of rigid bodies.
+fn force_control<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, f: &Sp<ForceControlSpec>) -> R<()> {
+    let k = "force_control";
+    if joint.rigid_bodies().iter().all(|b| b.force_dofs().is_empty()) {
+        return Err(cx.err(
+            k,
+            f.span(),
+            "`[force_control]` sets the iteration of force-controlled degrees of freedom, but no rigid body has one (`tx = { force = … }` and the like)",
+        ));
+    }
+    let s = f.get_ref();
+    let mut p = joint.force_control_params();
+    if let Some(v) = &s.tolerance {
+        let x = cx.positive(v, "force_control.tolerance")?;
+        if x >= 1.0 {
+            return Err(cx.err("force_control.tolerance", v.span(), format!("must be below 1, got {x}")));
+        }
+        p.tolerance = x;
+    }
+    if let Some(v) = &s.max_solves {
+        p.max_solves = cx.at_least(v, "force_control.max_solves", 1)?;
+    }
+    if let Some(v) = &s.geometry_tolerance {
+        p.geometry_tolerance = cx.positive(v, "force_control.geometry_tolerance")?;
+    }
+    if let Some(v) = &s.bordered {
+        p.bordered = *v.get_ref();
+    }
+    if let Some(v) = &s.fresh_jacobian {
+        p.fresh_jacobian = *v.get_ref();
+    }
+    joint.force_control(p);
     Ok(())
 }
 

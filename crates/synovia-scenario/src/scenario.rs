@@ -313,6 +313,9 @@ pub struct ScenarioDoc {
     /// The Newton iteration of nonlinear models (`[newton]`: a nonlinear material or finite
     /// strain in some body).
     pub newton: Option<Sp<NewtonSpec>>,
+    /// The force-control iteration of rigid bodies (`[force_control]`: a force-controlled
+    /// degree of freedom in some rigid body).
+    pub force_control: Option<Sp<ForceControlSpec>>,
     /// The analysis.
     pub analysis: Sp<AnalysisSpec>,
     /// Output options.
@@ -646,6 +649,27 @@ pub struct NewtonSpec {
     /// The contact's active sets against the Newton iteration: `nested` (default),
     /// `combined`, `outer`.
     pub active_sets: Option<Sp<String>>,
+}
+
+/// `[force_control]`: the iteration that finds the force-controlled coordinates of rigid
+/// bodies (`synovia::rigid::ForceControlParams`; every key optional, the defaults those of
+/// `ForceControlParams::default()`).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForceControlSpec {
+    /// Relative balance `|Q_k + F_k| ≤ tolerance × scale` (default 1e-10).
+    pub tolerance: Option<Sp<f64>>,
+    /// Contact solves per level (default 60).
+    pub max_solves: Option<Sp<usize>>,
+    /// Motion from the pose the geometry was built at, relative to the model size, before it
+    /// is rebuilt (default 1e-6).
+    pub geometry_tolerance: Option<Sp<f64>>,
+    /// The coordinates solved inside the contact solve (default true; false: the search over
+    /// trial solves).
+    pub bordered: Option<Sp<bool>>,
+    /// Several coordinates, search over trial solves: a fresh finite-difference Jacobian at
+    /// every accepted iterate (default false: Broyden updates).
+    pub fresh_jacobian: Option<Sp<bool>>,
 }
 
 /// The exponential static-to-kinetic friction law (dynamic runs).
