@@ -1171,20 +1171,41 @@ impl RigidDriver {
         stepper.set_record_strain_energy(true);
         let geometry = outcome?;
         self.jacobian = jac;
-        for (bi, body) in bodies.iter().enumerate() {
+        let Some((_, level)) = best.take() else {
+            return Err(JointError::Invalid("internal: no solve".into()));
+        };
+        self.accept_level(joint, &geometry, level, &values, t, solves)
+    }
+
+    /// Ends a level of the linear path at the accepted solve `level`: the offsets of the
+    /// coordinates' guesses kept for the next level, the strain energy (switched off during the
+    /// trials) and the rigid bodies' figures recorded, the coordinates accepted.
+    fn accept_level<const D: usize>(
+        &mut self,
+        joint: &JointModel<D>,
+        geometry: &ContactGeometry<D>,
+        (mut record, result): Level<D>,
+        values: &[Vec<Real>],
+        t: Real,
+        solves: usize,
+    ) -> Result<Level<D>, JointError> {
+        self.keep_guess_offsets(joint, t);
+        record.strain_energy = synovia_fem::post::total_strain_energy(joint.model(), &result.displacement)?;
+        let record = self.finish(joint, geometry, record, &result, values, t, solves)?;
+        self.accepted = Some(self.q.clone());
+        Ok((record, result))
+    }
+
+    /// `q_k − guess_k(t)` of every force-controlled coordinate with a guess: the offset that
+    /// starts the next level.
+    fn keep_guess_offsets<const D: usize>(&mut self, joint: &JointModel<D>, t: Real) {
+        for (bi, body) in joint.rigid_bodies().iter().enumerate() {
             for (k, c) in body.controls.iter().enumerate() {
                 if let DofControl::Force { guess: Some(g), .. } = c {
                     self.offset[bi][k] = self.q[bi][k] - g.value(t);
                 }
             }
         }
-        let Some((_, (mut record, result))) = best.take() else {
-            return Err(JointError::Invalid("internal: no solve".into()));
-        };
-        record.strain_energy = synovia_fem::post::total_strain_energy(model, &result.displacement)?;
-        let record = self.finish(joint, &geometry, record, &result, &values, t, solves)?;
-        self.accepted = Some(self.q.clone());
-        Ok((record, result))
     }
 
     /// One level with the force-controlled coordinates `z` solved with the contact conditions
@@ -1304,20 +1325,10 @@ impl RigidDriver {
             z = next;
         }
         stepper.set_record_strain_energy(true);
-        let Some((geometry, mut record, result)) = accepted else {
+        let Some((geometry, record, result)) = accepted else {
             return Ok(None);
         };
-        for (bi, body) in joint.rigid_bodies().iter().enumerate() {
-            for (kk, c) in body.controls.iter().enumerate() {
-                if let DofControl::Force { guess: Some(g), .. } = c {
-                    self.offset[bi][kk] = self.q[bi][kk] - g.value(cx.t);
-                }
-            }
-        }
-        record.strain_energy = synovia_fem::post::total_strain_energy(joint.model(), &result.displacement)?;
-        let record = self.finish(joint, &geometry, record, &result, values, cx.t, *solves)?;
-        self.accepted = Some(self.q.clone());
-        Ok(Some((record, result)))
+        self.accept_level(joint, &geometry, (record, result), values, cx.t, *solves).map(Some)
     }
 
     /// The level's start: the control values `h_k(t)`, `F_k(t)` of every rigid body, the
@@ -1415,13 +1426,7 @@ impl RigidDriver {
             }
         };
         self.set_poses(joint);
-        for (bi, body) in bodies.iter().enumerate() {
-            for (k, c) in body.controls.iter().enumerate() {
-                if let DofControl::Force { guess: Some(g), .. } = c {
-                    self.offset[bi][k] = self.q[bi][k] - g.value(t);
-                }
-            }
-        }
+        self.keep_guess_offsets(joint, t);
         let geometry = nl.geometry();
         let record = StepRecord {
             time: t,

@@ -49,6 +49,26 @@ pub(crate) fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |a, b| a.max(b.abs()))
 }
 
+/// [`check_kkt`] of a solution of a problem with a [`crate::RigidBorder`] at the offsets
+/// `g + Σ_j σ_j ζ_j` of the coordinates `ζ` it found ([`ContactProblem::shifted_constraints`]);
+/// without a border or with an empty `ζ`, [`check_kkt`] of the problem as given.
+pub fn check_kkt_at_border(
+    problem: &ContactProblem<'_>,
+    zeta: &[f64],
+    u: &[f64],
+    lambda_n: &[f64],
+    lambda_t: &[f64],
+) -> KktReport {
+    let shifted = if zeta.is_empty() { None } else { problem.shifted_constraints(zeta) };
+    match &shifted {
+        Some((normal, friction)) => {
+            let p = ContactProblem { normal, friction: friction.as_ref(), border: None, ..*problem };
+            check_kkt(&p, u, lambda_n, lambda_t)
+        }
+        None => check_kkt(problem, u, lambda_n, lambda_t),
+    }
+}
+
 /// Evaluates the KKT conditions of docs/model.md §5 for `(U, Λ_n, Λ_t)`.
 ///
 /// A solution whose vectors do not fit the problem (e.g. the empty `U` of a multipliers-only

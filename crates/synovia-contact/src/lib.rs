@@ -48,7 +48,7 @@ pub use error::{ContactError, IterationResidual};
 pub use friction::{
     project_on_disc, slip_speeds, ConstantFriction, ExponentialFriction, FrictionLaw, PairFrictionLaws,
 };
-pub use kkt::{check_kkt, KktReport};
+pub use kkt::{check_kkt, check_kkt_at_border, KktReport};
 pub use problem::{ContactProblem, FrictionConstraints, Interface, NormalConstraints, RigidBorder};
 pub use solver::{ContactParams, ContactSolution, ContactSolver, SolverReport};
 pub use static_contact::{CoordinateBorder, StaticContact, StaticContactResult};

@@ -12,7 +12,7 @@ use synovia_mesh::math::{Real, Vector};
 
 use crate::context::SolveContext;
 use crate::error::ContactError;
-use crate::kkt::{check_kkt, inf_norm, KktReport};
+use crate::kkt::{check_kkt, check_kkt_at_border, inf_norm, KktReport};
 use crate::operators::{BodyPlacement, ContactGeometry, ContactPair, GeometryCache};
 use crate::problem::{ContactProblem, FrictionConstraints, NormalConstraints, RigidBorder};
 use crate::solver::{ContactSolution, ContactSolver, SolverReport};
@@ -55,7 +55,7 @@ pub struct StaticContact<const D: usize> {
 /// the equilibrium `Q(ν) = Σ_r (∂d_r/∂z) κ_r Λ_n,r + Σ_c (∂s_c/∂z) Λ_t,c = target`
 /// (`target = −F` for the force `F` applied along `z`). The gaps and shifts are taken at
 /// `z₀` (the coordinate they were built or set at); the solve returns `ζ = z − z₀` in
-/// [`crate::SolverReport::border_value`], and its solution is that of the gaps `d + (∂d/∂z) ζ`.
+/// [`crate::SolverReport::border_values`], and its solution is that of the gaps `d + (∂d/∂z) ζ`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CoordinateBorder<const D: usize> {
     /// `∂d_r/∂z` per contact node.
@@ -649,7 +649,13 @@ impl<const D: usize> StaticContact<D> {
             nu.extend_from_slice(&solution.lambda_t);
             solution.u = crate::problem::Interface::new(problem, &context)?.displacement(&nu)?;
         }
-        let kkt = check_kkt_at_border(&problem, &solution);
+        let kkt = check_kkt_at_border(
+            &problem,
+            &solution.report.border_values,
+            &solution.u,
+            &solution.lambda_n,
+            &solution.lambda_t,
+        );
         self.finish(solution, kkt, &lifts, friction_op, 0, 0)
     }
 
@@ -714,7 +720,13 @@ impl<const D: usize> StaticContact<D> {
             if multipliers_only {
                 return Ok(Solved::Multipliers(Box::new(solution), it));
             }
-            let kkt = check_kkt_at_border(&problem, &solution);
+            let kkt = check_kkt_at_border(
+                &problem,
+                &solution.report.border_values,
+                &solution.u,
+                &solution.lambda_n,
+                &solution.lambda_t,
+            );
             return self.finish(solution, kkt, &lifts, friction_op, it, 0).map(Solved::full);
         };
         if border.is_some() {
@@ -1016,7 +1028,7 @@ struct Assembled<const D: usize> {
     lifts: Vec<Vector<D>>,
     normal: NormalConstraints,
     friction_op: Option<crate::operators::FrictionOperator>,
-    /// The coordinate border on these rows ([`StaticContact::set_coordinate_border`]).
+    /// The coordinate borders on these rows ([`StaticContact::set_coordinate_borders`]).
     border: Option<RigidBorder>,
 }
 
@@ -1133,23 +1145,6 @@ fn restrict_adjacency(adjacency: &[Vec<usize>], rows: &[usize], m: usize) -> Vec
             })
         })
         .collect()
-}
-
-/// [`check_kkt`] of a solution; for a bordered problem at the offsets of the coordinate the
-/// solve found, `g + σ ζ` ([`ContactProblem::shifted_constraints`]).
-fn check_kkt_at_border(problem: &ContactProblem<'_>, solution: &ContactSolution) -> KktReport {
-    let shifted = if solution.report.border_values.is_empty() {
-        None
-    } else {
-        problem.shifted_constraints(&solution.report.border_values)
-    };
-    match &shifted {
-        Some((normal, friction)) => {
-            let p = ContactProblem { normal, friction: friction.as_ref(), border: None, ..*problem };
-            check_kkt(&p, &solution.u, &solution.lambda_n, &solution.lambda_t)
-        }
-        None => check_kkt(problem, &solution.u, &solution.lambda_n, &solution.lambda_t),
-    }
 }
 
 /// The report of a screened solve: counts and times of all passes, states of the last one.

@@ -794,13 +794,6 @@ pub(crate) fn stalled_but_kkt_converged(
     if state.border_residual(nu) > tolerance {
         return Ok(false);
     }
-    let shifted = state.border.as_ref().and_then(|b| problem.shifted_constraints(&b.zeta));
-    let kkt = match &shifted {
-        Some((normal, friction)) => {
-            let p = ContactProblem { normal, friction: friction.as_ref(), border: None, ..*problem };
-            synovia_contact::check_kkt(&p, &u, &lambda_n, &lambda_t)
-        }
-        None => synovia_contact::check_kkt(problem, &u, &lambda_n, &lambda_t),
-    };
-    Ok(kkt.max() <= tolerance)
+    let zeta = state.border.as_ref().map_or(&[][..], |b| &b.zeta[..]);
+    Ok(synovia_contact::check_kkt_at_border(problem, zeta, &u, &lambda_n, &lambda_t).max() <= tolerance)
 }
