@@ -283,11 +283,13 @@ impl<const D: usize> DofMap<D> {
     /// dependent constraints agree.
     pub fn lifts(&self, model: &Model<D>, t: Real) -> Result<Vec<Vector<D>>, FemError> {
         let mut out = vec![Vector::<D>::zeros(); self.groups.len()];
+        // buffers reused across the groups: the constrained values, their projections
+        let (mut g, mut proj): (Vec<Real>, Vec<Real>) = (Vec::new(), Vec::new());
         for (gi, grp) in self.groups.iter().enumerate() {
             if grp.constraints.is_empty() {
                 continue;
             }
-            let mut g = Vec::with_capacity(grp.constraints.len());
+            g.clear();
             for c in &grp.constraints {
                 g.push(match c.value {
                     ConstraintValue::Zero => 0.0,
@@ -307,8 +309,8 @@ impl<const D: usize> DofMap<D> {
                     }
                 });
             }
-            let proj: Vec<Real> =
-                grp.ortho.iter().map(|(_, l)| l.iter().zip(&g).map(|(a, b)| a * b).sum()).collect();
+            proj.clear();
+            proj.extend(grp.ortho.iter().map(|(_, l)| l.iter().zip(&g).map(|(a, b)| a * b).sum::<Real>()));
             for (j, alpha) in &grp.dependent {
                 let pred: Real = alpha.iter().zip(&proj).map(|(a, b)| a * b).sum();
                 let scale = pred.abs().max(g[*j].abs());

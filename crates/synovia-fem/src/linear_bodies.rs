@@ -59,32 +59,19 @@ struct LinearBody<const D: usize> {
 }
 
 impl<const D: usize> LinearBody<D> {
-    /// `K_b` of body `b` (small strain, constant stiffness `c`).
-    fn build(model: &Model<D>, b: usize, c: VoigtMatrix) -> Result<Self, FemError> {
+    /// `K_b` of body `b` (small strain, constant stiffness `c`); on the pattern of `previous`
+    /// when that was built on the same cells (a mesh moved in place keeps its node graph).
+    fn build(model: &Model<D>, b: usize, c: VoigtMatrix, previous: Option<Self>) -> Result<Self, FemError> {
         let body = &model.bodies()[b];
         let mesh = &body.mesh;
-        let nn = mesh.n_nodes();
-        // the node graph of the cells, each node with its neighbours (itself included)
-        let mut adj: Vec<Vec<usize>> = (0..nn).map(|i| vec![i]).collect();
-        for cell in mesh.cells() {
-            for &p in cell {
-                adj[p].extend_from_slice(cell);
+        let mut k = match previous.filter(|p| p.cells.as_slice() == mesh.cells_flat()) {
+            Some(p) => {
+                let mut k = p.k;
+                k.zero();
+                k
             }
-        }
-        let columns: Vec<Vec<usize>> = (0..D * nn)
-            .map(|col| {
-                let a = col / D;
-                let mut rows: Vec<usize> = adj[a]
-                    .iter()
-                    .flat_map(|&q| (0..D).map(move |k| D * q + k))
-                    .filter(|&r| r >= col)
-                    .collect();
-                rows.sort_unstable();
-                rows.dedup();
-                rows
-            })
-            .collect();
-        let mut k = SymmetricMatrix::from_columns(D * nn, columns)?;
+            None => Self::pattern(mesh)?,
+        };
         let n = D * (D + 1);
         let (u0, mut fe, mut ke) = (vec![0.0; n], vec![0.0; n], vec![0.0; n * n]);
         for ci in 0..mesh.n_cells() {
@@ -117,6 +104,32 @@ impl<const D: usize> LinearBody<D> {
             }
         }
         Ok(Self { nodes: mesh.nodes().to_vec(), cells: mesh.cells_flat().to_vec(), c, k })
+    }
+
+    /// The pattern of `K_b`: the node graph of the cells, every node coupled to itself and
+    /// its neighbours in all `D` components (lower triangle).
+    fn pattern(mesh: &synovia_mesh::Mesh<D>) -> Result<SymmetricMatrix, FemError> {
+        let nn = mesh.n_nodes();
+        let mut adj: Vec<Vec<usize>> = (0..nn).map(|i| vec![i]).collect();
+        for cell in mesh.cells() {
+            for &p in cell {
+                adj[p].extend_from_slice(cell);
+            }
+        }
+        let columns: Vec<Vec<usize>> = (0..D * nn)
+            .map(|col| {
+                let a = col / D;
+                let mut rows: Vec<usize> = adj[a]
+                    .iter()
+                    .flat_map(|&q| (0..D).map(move |k| D * q + k))
+                    .filter(|&r| r >= col)
+                    .collect();
+                rows.sort_unstable();
+                rows.dedup();
+                rows
+            })
+            .collect();
+        Ok(SymmetricMatrix::from_columns(D * nn, columns)?)
     }
 
     /// `K_b` is that of body `b` of `model` as it is now.
@@ -180,7 +193,8 @@ impl<const D: usize> LinearBodies<D> {
             if self.bodies[b].as_ref().is_some_and(|l| l.fits(model, b)) {
                 continue;
             }
-            self.bodies[b] = Some(LinearBody::build(model, b, c)?);
+            let previous = self.bodies[b].take();
+            self.bodies[b] = Some(LinearBody::build(model, b, c, previous)?);
             self.tangent = None;
         }
         Ok(())

@@ -31,7 +31,6 @@
 //! An element whose `det F ≤ 0` or whose material returns a non-finite stress is reported as
 //! [`FemError::InvertedElement`]; the nonlinear solvers treat it as a failed step and cut it back.
 
-use nalgebra::DMatrix;
 use synovia_linalg::SymmetricMatrix;
 use synovia_material::{Material, VoigtVector};
 use synovia_mesh::math::{det, Real, Tensor, Vector};
@@ -139,8 +138,9 @@ pub fn element_response<const D: usize>(
         return Err(ElementFailure { det_f });
     }
     let strain = VoigtVector::from_vec(strain_measure::<D>(kinematics, &grad_u));
-    let stress = material.stress(&strain);
-    let energy = material.energy_density(&strain) * geo.measure;
+    // the stress, energy and (if asked) tangent of one evaluation of the material
+    let (stress, energy_density, material_tangent) = material.response(&strain, tangent.is_some());
+    let energy = energy_density * geo.measure;
     if stress.iter().any(|v| !v.is_finite()) || !energy.is_finite() {
         return Err(ElementFailure { det_f });
     }
@@ -148,7 +148,11 @@ pub fn element_response<const D: usize>(
     let nv = pr.len();
     // B (nv × n): rows of δe for each nodal dof (a, i)
     let mut b = [[0.0; 12]; 6];
-    let grads: Vec<Vector<D>> = (0..=D).map(|a| geo.grad(a)).collect();
+    let mut grads = [Vector::<D>::zeros(); 4];
+    for (a, g) in grads.iter_mut().enumerate().take(D + 1) {
+        *g = geo.grad(a);
+    }
+    let grads = &grads[..=D];
     for (a, g) in grads.iter().enumerate() {
         for i in 0..D {
             for (r, &(jj, kk)) in pr.iter().enumerate() {
@@ -166,8 +170,7 @@ pub fn element_response<const D: usize>(
     for (q, fq) in force.iter_mut().enumerate().take(n) {
         *fq = geo.measure * (0..nv).map(|r| b[r][q] * stress[r]).sum::<Real>();
     }
-    if let Some(kt) = tangent {
-        let c: DMatrix<Real> = material.tangent(&strain);
+    if let (Some(kt), Some(c)) = (tangent, material_tangent) {
         if c.iter().any(|v| !v.is_finite()) {
             return Err(ElementFailure { det_f });
         }

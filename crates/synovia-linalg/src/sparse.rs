@@ -93,7 +93,12 @@ impl SymmetricMatrix {
 
     /// Diagonal.
     pub fn diagonal(&self) -> Vec<f64> {
-        (0..self.n()).map(|j| self.get(j, j)).collect()
+        // rows sorted within a column of the lower triangle: the diagonal entry comes first
+        let cp = self.pattern.col_ptr();
+        let ri = self.pattern.row_idx();
+        (0..self.n())
+            .map(|j| if cp[j] < cp[j + 1] && ri[cp[j]] == j { self.values[cp[j]] } else { 0.0 })
+            .collect()
     }
 
     /// `y = A x` for the full symmetric matrix.

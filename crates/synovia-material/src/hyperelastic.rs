@@ -297,6 +297,22 @@ impl<E: InvariantEnergy> Hyperelastic<E> {
     }
 
     /// `𝕔_ijkl = ∂S_ij/∂E_kl` (module docs).
+    /// The Voigt tangent `∂S/∂E` at `a` over the index pairs `pairs`.
+    fn tangent_at(&self, a: &AtC, pairs: &[(usize, usize)]) -> VoigtMatrix {
+        let n = pairs.len();
+        let w = self.energy.gradient(&a.inv);
+        let h = self.energy.hessian(&a.inv);
+        let mut t = VoigtMatrix::zeros(n, n);
+        for (r, &(i, j)) in pairs.iter().enumerate() {
+            for (s, &(k, l)) in pairs.iter().enumerate() {
+                t[(r, s)] = self.tangent_entry(a, &w, &h, (i, j, k, l));
+            }
+        }
+        // symmetric by construction; remove rounding asymmetry
+        let tt = t.transpose();
+        (t + tt) * 0.5
+    }
+
     fn tangent_entry(
         &self,
         a: &AtC,
@@ -339,17 +355,24 @@ impl<E: InvariantEnergy, const D: usize> Material<D> for Hyperelastic<E> {
         let Some(a) = cauchy_green(D, strain).and_then(|c| at_c(&c)) else {
             return VoigtMatrix::from_element(n, n, f64::NAN);
         };
-        let w = self.energy.gradient(&a.inv);
-        let h = self.energy.hessian(&a.inv);
-        let mut t = VoigtMatrix::zeros(n, n);
-        for (r, &(i, j)) in pairs.iter().enumerate() {
-            for (s, &(k, l)) in pairs.iter().enumerate() {
-                t[(r, s)] = self.tangent_entry(&a, &w, &h, (i, j, k, l));
-            }
-        }
-        // symmetric by construction; remove rounding asymmetry
-        let tt = t.transpose();
-        (t + tt) * 0.5
+        self.tangent_at(&a, pairs)
+    }
+
+    /// One evaluation of the invariants and `C⁻¹` for the stress, the energy and the tangent
+    /// (the same values as the three separate calls).
+    fn response(&self, strain: &VoigtVector, with_tangent: bool) -> (VoigtVector, f64, Option<VoigtMatrix>) {
+        let n = D * (D + 1) / 2;
+        let (Some(pairs), Some(a)) = (voigt_pairs(D).ok(), cauchy_green(D, strain).and_then(|c| at_c(&c)))
+        else {
+            return (
+                VoigtVector::from_element(n, f64::NAN),
+                f64::NAN,
+                with_tangent.then(|| VoigtMatrix::from_element(n, n, f64::NAN)),
+            );
+        };
+        let s = self.stress_at(&a);
+        let stress = VoigtVector::from_iterator(n, pairs.iter().map(|&(i, j)| s[(i, j)]));
+        (stress, self.energy.energy(&a.inv), with_tangent.then(|| self.tangent_at(&a, pairs)))
     }
 
     fn energy_density(&self, strain: &VoigtVector) -> f64 {

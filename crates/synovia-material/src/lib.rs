@@ -142,6 +142,15 @@ pub trait Material<const D: usize>: Send + Sync + std::fmt::Debug {
         0.0
     }
 
+    /// The stress, the energy density and, if `with_tangent`, the tangent at one strain: what
+    /// an element's response needs, `(τ(e), Φ(e), ∂τ/∂e)`, in one call. The default calls
+    /// [`Self::stress`], [`Self::energy_density`] and [`Self::tangent`]; a law whose three
+    /// share their work (the invariants and `C⁻¹` of a hyperelastic law) overrides it with
+    /// the same values.
+    fn response(&self, strain: &VoigtVector, with_tangent: bool) -> (VoigtVector, f64, Option<VoigtMatrix>) {
+        (self.stress(strain), self.energy_density(strain), with_tangent.then(|| self.tangent(strain)))
+    }
+
     /// A short human-readable name.
     fn name(&self) -> String;
 }

@@ -400,11 +400,26 @@ impl<const D: usize> Mesh<D> {
 
     /// Moves every node by `f(x)`. Fails (leaving the mesh unchanged) if a cell becomes
     /// inverted, degenerate, or a coordinate non-finite.
+    ///
+    /// The cells and boundary parts are kept: with every cell still positively oriented, the
+    /// facets' sharing and their induced orientations (what [`Self::check_conformity`]
+    /// checks, and the boundary facets' outward node order) depend on the cells alone, so the
+    /// conformity of the mesh and its facet index carry over.
     pub fn map_nodes(&mut self, f: impl Fn(&Point<D>) -> Point<D>) -> Result<(), MeshError> {
         let new_nodes: Vec<Point<D>> = self.nodes.iter().map(f).collect();
-        let candidate = Self::new(new_nodes, self.cells.clone())?;
-        self.nodes = candidate.nodes;
-        self.facet_index = FacetIndex::default();
+        if let Some(node) = new_nodes.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
+            return Err(MeshError::NonFiniteNode { node });
+        }
+        let old = std::mem::replace(&mut self.nodes, new_nodes);
+        for c in 0..self.n_cells() {
+            let error = match self.cell_orientation(c) {
+                CellOrientation::Positive => continue,
+                CellOrientation::Inverted(det) => MeshError::InvertedCell { cell: c, det },
+                CellOrientation::Degenerate(det) => MeshError::DegenerateCell { cell: c, det },
+            };
+            self.nodes = old;
+            return Err(error);
+        }
         Ok(())
     }
 

@@ -691,8 +691,9 @@ impl Knee2d {
             .with_geometry_relaxation(0.9)
             .with_geometry_aitken(true)
             .with_geometry_pass_tolerance(Some(1e-3))
+            .with_settled_increment(Some(1e-4))
             .with_max_geometry_passes(60)
-            .with_tangent_reuse(Some(0.5))
+            .with_tangent_reuse(Some(0.7))
     }
 
     /// The model of [`Knee2d::model`] at the pose `time` with both cartilage layers (the layers

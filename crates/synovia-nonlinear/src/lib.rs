@@ -138,6 +138,14 @@ pub struct NewtonParams {
     /// geometry has not settled yet (default `None`: [`Self::tolerance`]); the last pass is
     /// always converged to [`Self::tolerance`].
     pub geometry_pass_tolerance: Option<Real>,
+    /// Finite strain: once the contact geometry has settled (the first step after its last
+    /// rebuild moved the solution by at most [`Self::geometry_tolerance`]), the iteration also
+    /// ends at a full step whose relative increment `‖Δu‖ / ‖u‖` is at most this (default
+    /// `None`: only [`Self::tolerance`] ends it). The answer carries the geometry's error of
+    /// up to [`Self::geometry_tolerance`] anyway, so a value well below it (e.g. a tenth)
+    /// stops the equilibrium iteration where further steps no longer change the answer at
+    /// that accuracy (docs/nonlinear.md, "Stopping the last pass").
+    pub settled_increment: Option<Real>,
     /// How the contact's active sets are iterated against the material's Newton iteration
     /// (default [`ActiveSetStrategy::Nested`]).
     pub active_sets: ActiveSetStrategy,
@@ -231,6 +239,7 @@ impl Default for NewtonParams {
             tangent_reuse: None,
             geometry_aitken: false,
             geometry_pass_tolerance: None,
+            settled_increment: None,
             active_sets: ActiveSetStrategy::Nested,
             linear_bodies_by_stiffness: true,
         }
@@ -277,6 +286,11 @@ impl NewtonParams {
     /// Sets [`Self::geometry_pass_tolerance`].
     pub fn with_geometry_pass_tolerance(mut self, tolerance: Option<Real>) -> Self {
         self.geometry_pass_tolerance = tolerance;
+        self
+    }
+    /// Sets [`Self::settled_increment`].
+    pub fn with_settled_increment(mut self, increment: Option<Real>) -> Self {
+        self.settled_increment = increment;
         self
     }
     /// Sets [`Self::max_geometry_passes`].
@@ -332,6 +346,13 @@ impl NewtonParams {
             if !(p > 0.0 && p < 1.0) {
                 return Err(NonlinearError::InvalidParameter(format!(
                     "the pass tolerance of the geometry fixed point must lie in (0, 1), got {p}"
+                )));
+            }
+        }
+        if let Some(d) = self.settled_increment {
+            if !(d > 0.0 && d < 1.0) {
+                return Err(NonlinearError::InvalidParameter(format!(
+                    "the increment that ends the iteration on a settled geometry must lie in (0, 1), got {d}"
                 )));
             }
         }
@@ -2136,10 +2157,16 @@ impl<const D: usize> NonlinearContact<D> {
                         && h.normal <= self.params.tolerance
                         && h.tangential <= self.params.tolerance
                 });
+            // finite strain on a settled geometry: a full step below the settled increment
+            let settled_step = finite
+                && alpha == 1.0
+                && pass_increment <= self.params.geometry_tolerance
+                && self.params.settled_increment.is_some_and(|d| increment <= d);
             let equilibrium = relative <= self.params.tolerance
                 || force_scale == 0.0
                 || (alpha == 1.0 && increment <= self.params.tolerance)
-                || (tiny && alpha == 1.0);
+                || (tiny && alpha == 1.0)
+                || settled_step;
             let converged = contact_settled && equilibrium;
             // a pass whose geometry is still moving ends at the looser pass tolerance
             let pass_converged = converged
