@@ -218,3 +218,23 @@ impl SymmetricMatrix {
         Ok(s)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The diagonal read from the first entry of each column equals `get(j, j)`, with a zero
+    /// where a column stores no diagonal entry.
+    #[test]
+    fn diagonal_equals_the_entries_and_is_zero_where_not_stored() {
+        // column 1 holds only row 2: no diagonal entry
+        let mut a = SymmetricMatrix::from_columns(3, vec![vec![0, 2], vec![2], vec![2]]).expect("pattern");
+        a.add(0, 0, 4.0).expect("in pattern");
+        a.add(2, 0, -1.5).expect("in pattern");
+        a.add(1, 2, 0.5).expect("in pattern");
+        a.add(2, 2, 3.0).expect("in pattern");
+        let want: Vec<f64> = (0..3).map(|j| a.get(j, j)).collect();
+        assert_eq!(a.diagonal(), want);
+        assert_eq!(a.diagonal(), vec![4.0, 0.0, 3.0]);
+    }
+}

@@ -406,6 +406,43 @@ mod tests {
         VoigtVector::from_row_slice(&v)
     }
 
+    /// `response` evaluates the invariants once and returns the stress, energy and tangent of
+    /// the three separate calls, to the last bit, in 2D and 3D, for both laws; outside the
+    /// domain (`det C ≤ 0`) all three are NaN.
+    #[test]
+    fn response_equals_the_separate_calls_bit_for_bit() {
+        fn check<const D: usize>(law: &dyn Material<D>, strain: &VoigtVector) {
+            let (stress, energy, tangent) = law.response(strain, true);
+            let want = (law.stress(strain), law.energy_density(strain), law.tangent(strain));
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(stress.as_slice()), bits(want.0.as_slice()), "stress");
+            assert_eq!(energy.to_bits(), want.1.to_bits(), "energy");
+            let tangent = tangent.expect("asked for");
+            assert_eq!(bits(tangent.as_slice()), bits(want.2.as_slice()), "tangent");
+            let (_, _, none) = law.response(strain, false);
+            assert!(none.is_none());
+        }
+        let nh = neo_hookean(10.0, 0.45).expect("test data");
+        let mr = mooney_rivlin(1.2, 0.4, 30.0).expect("test data");
+        let s2 = VoigtVector::from_row_slice(&[-0.21, 0.07, 0.13]);
+        let s3 = strain3([-0.18, 0.05, 0.02, 0.04, -0.03, 0.11]);
+        check::<2>(&nh, &s2);
+        check::<2>(&mr, &s2);
+        check::<3>(&nh, &s3);
+        check::<3>(&mr, &s3);
+        // det C ≤ 0: E_xx = −0.6 gives C_xx = −0.2
+        let (stress, energy, tangent) = <Hyperelastic<NeoHookean> as Material<2>>::response(
+            &nh,
+            &VoigtVector::from_row_slice(&[-0.6, 0.0, 0.0]),
+            true,
+        );
+        assert!(stress.iter().all(|v| v.is_nan()) && energy.is_nan());
+        assert!(tangent.is_some_and(|t| t.iter().all(|v| v.is_nan())));
+        // the default of the trait (a linear law) is the three calls as well
+        let lin = crate::plane_strain(10.0, 0.3).expect("test data");
+        check::<2>(&lin, &s2);
+    }
+
     #[test]
     fn linearisation_at_zero_strain_is_isotropic_elasticity() {
         let nh = neo_hookean(1000.0, 0.3).expect("test data");

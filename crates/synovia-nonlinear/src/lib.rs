@@ -325,7 +325,8 @@ impl NewtonParams {
     }
 
     /// Checks the parameters: tolerances in (0, 1), at least one iteration, the relaxation in
-    /// (0, 1], the contraction bound of tangent reuse in (0, 1), a positive geometry tolerance.
+    /// (0, 1], the contraction bound of tangent reuse in (0, 1), a positive geometry tolerance,
+    /// the pass tolerance and the settled increment in (0, 1).
     ///
     /// # Errors
     /// [`NonlinearError::InvalidParameter`] naming the first parameter out of its range.
@@ -352,7 +353,7 @@ impl NewtonParams {
         if let Some(d) = self.settled_increment {
             if !(d > 0.0 && d < 1.0) {
                 return Err(NonlinearError::InvalidParameter(format!(
-                    "the increment that ends the iteration on a settled geometry must lie in (0, 1), got {d}"
+                    "the settled increment (a full step that ends the iteration on a settled geometry) must lie in (0, 1), got {d}"
                 )));
             }
         }
