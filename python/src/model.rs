@@ -779,8 +779,10 @@ impl PyModel {
     /// fresh tangent at every iteration (the default); `geometry`: `"converged"`, `"per_level"` or
     /// `"reference"`; `geometry_aitken`: Aitken's relaxation of the geometry passes;
     /// `geometry_pass_tolerance`: the relative residual at which a pass ends while its geometry
-    /// still moves. Checked as a whole (SynoviaError naming the parameter out of range).
-    #[pyo3(signature = (*, tolerance = None, max_iterations = None, line_search = None, max_cutbacks = None, tangent_reuse = None, fresh_tangent = false, geometry = None, geometry_tolerance = None, max_geometry_passes = None, geometry_relaxation = None, geometry_aitken = None, geometry_pass_tolerance = None))]
+    /// still moves; `settled_increment`: once the geometry has settled, a full step of at most
+    /// this relative size ends the iteration. Checked as a whole (SynoviaError naming the
+    /// parameter out of range).
+    #[pyo3(signature = (*, tolerance = None, max_iterations = None, line_search = None, max_cutbacks = None, tangent_reuse = None, fresh_tangent = false, geometry = None, geometry_tolerance = None, max_geometry_passes = None, geometry_relaxation = None, geometry_aitken = None, geometry_pass_tolerance = None, settled_increment = None))]
     #[allow(clippy::too_many_arguments)]
     fn newton_params(
         &mut self,
@@ -796,6 +798,7 @@ impl PyModel {
         geometry_relaxation: Option<f64>,
         geometry_aitken: Option<bool>,
         geometry_pass_tolerance: Option<f64>,
+        settled_increment: Option<f64>,
     ) -> PyResult<()> {
         use synovia::nonlinear::GeometryUpdate;
         let update = match geometry {
@@ -823,6 +826,7 @@ impl PyModel {
             if let Some(v) = geometry_relaxation { p = p.with_geometry_relaxation(v); }
             if let Some(v) = geometry_aitken { p = p.with_geometry_aitken(v); }
             if let Some(v) = geometry_pass_tolerance { p = p.with_geometry_pass_tolerance(Some(v)); }
+            if let Some(v) = settled_increment { p = p.with_settled_increment(Some(v)); }
             p.check().map_err(err)?;
             j.newton_params(p);
             Ok(())

@@ -319,13 +319,15 @@ class Model:
         geometry_relaxation: Optional[float] = None,
         geometry_aitken: Optional[bool] = None,
         geometry_pass_tolerance: Optional[float] = None,
+        settled_increment: Optional[float] = None,
     ) -> None:
         """The Newton iteration of nonlinear models (only the given parameters change):
         tangent_reuse=rho in (0, 1) for modified Newton, fresh_tangent=True for Newton's method,
         geometry "converged" / "per_level" / "reference", geometry_aitken for Aitken's
         relaxation of the geometry passes, geometry_pass_tolerance for the relative residual at
-        which a pass ends while its geometry still moves. SynoviaError for a parameter out of
-        range."""
+        which a pass ends while its geometry still moves, settled_increment for the relative full
+        step that ends the iteration once the geometry has settled. SynoviaError for a
+        parameter out of range."""
     def force_control(
         self,
         *,

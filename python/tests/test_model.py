@@ -317,6 +317,8 @@ def test_newton_params_modified_newton_solves_the_same_problem():
     assert modified == pytest.approx(default, rel=1e-7)
     passes = floor_force(geometry_pass_tolerance=1e-3, tolerance=1e-11)
     assert passes == pytest.approx(default, rel=1e-7)
+    settled = floor_force(settled_increment=1e-9, tolerance=1e-11)
+    assert settled == pytest.approx(default, rel=1e-7)
     m = synovia.Model(2)
     for bad in (
         dict(tangent_reuse=1.0),
@@ -325,6 +327,8 @@ def test_newton_params_modified_newton_solves_the_same_problem():
         dict(max_iterations=0),
         dict(geometry="always"),
         dict(geometry_pass_tolerance=-1.0),
+        dict(settled_increment=1.0),
+        dict(settled_increment=0.0),
     ):
         with pytest.raises(synovia.SynoviaError):
             m.newton_params(**bad)

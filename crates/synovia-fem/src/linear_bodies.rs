@@ -35,9 +35,7 @@ use crate::assembly::cell_geometry;
 use crate::dofs::DofMap;
 use crate::error::FemError;
 use crate::model::{BodyId, Model};
-use crate::nonlinear::{
-    assemble_tangent_of, check_kinematics, element_response, internal_force_of, Kinematics,
-};
+use crate::nonlinear::{assemble_tangent_of, check_kinematics, internal_force_of, Kinematics};
 
 /// The stiffness `K_b` of each linear body of a model (module docs), for
 /// [`LinearBodies::internal_force`].
@@ -73,22 +71,12 @@ impl<const D: usize> LinearBody<D> {
             None => Self::pattern(mesh)?,
         };
         let n = D * (D + 1);
-        let (u0, mut fe, mut ke) = (vec![0.0; n], vec![0.0; n], vec![0.0; n * n]);
+        let mut ke = vec![0.0; n * n];
         for ci in 0..mesh.n_cells() {
             let (geo, _) = cell_geometry(model, b, ci)?;
-            element_response(
-                &geo,
-                body.material.as_ref(),
-                Kinematics::SmallStrain,
-                &u0,
-                &mut fe,
-                Some(&mut ke),
-            )
-            .map_err(|e| FemError::InvertedElement {
-                body: body.name.clone(),
-                cell: ci,
-                det_f: e.det_f,
-            })?;
+            // the element stiffness |T| Bᵀ C B (the tangent of the small-strain element
+            // response, without its stress and energy)
+            crate::element::stiffness_into(&geo, &c, &mut ke);
             let cell = mesh.cell(ci);
             for (pa, &na) in cell.iter().enumerate() {
                 for (pb, &nb) in cell.iter().enumerate() {

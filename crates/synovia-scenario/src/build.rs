@@ -1915,6 +1915,9 @@ fn newton<const D: usize>(cx: &Cx<'_>, joint: &mut JointModel<D>, n: &Sp<NewtonS
     if let Some(v) = &s.geometry_pass_tolerance {
         p = p.with_geometry_pass_tolerance(Some(cx.positive(v, "newton.geometry_pass_tolerance")?));
     }
+    if let Some(v) = &s.settled_increment {
+        p = p.with_settled_increment(Some(cx.positive(v, "newton.settled_increment")?));
+    }
     if let Some(v) = &s.active_sets {
         p = p.with_active_sets(cx.keyword(
             v,

@@ -646,6 +646,9 @@ pub struct NewtonSpec {
     /// Finite strain: the relative residual at which a pass ends while its geometry still
     /// moves (default: each pass converges to `tolerance`).
     pub geometry_pass_tolerance: Option<Sp<f64>>,
+    /// Finite strain: once the geometry has settled, a full step of at most this relative
+    /// size ends the iteration (default: only `tolerance` ends it).
+    pub settled_increment: Option<Sp<f64>>,
     /// The contact's active sets against the Newton iteration: `nested` (default),
     /// `combined`, `outer`.
     pub active_sets: Option<Sp<String>>,

@@ -56,7 +56,7 @@ fn newton_table_sets_the_parameters_and_solves_the_same_problem() {
     let with = format!(
         "{text}\n[newton]\ntolerance = 1e-11\nmax_iterations = 40\nline_search = true\nmax_cutbacks = 5\n\
          tangent_reuse = 0.5\ngeometry = \"converged\"\ngeometry_tolerance = 1e-9\nmax_geometry_passes = 25\n\
-         geometry_relaxation = 0.6\ngeometry_aitken = true\ngeometry_pass_tolerance = 1e-3\nactive_sets = \"nested\"\n"
+         geometry_relaxation = 0.6\ngeometry_aitken = true\ngeometry_pass_tolerance = 1e-3\nsettled_increment = 1e-9\nactive_sets = \"nested\"\n"
     );
     let built = build::<2>(&scenario(&path, &with)).expect("build");
     let expected = NewtonParams::default()
@@ -69,7 +69,8 @@ fn newton_table_sets_the_parameters_and_solves_the_same_problem() {
         .with_max_geometry_passes(25)
         .with_geometry_relaxation(0.6)
         .with_geometry_aitken(true)
-        .with_geometry_pass_tolerance(Some(1e-3));
+        .with_geometry_pass_tolerance(Some(1e-3))
+        .with_settled_increment(Some(1e-9));
     assert_eq!(built.joint.newton_parameters(), expected);
     // the default iteration and modified Newton with Aitken's relaxation: the same answer
     let a = build::<2>(&scenario(&path, &text)).expect("build").joint.run().expect("run");
@@ -95,6 +96,8 @@ fn bad_newton_values_are_refused_at_their_key() {
         ("geometry = \"always\"", "newton.geometry"),
         ("active_sets = \"inner\"", "newton.active_sets"),
         ("geometry_pass_tolerance = 0.0", "newton.geometry_pass_tolerance"),
+        ("settled_increment = 0.0", "newton.settled_increment"),
+        ("settled_increment = 1.5", "settled increment"),
     ] {
         let msg = refusal::<2>(&path, &format!("{text}\n[newton]\n{line}\n"));
         assert!(msg.contains(key), "`{line}`: {msg}");
