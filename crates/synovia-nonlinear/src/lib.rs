@@ -142,9 +142,9 @@ pub struct NewtonParams {
     /// rebuild moved the solution by at most [`Self::geometry_tolerance`]), the iteration also
     /// ends at a full step whose relative increment `‖Δu‖ / ‖u‖` is at most this (default
     /// `None`: only [`Self::tolerance`] ends it). The answer carries the geometry's error of
-    /// up to [`Self::geometry_tolerance`] anyway, so a value well below it (e.g. a tenth)
-    /// stops the equilibrium iteration where further steps no longer change the answer at
-    /// that accuracy (docs/nonlinear.md, "Stopping the last pass").
+    /// up to [`Self::geometry_tolerance`] anyway, so a value of at most that tolerance (`knee2d`:
+    /// equal to it) stops the equilibrium iteration where further steps no longer change the
+    /// answer at that accuracy (docs/nonlinear.md, "Fifth round").
     pub settled_increment: Option<Real>,
     /// How the contact's active sets are iterated against the material's Newton iteration
     /// (default [`ActiveSetStrategy::Nested`]).
