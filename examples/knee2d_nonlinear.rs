@@ -11,7 +11,8 @@
 //! choosing the approach inside each Newton iteration. Prints per pose the peak
 //! cartilage pressure, contact length and approach of both runs, the Newton work and the gap
 //! left on the deformed configuration, then the cost of each run (the linear one timed as the
-//! fastest of three runs, the neo-Hookean one of two, which must agree to the last bit) and their ratio, also in the JSON line (docs/nonlinear.md).
+//! fastest of three runs, the neo-Hookean one of two, which must agree to the last bit) and
+//! their ratio, also in the JSON line (docs/nonlinear.md).
 //!
 //! Run: `cargo run --release --example knee2d_nonlinear [STEPS]` (default 40 uniform steps + the
 //! 13 % peak = 41 poses, the poses of the `knee2d` example).
@@ -63,8 +64,7 @@ fn main() -> Result<(), KneeError> {
             })
             .collect()
     };
-    let repeat_identical = figures(&runs[0]) == figures(&runs[1]);
-    if !repeat_identical {
+    if figures(&runs[0]) != figures(&runs[1]) {
         return Err("the two neo-Hookean runs differ: the cycle is not deterministic".into());
     }
     let nonlinear = runs.swap_remove(0);

@@ -649,13 +649,7 @@ impl<const D: usize> StaticContact<D> {
             nu.extend_from_slice(&solution.lambda_t);
             solution.u = crate::problem::Interface::new(problem, &context)?.displacement(&nu)?;
         }
-        let kkt = check_kkt_at_border(
-            &problem,
-            &solution.report.border_values,
-            &solution.u,
-            &solution.lambda_n,
-            &solution.lambda_t,
-        );
+        let kkt = kkt_of(&problem, &solution);
         self.finish(solution, kkt, &lifts, friction_op, 0, 0)
     }
 
@@ -720,13 +714,7 @@ impl<const D: usize> StaticContact<D> {
             if multipliers_only {
                 return Ok(Solved::Multipliers(Box::new(solution), it));
             }
-            let kkt = check_kkt_at_border(
-                &problem,
-                &solution.report.border_values,
-                &solution.u,
-                &solution.lambda_n,
-                &solution.lambda_t,
-            );
+            let kkt = kkt_of(&problem, &solution);
             return self.finish(solution, kkt, &lifts, friction_op, it, 0).map(Solved::full);
         };
         if border.is_some() {
@@ -1033,6 +1021,18 @@ struct Assembled<const D: usize> {
 }
 
 /// The friction constraints of `op`, if it has any cell.
+/// The KKT residuals of `solution` for `problem`, at the offsets of the bordered coordinates it
+/// found ([`check_kkt_at_border`]).
+fn kkt_of(problem: &ContactProblem<'_>, solution: &ContactSolution) -> KktReport {
+    check_kkt_at_border(
+        problem,
+        &solution.report.border_values,
+        &solution.u,
+        &solution.lambda_n,
+        &solution.lambda_t,
+    )
+}
+
 fn active_friction(op: Option<&crate::operators::FrictionOperator>) -> Option<&FrictionConstraints> {
     op.map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0)
 }

@@ -296,7 +296,6 @@ impl<E: InvariantEnergy> Hyperelastic<E> {
         (a.g[0] * w[0] + a.g[1] * w[1] + a.g[2] * w[2]) * 2.0
     }
 
-    /// `𝕔_ijkl = ∂S_ij/∂E_kl` (module docs).
     /// The Voigt tangent `∂S/∂E` at `a` over the index pairs `pairs`.
     fn tangent_at(&self, a: &AtC, pairs: &[(usize, usize)]) -> VoigtMatrix {
         let n = pairs.len();
@@ -313,6 +312,7 @@ impl<E: InvariantEnergy> Hyperelastic<E> {
         (t + tt) * 0.5
     }
 
+    /// `𝕔_ijkl = ∂S_ij/∂E_kl` (module docs).
     fn tangent_entry(
         &self,
         a: &AtC,

@@ -110,6 +110,14 @@ impl PartialEq for FacetIndex {
     }
 }
 
+/// [`MeshError::NonFiniteNode`] for the first node with a non-finite coordinate.
+fn check_finite<const D: usize>(nodes: &[Point<D>]) -> Result<(), MeshError> {
+    match nodes.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
+        Some(node) => Err(MeshError::NonFiniteNode { node }),
+        None => Ok(()),
+    }
+}
+
 /// Outcome of validating one cell's orientation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum CellOrientation {
@@ -130,15 +138,22 @@ impl<const D: usize> Mesh<D> {
     /// cells).
     pub fn new(nodes: Vec<Point<D>>, cells: Vec<usize>) -> Result<Self, MeshError> {
         let mesh = Self::unchecked(nodes, cells)?;
-        for c in 0..mesh.n_cells() {
-            match mesh.cell_orientation(c) {
+        mesh.check_orientation()?;
+        mesh.check_conformity()?;
+        Ok(mesh)
+    }
+
+    /// Checks that every cell is positively oriented: the first inverted or degenerate cell
+    /// as [`MeshError::InvertedCell`] / [`MeshError::DegenerateCell`].
+    fn check_orientation(&self) -> Result<(), MeshError> {
+        for c in 0..self.n_cells() {
+            match self.cell_orientation(c) {
                 CellOrientation::Positive => {}
                 CellOrientation::Inverted(det) => return Err(MeshError::InvertedCell { cell: c, det }),
                 CellOrientation::Degenerate(det) => return Err(MeshError::DegenerateCell { cell: c, det }),
             }
         }
-        mesh.check_conformity()?;
-        Ok(mesh)
+        Ok(())
     }
 
     /// Checks that the (positively oriented) cells form a conforming mesh: every facet is
@@ -221,9 +236,7 @@ impl<const D: usize> Mesh<D> {
         if !is_supported_dim(D) {
             return Err(MeshError::UnsupportedDimension(D));
         }
-        if let Some(node) = nodes.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
-            return Err(MeshError::NonFiniteNode { node });
-        }
+        check_finite(&nodes)?;
         let per = D + 1;
         if cells.len() % per != 0 {
             return Err(MeshError::RaggedCells { len: cells.len(), per_cell: per });
@@ -407,20 +420,9 @@ impl<const D: usize> Mesh<D> {
     /// conformity of the mesh and its facet index carry over.
     pub fn map_nodes(&mut self, f: impl Fn(&Point<D>) -> Point<D>) -> Result<(), MeshError> {
         let new_nodes: Vec<Point<D>> = self.nodes.iter().map(f).collect();
-        if let Some(node) = new_nodes.iter().position(|p| p.iter().any(|x| !x.is_finite())) {
-            return Err(MeshError::NonFiniteNode { node });
-        }
+        check_finite(&new_nodes)?;
         let old = std::mem::replace(&mut self.nodes, new_nodes);
-        for c in 0..self.n_cells() {
-            let error = match self.cell_orientation(c) {
-                CellOrientation::Positive => continue,
-                CellOrientation::Inverted(det) => MeshError::InvertedCell { cell: c, det },
-                CellOrientation::Degenerate(det) => MeshError::DegenerateCell { cell: c, det },
-            };
-            self.nodes = old;
-            return Err(error);
-        }
-        Ok(())
+        self.check_orientation().inspect_err(|_| self.nodes = old)
     }
 
     /// The same mesh typed with the dimension parameter `B`, which must equal `D` (lets
