@@ -1,5 +1,5 @@
 // A half-disc (radius 0.5, centre (1, 1.5)) resting on a block [0, 2] x [0, 1]: two separate
-// bodies touching at (1, 1), for tests/gmsh_solve.rs (meshed there with the gmsh CLI).
+// bodies touching at (1, 1), for tests/suite/gmsh_solve.rs (meshed there with the gmsh CLI).
 // Bodies `upper` and `lower`; boundary groups `prescribed_top` (the flat side of the disc),
 // `contact_upper` (its arc), `contact_lower` (the top of the block), `clamped_base`.
 Geometry.AutoCoherence = 0; // keep the two touching points (1, 1) apart: two bodies

@@ -1,5 +1,5 @@
 """Reads synovia's .vtu files with meshio and with VTK's own XML reader and checks them against
-what the Rust side says it wrote (tests/vtu_readers.rs).
+what the Rust side says it wrote (tests/suite/vtu_readers.rs).
 
 Usage: python3 vtu_readers.py EXPECTED.json
 

@@ -28,7 +28,7 @@
 //! motion of the driven arc is rotated into that frame. The stiffness is therefore factorised
 //! **once for the whole cycle** ([`KneeCycle`]); only the contact rows change from pose to
 //! pose. This is the same problem as re-meshing the femur in each pose ([`Knee2d::model`],
-//! kept as the reference; `tests/knee2d.rs` compares the two). For a frictionless contact the
+//! kept as the reference; `tests/suite/knee2d.rs` compares the two). For a frictionless contact the
 //! solution of a pose does not depend on the path, so no state is carried between steps. With
 //! flexion the contact moves over the femoral cartilage (toward the posterior condyle), i.e.
 //! over different elements of the femur mesh. Femoral displacements of a [`KneePose`] are in

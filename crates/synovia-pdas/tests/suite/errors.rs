@@ -1,6 +1,6 @@
 //! Error paths: no convergence, infeasible and singular problems, bad parameters.
 
-mod common;
+use crate::common;
 
 use common::{frictionless, tresca_2d};
 use synovia_contact::{ContactError, ContactParams, ContactSolver};

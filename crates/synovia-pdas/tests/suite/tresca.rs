@@ -1,6 +1,6 @@
 //! Tresca friction in 2D and 3D: stick and slip, ρ-independence, AU-PDAS vs PDAS, warm start.
 
-mod common;
+use crate::common;
 
 use common::{assert_kkt, assert_same, tresca_2d, tresca_3d};
 use synovia_contact::testing::OwnedProblem;

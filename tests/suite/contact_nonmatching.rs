@@ -21,7 +21,7 @@ use synovia_models::hertz::{hertz2d_block, refined_axis, HertzBlock2d};
 /// state with the uniform contact pressure `p = δ / (H₁/M₁ + H₂/M₂)`, `M = λ + 2μ`.
 ///
 /// The upper block is driven by a prescribed displacement (with a traction on its top it would be
-/// semi-coercive, held only by the contact — solvable since issue 7, see `tests/semi_coercive.rs`,
+/// semi-coercive, held only by the contact — solvable since issue 7, see `tests/suite/semi_coercive.rs`,
 /// but the displacement-driven form was written first); the applied force is then the reaction
 /// at the top, computed from the stresses.
 fn stacked_blocks(n_lower: usize, n_upper: usize, upper_is_slave: bool) -> (Model<2>, Vec<ContactPair<2>>) {

@@ -1,6 +1,6 @@
 //! Frictionless contact: KKT, partial contact, few iterations, mesh independence.
 
-mod common;
+use crate::common;
 
 use common::{assert_kkt, assert_same, frictionless};
 use synovia_contact::{ContactSolution, ContactSolver};

@@ -241,7 +241,7 @@ pub const HERTZ3D_CASES: [HertzBlock3d; 2] = [
 ];
 
 /// 3D Hertz (sphere on an elastic block) on non-matching meshes with dual mortar: `a` and `p₀`
-/// within the 5 % of the matching-mesh 3D Hertz test (`tests/contact.rs`).
+/// within the 5 % of the matching-mesh 3D Hertz test (`tests/suite/contact.rs`).
 #[test]
 fn mortar_hertz_3d_on_non_matching_meshes() {
     let solver = by_name("pdas").expect("solver");

@@ -2,7 +2,7 @@
 //! step warm-started from the last one's `U` and multipliers) it reaches PDAS's solution, with
 //! the sets unchanged by the last step; from PDAS's solution one step returns it unchanged.
 
-mod common;
+use crate::common;
 
 use common::{assert_kkt, assert_same, tresca_2d, tresca_3d};
 use synovia_contact::testing::OwnedProblem;

@@ -288,7 +288,7 @@ fn a_lifted_start_with_frozen_friction_returns_to_contact() -> Result<(), Box<dy
 /// refused). With a density so small that the inertia terms are 1e-7 of the stiffness at this
 /// step (`ρ/Δt² = 1e-4` against `E = 1e3`), the dynamic run is the quasi-static one: the
 /// indenter's normal force and reaction at `t = 1` equal the quasi-static run's to 1e-5, for
-/// the linear and the neo-Hookean law (small strain; tests/dynamic_rigid.rs checks the
+/// the linear and the neo-Hookean law (small strain; tests/suite/dynamic_rigid.rs checks the
 /// dynamics itself against an exact reference).
 #[test]
 fn rigid_bodies_in_dynamic_runs_press_as_in_quasistatic_runs() -> Result<(), Box<dyn std::error::Error>> {

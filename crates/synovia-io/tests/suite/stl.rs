@@ -110,7 +110,7 @@ fn devices_are_not_read_as_files() {
 }
 
 /// Self-intersection of the implant surfaces, timed (printed with
-/// `cargo test --release -p synovia-io --test stl -- --nocapture`; about 0.1 s each): the
+/// `cargo test --release -p synovia-io --test suite stl:: -- --nocapture`; about 0.1 s each): the
 /// femoral component and both contact patches do not cross themselves; the tibial insert
 /// crosses itself at 45 pairs of triangles in about eight small folds (e.g. triangles 293 and
 /// 47 589 share the vertex (20.218, 9.624, 30.054) mm and overlap along 62 µm from it). Each of

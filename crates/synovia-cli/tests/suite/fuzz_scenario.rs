@@ -6,7 +6,7 @@
 //! must give `Ok` or a `ScenarioError`, never a panic.
 //!
 //! A few hundred cases by default (the CI smoke pass); more with
-//! `SYNOVIA_FUZZ_CASES=100000 cargo test --release -p synovia-cli --test fuzz_scenario`.
+//! `SYNOVIA_FUZZ_CASES=100000 cargo test --release -p synovia-cli --test suite fuzz_scenario::`.
 //! See `docs/fuzzing.md`.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -18,7 +18,7 @@ use proptest::prelude::*;
 use synovia_cli::run::check;
 use synovia_cli::{Scenario, Source};
 
-#[path = "../../../tests/support/mutate.rs"]
+#[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
 use mutate::{apply, fuzz_cases, mutated};
 

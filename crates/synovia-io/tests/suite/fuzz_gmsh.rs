@@ -6,7 +6,7 @@
 //! `bodies::<3>()`. Every input must give `Ok` or an `IoError`, never a panic.
 //!
 //! A few hundred cases by default (the CI smoke pass); more with
-//! `SYNOVIA_FUZZ_CASES=100000 cargo test --release -p synovia-io --test fuzz_gmsh`.
+//! `SYNOVIA_FUZZ_CASES=100000 cargo test --release -p synovia-io --test suite fuzz_gmsh::`.
 //! See `docs/fuzzing.md`.
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use proptest::prelude::*;
 use synovia_io::parse_msh;
 
-#[path = "../../../tests/support/mutate.rs"]
+#[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
 use mutate::{apply, fuzz_cases, mutated};
 

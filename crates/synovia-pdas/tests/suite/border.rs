@@ -2,7 +2,7 @@
 //! (`RigidBorder`, docs/model.md §10): the bordered PDAS solve equals the plain solve at the
 //! offsets `g + σ ζ` it finds, meets `σᵀ ν = target`, and is refused where it cannot be solved.
 
-mod common;
+use crate::common;
 
 use common::{assert_kkt, assert_same, frictionless, tresca_2d, tresca_3d};
 use synovia_contact::testing::OwnedProblem;
