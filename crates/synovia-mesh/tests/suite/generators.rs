@@ -1,6 +1,6 @@
 //! Mesh generators (`synovia_mesh::generators`): geometry, parts, orientation, convergence.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 

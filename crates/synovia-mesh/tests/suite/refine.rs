@@ -1,6 +1,6 @@
 //! Conforming local refinement by longest-edge bisection (`synovia_mesh::refine`).
 
-mod common;
+use crate::common;
 
 use std::collections::HashSet;
 

@@ -1,0 +1,6 @@
+//! The integration tests of `synovia-feti`, one module per concern, compiled into one test binary
+//! (the generic code they use is instantiated once, not once per file). Run one module with a
+//! filter, e.g. `cargo test --release -p synovia-feti --test suite hertz::`.
+
+mod hertz;
+mod scalability;
