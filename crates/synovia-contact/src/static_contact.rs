@@ -1020,7 +1020,6 @@ struct Assembled<const D: usize> {
     border: Option<RigidBorder>,
 }
 
-/// The friction constraints of `op`, if it has any cell.
 /// The KKT residuals of `solution` for `problem`, at the offsets of the bordered coordinates it
 /// found ([`check_kkt_at_border`]).
 fn kkt_of(problem: &ContactProblem<'_>, solution: &ContactSolution) -> KktReport {
@@ -1033,6 +1032,7 @@ fn kkt_of(problem: &ContactProblem<'_>, solution: &ContactSolution) -> KktReport
     )
 }
 
+/// The friction constraints of `op`, if it has any cell.
 fn active_friction(op: Option<&crate::operators::FrictionOperator>) -> Option<&FrictionConstraints> {
     op.map(|f| &f.constraints).filter(|f| f.rows.nrows() > 0)
 }
