@@ -2158,10 +2158,13 @@ impl<const D: usize> NonlinearContact<D> {
                         && h.normal <= self.params.tolerance
                         && h.tangential <= self.params.tolerance
                 });
+            // the pass started from the solution's geometry: its first step moved the iterate
+            // by at most the geometry tolerance
+            let pass_on_settled_geometry = pass_increment <= self.params.geometry_tolerance;
             // finite strain on a settled geometry: a full step below the settled increment
             let settled_step = finite
                 && alpha == 1.0
-                && pass_increment <= self.params.geometry_tolerance
+                && pass_on_settled_geometry
                 && self.params.settled_increment.is_some_and(|d| increment <= d);
             let equilibrium = relative <= self.params.tolerance
                 || force_scale == 0.0
@@ -2173,13 +2176,12 @@ impl<const D: usize> NonlinearContact<D> {
             let pass_converged = converged
                 || (finite
                     && contact_settled
-                    && pass_increment > self.params.geometry_tolerance
+                    && !pass_on_settled_geometry
                     && self.params.geometry_pass_tolerance.is_some_and(|p| relative <= p));
             // a converged pass ends the level when the geometry it started from was already
-            // that of the solution (its first step moved the iterate by less than the
-            // tolerance); otherwise the geometry is rebuilt for another pass
+            // that of the solution; otherwise the geometry is rebuilt for another pass
             let geometry_settled = !finite
-                || pass_increment <= self.params.geometry_tolerance
+                || pass_on_settled_geometry
                 || self.params.geometry_update == GeometryUpdate::PerLevel;
             if pass_converged && !geometry_settled {
                 if passes > self.params.max_geometry_passes {
