@@ -57,12 +57,35 @@ pub struct TrailingBlock {
     pub dofs: Vec<usize>,
     /// `position[dof]` = index of `dof` in [`Self::dofs`], or `usize::MAX`.
     pub position: Vec<usize>,
-    /// `L₂₂` (dense, lower triangular, `k × k`).
-    pub factor: faer::Mat<f64>,
     /// The diagonal blocks of `L₂₂` with nothing below them (consecutive ranges covering
     /// `0..k`, [`diagonal_blocks`]): `L₂₂ = diag(L₁, L₂, …)`, e.g. one block per body of an
     /// interface between bodies that only contact couples. One block `0..k` is always correct.
     pub blocks: Vec<std::ops::Range<usize>>,
+    /// Where the dense lower-triangular blocks `L_b` are stored.
+    storage: TrailingStorage,
+    /// A number no other trailing block of this process has ([`Self::generation`]).
+    generation: u64,
+}
+
+/// The next [`TrailingBlock::generation`].
+static TRAILING_GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+fn next_generation() -> u64 {
+    TRAILING_GENERATION.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+/// The storage of the blocks of `L₂₂` ([`TrailingBlock::diagonal_block`]).
+#[derive(Debug, Clone)]
+enum TrailingStorage {
+    /// A dense `k × k` copy of `L₂₂`.
+    Copied(faer::Mat<f64>),
+    /// Read in place from the supernodal factor's values: when every supernode holding
+    /// trailing columns has nothing below its diagonal block (each is a root of the elimination
+    /// forest, as the interface's dense Schur complement of one body is), block `b` is the
+    /// trailing `size × size` part of one supernode's dense column-major `ncols × ncols` block —
+    /// no copy of `L₂₂` (288 MB at `k = 6 000`). `(offset, ncols, first)`: the supernode's
+    /// first value, its columns, and the block's first column within it.
+    InFactor { values: Arc<Vec<f64>>, supernodes: Vec<(usize, usize, usize)> },
 }
 
 /// The finest partition of `0..k` into consecutive ranges `a..b` with `l[(i, j)] = 0` for all
@@ -85,6 +108,66 @@ pub fn diagonal_blocks(l: faer::MatRef<'_, f64>) -> Vec<std::ops::Range<usize>> 
 }
 
 impl TrailingBlock {
+    /// The dense lower-triangular diagonal block `L_b` of `L₂₂` on the rows and columns
+    /// `self.blocks[b]` (`None` for `b` out of range).
+    pub fn diagonal_block(&self, b: usize) -> Option<faer::MatRef<'_, f64>> {
+        let range = self.blocks.get(b)?;
+        match &self.storage {
+            TrailingStorage::Copied(l) => {
+                Some(l.as_ref().submatrix(range.start, range.start, range.len(), range.len()))
+            }
+            TrailingStorage::InFactor { values, supernodes } => {
+                let &(offset, ncols, first) = supernodes.get(b)?;
+                let whole = faer::MatRef::from_column_major_slice(
+                    values.get(offset..offset + ncols * ncols)?,
+                    ncols,
+                    ncols,
+                );
+                Some(whole.submatrix(first, first, ncols - first, ncols - first))
+            }
+        }
+    }
+
+    /// The entry `(L₂₂)_ij` (zero outside the diagonal blocks and above the diagonal).
+    pub fn entry(&self, i: usize, j: usize) -> f64 {
+        let Some(b) = self.blocks.iter().position(|r| r.contains(&i)) else { return 0.0 };
+        let range = &self.blocks[b];
+        if !range.contains(&j) || j > i {
+            return 0.0;
+        }
+        self.diagonal_block(b).map_or(0.0, |l| l[(i - range.start, j - range.start)])
+    }
+
+    /// A number that identifies this block among all blocks of the process (one per
+    /// factorisation): caches keyed by it cannot mistake a refactorised block for the old one,
+    /// even at the same address.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
+    /// Whether `L₂₂` is read from the factor's own storage (no dense copy).
+    pub fn in_factor(&self) -> bool {
+        matches!(self.storage, TrailingStorage::InFactor { .. })
+    }
+
+    /// `z ← L₂₂⁻¹ z` (`transpose = false`) or `z ← L₂₂⁻ᵀ z` for one right-hand side of `k`
+    /// entries, block by block (`L₂₂ = diag(L_b)`; a zero block stays zero).
+    fn triangular_solve_in_place(&self, z: &mut [f64], transpose: bool) {
+        for (b, range) in self.blocks.iter().enumerate() {
+            let (Some(l), Some(zb)) = (self.diagonal_block(b), z.get_mut(range.clone())) else { continue };
+            if zb.iter().all(|v| *v == 0.0) {
+                continue;
+            }
+            let size = zb.len();
+            let zb = MatMut::from_column_major_slice_mut(zb, size, 1);
+            if transpose {
+                faer::linalg::triangular_solve::solve_upper_triangular_in_place(l.transpose(), zb, Par::Seq);
+            } else {
+                faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, zb, Par::Seq);
+            }
+        }
+    }
+
     /// Solves `(A⁻¹)_cc`-products in place: `X ← L₂₂⁻ᵀ L₂₂⁻¹ X` for the `k × r` block `x`
     /// (rows in the order of [`Self::dofs`]).
     ///
@@ -98,18 +181,15 @@ impl TrailingBlock {
     /// of it.
     pub fn solve_in_place(&self, mut x: MatMut<'_, f64>) {
         let k = x.nrows();
-        let whole = std::iter::once(0..k);
-        let blocks: Vec<std::ops::Range<usize>> = if self.blocks.last().is_some_and(|b| b.end == k) {
-            self.blocks.clone()
-        } else {
-            whole.collect()
-        };
-        for block in &blocks {
+        if self.blocks.last().is_none_or(|b| b.end != k) {
+            return;
+        }
+        for (b, block) in self.blocks.iter().enumerate() {
             let (a, size) = (block.start, block.len());
             let Some(first) = (0..size).find(|&i| (0..x.ncols()).any(|c| x[(a + i, c)] != 0.0)) else {
                 continue;
             };
-            let l = self.factor.as_ref().submatrix(a, a, size, size);
+            let Some(l) = self.diagonal_block(b) else { continue };
             let mut xb = x.rb_mut().subrows_mut(a, size);
             faer::linalg::triangular_solve::solve_lower_triangular_in_place(
                 l.submatrix(first, first, size - first, size - first),
@@ -208,7 +288,8 @@ pub struct MemoryEstimate {
     pub factor_bytes: u64,
     /// Bytes of faer's workspace of the numeric factorisation.
     pub workspace_bytes: u64,
-    /// Bytes of the dense trailing block `L₂₂` of an [`Ordering::Trailing`] factorisation.
+    /// Bytes of the dense copy of the trailing block `L₂₂` of an [`Ordering::Trailing`]
+    /// factorisation (zero when it is read in place from the factor).
     pub trailing_bytes: u64,
 }
 
@@ -258,7 +339,8 @@ pub fn available_memory() -> Option<u64> {
 #[derive(Debug, Clone)]
 pub struct CholeskySolver {
     symbolic: Arc<SymbolicCholesky<usize>>,
-    factor: Vec<f64>,
+    /// The factor's values; shared with the [`TrailingBlock`] that reads `L₂₂` from them.
+    factor: Arc<Vec<f64>>,
     factorized: bool,
     info: CholeskyInfo,
     trailing_dofs: Option<Vec<usize>>,
@@ -351,7 +433,7 @@ impl CholeskySolver {
         let numeric_scratch = (par, symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
         Ok(Self {
             symbolic: Arc::new(symbolic),
-            factor: Vec::new(),
+            factor: Arc::new(Vec::new()),
             factorized: false,
             info,
             trailing_dofs,
@@ -382,9 +464,13 @@ impl CholeskySolver {
     pub fn memory_estimate(&self) -> MemoryEstimate {
         let entries = self.symbolic.len_val();
         let req = self.numeric_scratch_for(self.numeric_par());
-        let k = self.trailing_dofs.as_ref().map_or(0, Vec::len) as u64;
+        let k = self.trailing_dofs.as_ref().map_or(0, Vec::len);
+        let n = self.symbolic.nrows();
+        // a block read in place from the factor costs nothing besides it
+        let copied = k > 0 && k <= n && Self::trailing_supernodes(&self.symbolic, n - k).is_none();
+        let k = if copied { k as u64 } else { 0 };
         MemoryEstimate {
-            dofs: self.symbolic.nrows(),
+            dofs: n,
             factor_entries: entries,
             factor_bytes: (entries as u64).saturating_mul(8),
             workspace_bytes: req.size_bytes() as u64,
@@ -433,6 +519,9 @@ impl CholeskySolver {
             return Err(LinalgError::Length { what: "matrix", expected: self.symbolic.nrows(), got: a.n() });
         }
         self.factorized = false;
+        // the trailing block may read the old values in place: dropped first, so that the
+        // values can be refactorised where they are
+        self.trailing = None;
         self.check_memory()?;
         let len = self.symbolic.len_val();
         // the supernodal factorisation sets every value of the factor to zero itself before
@@ -440,20 +529,26 @@ impl CholeskySolver {
         // place; the simplicial one expects zeros
         let supernodal =
             matches!(self.symbolic.raw(), faer::sparse::linalg::cholesky::SymbolicCholeskyRaw::Supernodal(_));
-        if !(supernodal && self.factor.len() == len) {
-            self.factor.clear();
-            self.factor.try_reserve_exact(len).map_err(|_| {
-                LinalgError::Sparse(format!("out of memory for a Cholesky factor of {len} entries"))
-            })?;
-            self.factor.resize(len, 0.0);
-        }
         let par = self.numeric_par();
         let req = self.numeric_scratch_for(par);
         let mut mem =
             MemBuffer::try_new(req).map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
+        if Arc::get_mut(&mut self.factor).is_none() {
+            // a trailing block handed out before still reads the old values: new storage
+            self.factor = Arc::new(Vec::new());
+        }
+        let values = Arc::get_mut(&mut self.factor)
+            .ok_or_else(|| LinalgError::Sparse("internal: the factor's storage is shared".into()))?;
+        if !(supernodal && values.len() == len) {
+            values.clear();
+            values.try_reserve_exact(len).map_err(|_| {
+                LinalgError::Sparse(format!("out of memory for a Cholesky factor of {len} entries"))
+            })?;
+            values.resize(len, 0.0);
+        }
         self.symbolic
             .factorize_numeric_llt::<f64>(
-                &mut self.factor,
+                values,
                 a.as_faer(),
                 Side::Lower,
                 LltRegularization::default(),
@@ -481,12 +576,62 @@ impl CholeskySolver {
         self.trailing.as_ref()
     }
 
-    /// Copies the last `k = dofs.len()` columns of `L` (rows ≥ `n − k`) into a dense `L₂₂`.
+    /// The supernodes holding the trailing columns `t0..n` as `(offset of the values, columns,
+    /// first trailing column within it)`, when each has nothing below its diagonal block and
+    /// they cover `t0..n` (then `L₂₂` is block diagonal with one block per supernode, stored
+    /// densely in the factor); `None` otherwise (simplicial factors included).
+    fn trailing_supernodes(
+        symbolic: &SymbolicCholesky<usize>,
+        t0: usize,
+    ) -> Option<Vec<(usize, usize, usize)>> {
+        use faer::sparse::linalg::cholesky::SymbolicCholeskyRaw;
+        let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else { return None };
+        let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+        let (row_ptr, val_ptr) = (sym.col_ptr_for_row_idx(), sym.col_ptr_for_val());
+        let mut out = Vec::new();
+        let mut covered = t0;
+        for s in 0..sym.n_supernodes() {
+            if end[s] <= t0 {
+                continue;
+            }
+            let ncols = end[s] - begin[s];
+            let pattern = row_ptr[s + 1] - row_ptr[s];
+            if pattern != 0 || begin[s].max(t0) != covered || val_ptr[s + 1] - val_ptr[s] != ncols * ncols {
+                return None;
+            }
+            out.push((val_ptr[s], ncols, t0.saturating_sub(begin[s])));
+            covered = end[s];
+        }
+        (covered == symbolic.nrows() && !out.is_empty()).then_some(out)
+    }
+
+    /// The trailing block `L₂₂` of the last `k = dofs.len()` columns of `L` (rows ≥ `n − k`):
+    /// read in place from the factor when its supernodes allow
+    /// ([`Self::trailing_supernodes`]), else copied into a dense `k × k` matrix.
     fn extract_trailing(&self, dofs: &[usize]) -> Result<TrailingBlock, LinalgError> {
         use faer::sparse::linalg::cholesky::{supernodal::SupernodalLltRef, SymbolicCholeskyRaw};
         let n = self.symbolic.nrows();
         let k = dofs.len();
         let t0 = n - k;
+        let mut position = vec![usize::MAX; n];
+        for (p, &d) in dofs.iter().enumerate() {
+            position[d] = p;
+        }
+        if let Some(supernodes) = Self::trailing_supernodes(&self.symbolic, t0) {
+            let mut blocks = Vec::with_capacity(supernodes.len());
+            let mut start = 0;
+            for &(_, ncols, first) in &supernodes {
+                blocks.push(start..start + ncols - first);
+                start += ncols - first;
+            }
+            return Ok(TrailingBlock {
+                dofs: dofs.to_vec(),
+                position,
+                blocks,
+                storage: TrailingStorage::InFactor { values: self.factor.clone(), supernodes },
+                generation: next_generation(),
+            });
+        }
         let mut l22 = faer::Mat::<f64>::zeros(k, k);
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(sym) => {
@@ -494,7 +639,7 @@ impl CholeskySolver {
                 let row_idx = sym.row_idx();
                 for j in t0..n {
                     let range = col_ptr[j]..col_ptr[j + 1];
-                    for (&i, &v) in row_idx[range.clone()].iter().zip(&self.factor[range]) {
+                    for (&i, &v) in row_idx[range.clone()].iter().zip(&self.factor.as_slice()[range]) {
                         if i >= j {
                             l22[(i - t0, j - t0)] = v;
                         }
@@ -502,7 +647,7 @@ impl CholeskySolver {
                 }
             }
             SymbolicCholeskyRaw::Supernodal(sym) => {
-                let llt = SupernodalLltRef::new(sym, &self.factor);
+                let llt = SupernodalLltRef::new(sym, self.factor.as_slice());
                 for s in 0..sym.n_supernodes() {
                     let node = llt.supernode(s);
                     let start = node.start();
@@ -528,12 +673,14 @@ impl CholeskySolver {
                 }
             }
         }
-        let mut position = vec![usize::MAX; n];
-        for (p, &d) in dofs.iter().enumerate() {
-            position[d] = p;
-        }
         let blocks = diagonal_blocks(l22.as_ref());
-        Ok(TrailingBlock { dofs: dofs.to_vec(), position, factor: l22, blocks })
+        Ok(TrailingBlock {
+            dofs: dofs.to_vec(),
+            position,
+            blocks,
+            storage: TrailingStorage::Copied(l22),
+            generation: next_generation(),
+        })
     }
 
     /// Solves `A x = b` in place for a right-hand side that vanishes outside the trailing
@@ -566,11 +713,7 @@ impl CholeskySolver {
         for (p, zp) in z[t0..].iter_mut().enumerate() {
             *zp = b[fwd[t0 + p]];
         }
-        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-            block.factor.as_ref(),
-            MatMut::from_column_major_slice_mut(&mut z[t0..], k, 1),
-            Par::Seq,
-        );
+        block.triangular_solve_in_place(&mut z[t0..], false);
         self.sparse_half_solve(MatMut::from_column_major_slice_mut(&mut z, n, 1), true)?;
         for (i, bi) in b.iter_mut().enumerate() {
             *bi = z[inv[i]];
@@ -608,7 +751,7 @@ impl CholeskySolver {
         use faer::sparse::SparseColMatRef;
         match self.symbolic.raw() {
             SymbolicCholeskyRaw::Simplicial(sym) => {
-                let l = SparseColMatRef::<'_, usize, f64>::new(sym.factor(), &self.factor);
+                let l = SparseColMatRef::<'_, usize, f64>::new(sym.factor(), self.factor.as_slice());
                 if transpose {
                     solve_lower_triangular_transpose_in_place(l, Conj::No, x, Par::Seq);
                 } else {
@@ -619,7 +762,7 @@ impl CholeskySolver {
                 let req = self.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq);
                 let mut mem = MemBuffer::try_new(req)
                     .map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
-                let llt = SupernodalLltRef::new(sym, &self.factor);
+                let llt = SupernodalLltRef::new(sym, self.factor.as_slice());
                 if transpose {
                     llt.l_transpose_solve_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut mem));
                 } else {
@@ -672,11 +815,7 @@ impl CholeskySolver {
         }
         let k = block.dofs.len();
         let mut z = y[n - k..].to_vec();
-        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
-            block.factor.as_ref().transpose(),
-            MatMut::from_column_major_slice_mut(&mut z, k, 1),
-            Par::Seq,
-        );
+        block.triangular_solve_in_place(&mut z, true);
         let mut x = vec![0.0; n];
         for (&d, v) in block.dofs.iter().zip(z) {
             x[d] = v;
@@ -712,11 +851,7 @@ impl CholeskySolver {
         let outside = fwd[..t0].iter().any(|&i| s[i] != 0.0);
         if !outside {
             let mut sc: Vec<f64> = (0..k).map(|p| s[fwd[t0 + p]]).collect();
-            faer::linalg::triangular_solve::solve_lower_triangular_in_place(
-                block.factor.as_ref(),
-                MatMut::from_column_major_slice_mut(&mut sc, k, 1),
-                Par::Seq,
-            );
+            block.triangular_solve_in_place(&mut sc, false);
             for (zp, v) in z[t0..].iter_mut().zip(&sc) {
                 *zp -= v;
             }
@@ -784,7 +919,7 @@ impl CholeskySolver {
                 x[c * n + inv[d]] += v;
             }
         }
-        let llt = SupernodalLltRef::new(sym, &self.factor);
+        let llt = SupernodalLltRef::new(sym, self.factor.as_slice());
         let ns = sym.n_supernodes();
         let mut nonzero = Vec::with_capacity(k);
         let (mut xs, mut update) = (Vec::new(), Vec::new());
@@ -905,7 +1040,7 @@ impl CholeskySolver {
         let req = self.symbolic.solve_in_place_scratch::<f64>(b.ncols(), par);
         let mut mem =
             MemBuffer::try_new(req).map_err(|_| LinalgError::Sparse("out of memory (scratch)".into()))?;
-        LltRef::new(&self.symbolic, &self.factor).solve_in_place_with_conj(
+        LltRef::new(&self.symbolic, self.factor.as_slice()).solve_in_place_with_conj(
             Conj::No,
             b,
             par,
@@ -1332,5 +1467,56 @@ mod tests {
         solver.solve_in_place(&mut b).expect("solve");
         let error = b.iter().zip(&x).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max);
         assert!(error < 1e-12, "solve error {error}");
+    }
+
+    /// The trailing block of one body is read in place from the factor (no copy of `L₂₂`):
+    /// its entries reproduce `(A⁻¹)_cc = L₂₂⁻ᵀ L₂₂⁻¹` of whole solves, the memory estimate
+    /// counts no copy, and a block kept by a caller across a refactorisation keeps the old
+    /// values (the factor gets new storage) while the solver's new block has the new ones.
+    #[test]
+    fn trailing_block_is_read_in_place_and_survives_a_refactorisation() {
+        // (large enough for faer's supernodal factorisation; smaller grids are simplicial, and
+        // their `L₂₂` is copied)
+        let m = 100;
+        let (a, blocks, adjacency) = grid2(m);
+        let n = a.n();
+        let last: Vec<usize> = (0..2 * m).collect();
+        let ordering = Ordering::Trailing { base: Box::new(Ordering::Metis { blocks, adjacency }), last };
+        let mut solver = CholeskySolver::analyse(&a, &ordering).expect("analyse");
+        assert_eq!(solver.memory_estimate().trailing_bytes, 0, "a copy of L22 is counted");
+        solver.factorize(&a).expect("factorise");
+        let block = solver.trailing().expect("trailing block").clone();
+        assert!(block.in_factor(), "L22 was copied");
+        let k = block.dofs.len();
+        // columns of (A⁻¹)_cc: by the block, and by whole solves
+        let inverse_column = |s: &CholeskySolver, p: usize, dofs: &[usize]| -> Vec<f64> {
+            let mut e = vec![0.0; n];
+            e[dofs[p]] = 1.0;
+            s.solve_in_place(&mut e).expect("solve");
+            dofs.iter().map(|&d| e[d]).collect()
+        };
+        let by_block = |b: &TrailingBlock, p: usize| -> Vec<f64> {
+            b.solve_sparse_columns(&[vec![(p, 1.0)]], false).expect("block solve").remove(0)
+        };
+        for p in [0, k / 2, k - 1] {
+            let (x, y) = (by_block(&block, p), inverse_column(&solver, p, &block.dofs));
+            let err = x.iter().zip(&y).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max);
+            assert!(err < 1e-12, "column {p}: {err}");
+        }
+        // refactorise 2 A while the caller still holds the old block
+        let mut a2 = a.clone();
+        a2.add_scaled(1.0, &a).expect("2 A");
+        solver.factorize(&a2).expect("refactorise");
+        let new_block = solver.trailing().expect("trailing block").clone();
+        assert_ne!(new_block.generation(), block.generation());
+        for p in [0, k - 1] {
+            let (old, new) = (by_block(&block, p), by_block(&new_block, p));
+            // (2 A)⁻¹ = A⁻¹ / 2: the old block still answers for A, the new one for 2 A
+            let err = old.iter().zip(&new).map(|(u, v)| (u - 2.0 * v).abs()).fold(0.0, f64::max);
+            assert!(err < 1e-12, "column {p}: old and new blocks {err}");
+            let whole = inverse_column(&solver, p, &new_block.dofs);
+            let err = new.iter().zip(&whole).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max);
+            assert!(err < 1e-12, "column {p}: new block against whole solves {err}");
+        }
     }
 }

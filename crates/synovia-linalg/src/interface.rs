@@ -609,16 +609,18 @@ fn trailing_solves(
     Ok(cols.iter().copied().zip(solved).collect())
 }
 
-/// A fingerprint of a trailing block: its address, size and corner entries.
+/// A fingerprint of a trailing block: its generation (one per factorisation), size and corner
+/// entries. (Its address is not enough: a refactorisation may allocate the new block where the
+/// old one was.)
 fn block_fingerprint(block: &TrailingBlock) -> usize {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    (block as *const TrailingBlock as usize).hash(&mut h);
+    block.generation().hash(&mut h);
     let k = block.dofs.len();
     k.hash(&mut h);
     if k > 0 {
-        block.factor[(0, 0)].to_bits().hash(&mut h);
-        block.factor[(k - 1, k - 1)].to_bits().hash(&mut h);
+        block.entry(0, 0).to_bits().hash(&mut h);
+        block.entry(k - 1, k - 1).to_bits().hash(&mut h);
     }
     h.finish() as usize
 }
