@@ -129,6 +129,8 @@ pub fn partition_cells<const D: usize>(
         let x: Vec<metis::Idx> = xadj.iter().map(|&v| to_idx(v)).collect::<Result<_, _>>()?;
         let a: Vec<metis::Idx> = adjncy.iter().map(|&v| to_idx(v)).collect::<Result<_, _>>()?;
         let np = to_idx(parts.min(nc))?;
+        // METIS's random-number state is process-wide: one call at a time (synovia_linalg::metis_lock)
+        let _guard = synovia_linalg::metis_lock();
         metis::Graph::new(1, np, &x, &a)
             .map_err(|e| err(e.to_string()))?
             .set_option(metis::option::Seed(7))

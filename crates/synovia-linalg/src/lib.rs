@@ -32,8 +32,8 @@ pub mod rows;
 pub mod sparse;
 
 pub use cholesky::{
-    available_memory, memory_limit, CholeskyInfo, CholeskySolver, InterfaceBlockParams, MemoryEstimate,
-    Ordering, TrailingBlock, MEMORY_LIMIT_ENV,
+    available_memory, memory_limit, metis_lock, CholeskyInfo, CholeskySolver, InterfaceBlockParams,
+    MemoryEstimate, Ordering, TrailingBlock, MEMORY_LIMIT_ENV,
 };
 pub use error::LinalgError;
 pub use interface::BlockSolveStore;

@@ -86,12 +86,11 @@ fn subdivide_smooths_the_stl_as_the_library_does_and_its_keys_are_checked() {
     // (measured: 6.2e-7 apart, 5.3e-7 with the ball 1e-3 lower: the single-precision file's
     // rounding of the smoothed points, ≈ 1e-7 of the coordinates)
     assert!((smooth - library).abs() < 1e-5 * library, "{smooth} vs {library}");
-    // zero levels: the faceted ball (to rounding: two runs of the same model in one test process
-    // differ in the last bits now and then while other tests run beside them — seen in 3 of 16
-    // runs of this suite, 2.4187999835056786 against …6835 / …6804 / …6800; the cause is not
-    // found yet, see docs/reliability.md)
+    // zero levels: the faceted ball, bit for bit (two runs of the same model in one process;
+    // they differed in the last bits while other tests ran beside them until every call into
+    // METIS held `synovia_linalg::metis_lock`: docs/reliability.md)
     let zero = contact_force(&pressed_block(&stl(&file, ", subdivide = 0")), "zero");
-    assert!((zero - faceted).abs() <= 1e-13 * faceted, "{zero} vs {faceted}");
+    assert_eq!(zero.to_bits(), faceted.to_bits(), "{zero} vs {faceted}");
     assert!((smooth - faceted).abs() > 1e-2 * faceted, "{smooth} vs {faceted}");
 
     // the keys are checked
