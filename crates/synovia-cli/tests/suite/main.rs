@@ -3,6 +3,7 @@
 //! filter, e.g. `cargo test --release -p synovia-cli --test suite cli::`.
 
 mod cli;
+mod concurrent;
 mod format;
 mod fuzz_scenario;
 mod outputs;
