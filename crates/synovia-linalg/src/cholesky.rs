@@ -67,7 +67,7 @@ pub struct TrailingBlock {
     generation: u64,
 }
 
-/// The next [`TrailingBlock::generation`].
+/// The next [`TrailingBlock::generation`] or [`CholeskySolver::generation`].
 static TRAILING_GENERATION: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 fn next_generation() -> u64 {
@@ -75,7 +75,7 @@ fn next_generation() -> u64 {
 }
 
 /// The storage of the blocks of `L₂₂` ([`TrailingBlock::diagonal_block`]).
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 enum TrailingStorage {
     /// A dense `k × k` copy of `L₂₂`.
     Copied(faer::Mat<f64>),
@@ -86,6 +86,18 @@ enum TrailingStorage {
     /// no copy of `L₂₂` (288 MB at `k = 6 000`). `(offset, ncols, first)`: the supernode's
     /// first value, its columns, and the block's first column within it.
     InFactor { values: Arc<Vec<f64>>, supernodes: Vec<(usize, usize, usize)> },
+}
+
+/// Sizes only: the values are the factor's (millions of entries).
+impl std::fmt::Debug for TrailingStorage {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Copied(l) => write!(f, "Copied({} × {})", l.nrows(), l.ncols()),
+            Self::InFactor { values, supernodes } => {
+                write!(f, "InFactor {{ factor entries: {}, supernodes: {supernodes:?} }}", values.len())
+            }
+        }
+    }
 }
 
 /// The finest partition of `0..k` into consecutive ranges `a..b` with `l[(i, j)] = 0` for all
@@ -179,10 +191,17 @@ impl TrailingBlock {
     /// backward half `L_b⁻ᵀ` runs over all of the block's rows). Right-hand sides sorted by
     /// their first non-zero row and solved in groups ([`Self::solve_sparse_columns`]) make use
     /// of it.
-    pub fn solve_in_place(&self, mut x: MatMut<'_, f64>) {
-        let k = x.nrows();
-        if self.blocks.last().is_none_or(|b| b.end != k) {
-            return;
+    ///
+    /// # Errors
+    /// [`LinalgError::Length`] when `x` does not have the block's `k` rows.
+    pub fn solve_in_place(&self, mut x: MatMut<'_, f64>) -> Result<(), LinalgError> {
+        let k = self.dofs.len();
+        if x.nrows() != k || self.blocks.last().is_some_and(|b| b.end != k) {
+            return Err(LinalgError::Length {
+                what: "trailing-block right-hand sides",
+                expected: k,
+                got: x.nrows(),
+            });
         }
         for (b, block) in self.blocks.iter().enumerate() {
             let (a, size) = (block.start, block.len());
@@ -198,6 +217,7 @@ impl TrailingBlock {
             );
             faer::linalg::triangular_solve::solve_upper_triangular_in_place(l.transpose(), xb, Par::Seq);
         }
+        Ok(())
     }
 
     /// `x_j = L₂₂⁻ᵀ L₂₂⁻¹ c_j` for sparse right-hand sides `c_j` given as `(position, value)`
@@ -224,32 +244,39 @@ impl TrailingBlock {
         let first = |j: usize| rhs[j].iter().map(|&(p, _)| p).min().unwrap_or(k);
         order.sort_by_key(|&j| (first(j), j));
         let groups: Vec<&[usize]> = order.chunks(SPARSE_GROUP).collect();
-        let solve_group = |group: &[usize]| -> Vec<(usize, Vec<f64>)> {
+        type Solved = Vec<(usize, Vec<f64>)>;
+        let solve_group = |group: &[usize]| -> Result<Solved, LinalgError> {
             let mut x = faer::Mat::<f64>::zeros(k, group.len());
             for (c, &j) in group.iter().enumerate() {
                 for &(p, v) in &rhs[j] {
                     x[(p, c)] += v;
                 }
             }
-            self.solve_in_place(x.as_mut());
-            group.iter().enumerate().map(|(c, &j)| (j, x.col(c).iter().copied().collect())).collect()
+            self.solve_in_place(x.as_mut())?;
+            Ok(group.iter().enumerate().map(|(c, &j)| (j, x.col(c).iter().copied().collect())).collect())
         };
-        let solve_share = |share: usize, of: usize| -> Vec<(usize, Vec<f64>)> {
-            groups.iter().skip(share).step_by(of).flat_map(|g| solve_group(g)).collect()
+        let solve_share = |share: usize, of: usize| -> Result<Solved, LinalgError> {
+            let mut out = Vec::new();
+            for g in groups.iter().skip(share).step_by(of) {
+                out.extend(solve_group(g)?);
+            }
+            Ok(out)
         };
-        let solved: Vec<(usize, Vec<f64>)> = if threads && groups.len() >= 2 {
+        let solved: Solved = if threads && groups.len() >= 2 {
             std::thread::scope(|scope| {
                 let other = scope.spawn(|| solve_share(1, 2));
-                let mut mine = solve_share(0, 2);
+                let mine = solve_share(0, 2);
                 // a panic of the other half is re-raised here (no user input can cause one)
-                match other.join() {
-                    Ok(theirs) => mine.extend(theirs),
+                let theirs = match other.join() {
+                    Ok(theirs) => theirs,
                     Err(e) => std::panic::resume_unwind(e),
-                }
-                mine
-            })
+                };
+                let mut mine = mine?;
+                mine.extend(theirs?);
+                Ok::<_, LinalgError>(mine)
+            })?
         } else {
-            solve_share(0, 1)
+            solve_share(0, 1)?
         };
         let mut out = vec![Vec::new(); rhs.len()];
         for (j, x) in solved {
@@ -351,6 +378,8 @@ pub struct CholeskySolver {
     /// per factorisation (a loop over every supernode's descendants, 2.4 % of the CPU time of
     /// the `knee2d` neo-Hookean cycle's 56 refactorisations; docs/nonlinear.md, "Fourth round").
     numeric_scratch: (Par, faer::dyn_stack::StackReq),
+    /// A number no other factorisation of this process has ([`Self::generation`]).
+    generation: u64,
 }
 
 /// The parallelism of the numeric factorisation of `symbolic`: threads pay only for large
@@ -440,6 +469,7 @@ impl CholeskySolver {
             trailing: None,
             memory_limit: None,
             numeric_scratch,
+            generation: next_generation(),
         })
     }
 
@@ -537,8 +567,8 @@ impl CholeskySolver {
             // a trailing block handed out before still reads the old values: new storage
             self.factor = Arc::new(Vec::new());
         }
-        let values = Arc::get_mut(&mut self.factor)
-            .ok_or_else(|| LinalgError::Sparse("internal: the factor's storage is shared".into()))?;
+        // the storage is not shared now (replaced just above if it was), so this never copies
+        let values = Arc::make_mut(&mut self.factor);
         if !(supernodal && values.len() == len) {
             values.clear();
             values.try_reserve_exact(len).map_err(|_| {
@@ -562,12 +592,21 @@ impl CholeskySolver {
                 }
             })?;
         self.factorized = true;
+        self.generation = next_generation();
         self.trailing = match &self.trailing_dofs {
             Some(dofs) if !dofs.is_empty() => Some(Arc::new(self.extract_trailing(dofs)?)),
             _ => None,
         };
         self.info.numeric_s = t0.elapsed().as_secs_f64();
         Ok(())
+    }
+
+    /// A number that identifies the present factorisation among all factorisations of the
+    /// process (a new one at every [`Self::factorize`]; clones share it with their values):
+    /// caches of solves keyed by it cannot mistake a refactorised solver, or a new solver
+    /// allocated where a dropped one was, for the old one.
+    pub fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// The trailing block `L₂₂` of an [`Ordering::Trailing`] factorisation (after

@@ -571,7 +571,9 @@ fn whole_factor_unit_columns(
 fn whole_factor_id(op: &CholeskyOperator<'_>) -> usize {
     use std::hash::{Hash, Hasher};
     let mut h = std::collections::hash_map::DefaultHasher::new();
-    (op.factor() as *const CholeskySolver as usize).hash(&mut h);
+    // the factorisation's generation, not the solver's address (which a refactorised solver
+    // keeps and a new solver may reuse)
+    op.factor().generation().hash(&mut h);
     op.n().hash(&mut h);
     h.finish() as usize
 }
@@ -609,19 +611,13 @@ fn trailing_solves(
     Ok(cols.iter().copied().zip(solved).collect())
 }
 
-/// A fingerprint of a trailing block: its generation (one per factorisation), size and corner
-/// entries. (Its address is not enough: a refactorisation may allocate the new block where the
-/// old one was.)
+/// A fingerprint of a trailing block: its generation (one per factorisation). (Its address is
+/// not enough: a refactorisation may allocate the new block where the old one was.)
 fn block_fingerprint(block: &TrailingBlock) -> usize {
     use std::hash::{Hash, Hasher};
+    // the generation alone: one per factorisation, never reused in the process
     let mut h = std::collections::hash_map::DefaultHasher::new();
     block.generation().hash(&mut h);
-    let k = block.dofs.len();
-    k.hash(&mut h);
-    if k > 0 {
-        block.entry(0, 0).to_bits().hash(&mut h);
-        block.entry(k - 1, k - 1).to_bits().hash(&mut h);
-    }
     h.finish() as usize
 }
 
@@ -641,6 +637,32 @@ mod tests {
             }
         }
         a
+    }
+
+    /// The key of a Cholesky operator (what kept solves are filed under) is that of its
+    /// factorisation: it changes when the same solver is refactorised in place (same
+    /// address, new values), and so does the key of its whole-factor unit solves; a clone
+    /// (same values) keeps it.
+    #[test]
+    fn operator_keys_follow_the_factorisation_not_the_address() {
+        let a = tridiagonal(30);
+        let mut a2 = a.clone();
+        a2.values_mut().iter_mut().for_each(|v| *v *= 2.0);
+        let mut solver = crate::CholeskySolver::analyse(&a, &Ordering::Amd).expect("analyse");
+        solver.factorize(&a).expect("factorize");
+        let (key1, unit1) = {
+            let op = CholeskyOperator::new(&a, &solver).expect("operator");
+            (op.key(), whole_factor_id(&op))
+        };
+        let clone = solver.clone();
+        let address = std::ptr::addr_of!(solver) as usize;
+        solver.factorize(&a2).expect("refactorize");
+        assert_eq!(std::ptr::addr_of!(solver) as usize, address);
+        let op2 = CholeskyOperator::new(&a2, &solver).expect("operator");
+        assert_ne!(op2.key(), key1, "a refactorised solver kept its key");
+        assert_ne!(whole_factor_id(&op2), unit1, "a refactorised solver kept its unit-solve key");
+        let op_clone = CholeskyOperator::new(&a, &clone).expect("operator");
+        assert_eq!(op_clone.key(), key1, "a clone of the factorisation has another key");
     }
 
     /// Every column of `S` of `rows` through the Cholesky back-end with `store`, and the

@@ -267,7 +267,9 @@ impl FactorisedOperator for CholeskyOperator<'_> {
     fn key(&self) -> u64 {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
-        (self.factor as *const CholeskySolver as usize).hash(&mut h);
+        // the factorisation's generation, not the solver's address: a refactorised solver, or
+        // a new one where a dropped one was, must not find the old one's kept solves
+        self.factor.generation().hash(&mut h);
         self.matrix.n().hash(&mut h);
         h.finish()
     }
