@@ -17,9 +17,18 @@ use synovia_cli::{Scenario, Source};
 /// (`block3d`, below, large enough for two orderings to overlap in time, and `hertz3d`),
 /// friction (`cattaneo_mindlin2d`), a neo-Hookean body (`hertz2d_neo_hookean`), TFETI
 /// subdomains partitioned by METIS (`hertz2d_tfeti`), a dynamic rolling contact
-/// (`dynamic_roller2d`).
-const SCENARIOS: [&str; 6] =
-    ["block3d", "hertz3d", "cattaneo_mindlin2d", "hertz2d_neo_hookean", "hertz2d_tfeti", "dynamic_roller2d"];
+/// (`dynamic_roller2d`), and the knee replacement's stance (`tkr3d_stance`: an STL femur
+/// queried on two threads with bounded queries, its kept far answers shared between them, and
+/// a force-controlled coordinate).
+const SCENARIOS: [&str; 7] = [
+    "block3d",
+    "hertz3d",
+    "cattaneo_mindlin2d",
+    "hertz2d_neo_hookean",
+    "hertz2d_tfeti",
+    "dynamic_roller2d",
+    "tkr3d_stance",
+];
 
 /// A block of 24 × 24 × 12 cells (≈ 23 000 unknowns, METIS ordering) pressed onto a sphere.
 const BLOCK3D: &str = r#"
