@@ -26,7 +26,8 @@
 //! ```
 //!
 //! `--neo-hookean` runs the poses twice in one process, frictionless (with `--friction 0.04`
-//! the model's friction; the whole cycle does not complete with it yet): the linear insert (the main job's model and solves, the
+//! the model's friction), the femur's concave edges rounded by fillets of 0.1 mm in both runs
+//! (`--femur-fillet R` sets another radius, 0 none): the linear insert (the main job's model and solves, the
 //! re-solve session: with friction the first pose a static solve and the others quasi-static
 //! steps, frictionless every pose a static solve) and the compressible neo-Hookean insert in
 //! finite strain with the same `E`, `ν` (`InsertLaw::NeoHookean`, the poses as quasi-static
@@ -51,9 +52,11 @@ type Error = Box<dyn std::error::Error>;
 /// Threshold of the `film_area` columns (MPa): the lower limit of Fuji Prescale LW film, with
 /// which published TKR contact areas are measured (docs/tkr3d.md).
 const FILM_THRESHOLD_MPA: f64 = 2.5;
-/// Radius (mm) of the fillets of the femur's concave edges in the neo-Hookean comparison with
-/// friction (`--femur-fillet`; docs/tkr3d.md, "Neo-Hookean insert").
-const NH_FRICTION_FILLET: f64 = 0.1;
+/// Radius (mm) of the fillets of the femur's concave edges in the neo-Hookean comparison, with
+/// or without friction (`--femur-fillet`; docs/tkr3d.md, "Neo-Hookean insert": a node pressed
+/// into a concave edge of the faceted femur keeps the finite-strain geometry passes from
+/// settling — frictionless the whole cycle stopped at its 16 % pose without them).
+const NH_FILLET: f64 = 0.1;
 
 /// Figures of one pose.
 struct Pose {
@@ -128,19 +131,18 @@ fn main() -> Result<(), Error> {
     if let Some(v) = std::env::args().skip_while(|a| a != "--friction").nth(1) {
         model.friction = v.parse()?;
     } else if std::env::args().any(|a| a == "--neo-hookean") {
-        // the comparison is frictionless unless `--friction μ` asks for friction: with friction
-        // the neo-Hookean cycle does not complete yet (docs/tkr3d.md, "Neo-Hookean insert")
+        // the comparison is frictionless unless `--friction μ` asks for friction
         model.friction = 0.0;
     }
     let friction = model.friction;
     // `--femur-fillet R`: round the femoral surface's concave edges by fillets of radius R (mm;
     // `Tkr3d::femur_fillet`). Default 0 (the STL's facets as they are), except for the
-    // neo-Hookean comparison with friction, where a node pressed into a concave edge keeps the
-    // geometry passes from settling without them (docs/tkr3d.md, "Neo-Hookean insert")
+    // neo-Hookean comparison, where a node pressed into a concave edge keeps the geometry passes
+    // from settling without them (docs/tkr3d.md, "Neo-Hookean insert")
     if let Some(v) = std::env::args().skip_while(|a| a != "--femur-fillet").nth(1) {
         model.femur_fillet = v.parse()?;
-    } else if friction > 0.0 && std::env::args().any(|a| a == "--neo-hookean") {
-        model.femur_fillet = NH_FRICTION_FILLET;
+    } else if std::env::args().any(|a| a == "--neo-hookean") {
+        model.femur_fillet = NH_FILLET;
     }
     // `--insert-material E,nu`: Young's modulus (MPa) and Poisson's ratio of the insert
     // (default UHMWPE 463 MPa, 0.46)
