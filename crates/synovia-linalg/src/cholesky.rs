@@ -549,6 +549,9 @@ impl CholeskySolver {
             return Err(LinalgError::Length { what: "matrix", expected: self.symbolic.nrows(), got: a.n() });
         }
         self.factorized = false;
+        // the values change from here on (also when the factorisation fails): a new generation,
+        // so that no solve kept under the old one is taken for this factorisation's
+        self.generation = next_generation();
         // the trailing block may read the old values in place: dropped first, so that the
         // values can be refactorised where they are
         self.trailing = None;
@@ -592,7 +595,6 @@ impl CholeskySolver {
                 }
             })?;
         self.factorized = true;
-        self.generation = next_generation();
         self.trailing = match &self.trailing_dofs {
             Some(dofs) if !dofs.is_empty() => Some(Arc::new(self.extract_trailing(dofs)?)),
             _ => None,

@@ -663,6 +663,13 @@ mod tests {
         assert_ne!(whole_factor_id(&op2), unit1, "a refactorised solver kept its unit-solve key");
         let op_clone = CholeskyOperator::new(&a, &clone).expect("operator");
         assert_eq!(op_clone.key(), key1, "a clone of the factorisation has another key");
+        // a failed factorisation (−A is not positive definite) overwrote the values: new key
+        let key2 = op2.key();
+        let mut negative = a.clone();
+        negative.values_mut().iter_mut().for_each(|v| *v = -*v);
+        assert!(solver.factorize(&negative).is_err());
+        let op3 = CholeskyOperator::new(&negative, &solver).expect("operator");
+        assert_ne!(op3.key(), key2, "a failed factorisation kept the key of the one before");
     }
 
     /// Every column of `S` of `rows` through the Cholesky back-end with `store`, and the
