@@ -567,15 +567,10 @@ fn whole_factor_unit_columns(
     Ok(solved)
 }
 
-/// The key of the whole-factor unit solves of `op` in a [`BlockSolveStore`].
+/// The key of the whole-factor unit solves of `op` in a [`BlockSolveStore`]: the operator's
+/// own [`FactorisedOperator::key`] (its factorisation's generation and size).
 fn whole_factor_id(op: &CholeskyOperator<'_>) -> usize {
-    use std::hash::{Hash, Hasher};
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    // the factorisation's generation, not the solver's address (which a refactorised solver
-    // keeps and a new solver may reuse)
-    op.factor().generation().hash(&mut h);
-    op.n().hash(&mut h);
-    h.finish() as usize
+    op.key() as usize
 }
 
 /// [`FactorisedOperator::reserve_interface`] of the Cholesky back-end: the kept whole-factor
