@@ -1,5 +1,6 @@
 //! The byte-level mutation engine shared by the fuzz targets
-//! `crates/synovia-io/tests/suite/fuzz_gmsh.rs` and `crates/synovia-cli/tests/suite/fuzz_scenario.rs`
+//! `crates/synovia-io/tests/suite/fuzz_gmsh.rs`, `crates/synovia-cli/tests/suite/fuzz_scenario.rs`,
+//! `crates/synovia-scenario/tests/suite/fuzz_stl.rs` and `crates/synovia-time/tests/suite/fuzz_table.rs`
 //! (included there with `#[path]`; see `docs/fuzzing.md`). Not a test target itself: cargo only
 //! builds the `.rs` files directly under `tests/`.
 

@@ -179,7 +179,23 @@ impl LoadHistory for PiecewiseLinear {
         let k = self.times.partition_point(|&tk| tk <= t);
         let (t0, t1) = (self.times[k - 1], self.times[k]);
         let (h0, h1) = (self.values[k - 1], self.values[k]);
-        h0 + (h1 - h0) * (t - t0) / (t1 - t0)
+        interpolate(t, (t0, h0), (t1, h1))
+    }
+}
+
+/// `h0 + (h1 − h0) s` with `s = (t − t0) / (t1 − t0) ∈ [0, 1]`, finite for every finite
+/// input with `t0 ≤ t ≤ t1`, `t0 < t1`: the fraction `s` is formed first (halved
+/// operands when `t1 − t0` overflows) and `(1 − s) h0 + s h1` replaces the difference form
+/// when `h1 − h0` overflows (points near ±1.8e308, found by `fuzz_table`).
+fn interpolate(t: Real, (t0, h0): (Real, Real), (t1, h1): (Real, Real)) -> Real {
+    let span = t1 - t0;
+    let s = if span.is_finite() { (t - t0) / span } else { (0.5 * t - 0.5 * t0) / (0.5 * t1 - 0.5 * t0) };
+    let s = s.clamp(0.0, 1.0);
+    let rise = h1 - h0;
+    if rise.is_finite() {
+        h0 + rise * s
+    } else {
+        (1.0 - s) * h0 + s * h1
     }
 }
 
@@ -471,5 +487,32 @@ mod tests {
         let p = Periodic::new(FnHistory::new(|t| t), 2.0).expect("period");
         assert!((p.value(-0.5) - 1.5).abs() < 1e-15);
         assert!((p.value(4.25) - 0.25).abs() < 1e-15);
+    }
+
+    #[test]
+    fn piecewise_linear_stays_finite_at_the_ends_of_the_range() {
+        // times and values near ±f64::MAX: the old form (h1 − h0)(t − t0)/(t1 − t0)
+        // overflowed to ±inf or NaN on each of these
+        let big = 1.0e308;
+        let cases = [
+            (vec![(0.0, 0.0), (0.005, -2.25), (big, 3000.0)], 1.25e305, -2.25, 3000.0),
+            (vec![(-big, 1.0), (big, 2.0)], 0.0, 1.0, 2.0),
+            (vec![(0.0, -big), (1.0, big)], 0.25, -big, big),
+            (vec![(-big, -big), (big, big)], 0.5e308, -big, big),
+        ];
+        for (points, t, lo, hi) in cases {
+            let h = PiecewiseLinear::new(&points).expect("finite points");
+            let v = h.value(t);
+            assert!(v.is_finite() && (lo..=hi).contains(&v), "{points:?} at {t}: {v}");
+        }
+        // exact midpoints where nothing overflows, and the old values at ordinary points
+        assert!(PiecewiseLinear::new(&[]).is_err());
+        let h = PiecewiseLinear::new(&[(-big, -big), (big, big)]).expect("points");
+        assert_eq!(h.value(0.0), 0.0);
+        let h = PiecewiseLinear::new(&[(0.0, 1.0), (2.0, 3.0), (4.0, -1.0)]).expect("points");
+        assert_eq!(h.value(1.0), 2.0);
+        assert_eq!(h.value(3.0), 1.0);
+        assert_eq!(h.value(-1.0), 1.0);
+        assert_eq!(h.value(5.0), -1.0);
     }
 }

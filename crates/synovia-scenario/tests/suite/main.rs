@@ -6,4 +6,5 @@ mod arrays;
 mod dynamic_nonlinear;
 mod force_control;
 mod friction_law_quasistatic;
+mod fuzz_stl;
 mod newton_and_fillet;

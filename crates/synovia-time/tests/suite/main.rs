@@ -4,6 +4,7 @@
 
 mod dynamic;
 mod friction_laws;
+mod fuzz_table;
 mod history;
 mod nonlinear_dynamic;
 mod one_pipeline;

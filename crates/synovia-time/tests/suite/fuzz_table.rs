@@ -1,0 +1,136 @@
+//! Byte-level fuzzing of the history tables (kinematics and load files of a scenario's
+//! `[[table]]`): the seeds — the gait kinematics `.sto` of `data/tka-grand-challenge-dm/` and
+//! the CSV files in `tests/data/tables/` (comma, semicolon and tab delimited) — mutated by the
+//! engine of `tests/support/mutate.rs`, go through `Table::parse_storage` and
+//! `Table::parse_csv`, then `require` (the six kinematics columns), `column` and `history`
+//! with unit factors (metres to millimetres, percent to cycles, a reversed time), and the
+//! histories are evaluated over the table's time range. Every input must give `Ok` or a
+//! `TableError`, never a panic, and every history built must give finite values.
+//!
+//! A few hundred cases by default (the CI smoke pass); more with
+//! `SYNOVIA_FUZZ_CASES=100000 cargo test --release -p synovia-time --test suite fuzz_table::`.
+//! See `docs/fuzzing.md`.
+
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+use proptest::prelude::*;
+use synovia_time::history::LoadHistory;
+use synovia_time::table::Table;
+
+#[path = "../../../../tests/support/mutate.rs"]
+mod mutate;
+use mutate::{apply, fuzz_cases, mutated};
+
+/// The seed corpus: the gait kinematics `.sto` and `tests/data/tables/*.csv`.
+fn seeds() -> Vec<Vec<u8>> {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(root.join("tests/data/tables"))
+        .expect("tests/data/tables")
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+        .collect();
+    paths.sort();
+    paths.push(root.join("data/tka-grand-challenge-dm/fluoroscopic_gait_kinematics.sto"));
+    assert!(paths.len() >= 4, "seed corpus missing");
+    paths.iter().map(|p| std::fs::read(p).expect("seed")).collect()
+}
+
+fn seeds_cached() -> &'static [Vec<u8>] {
+    static SEEDS: std::sync::OnceLock<Vec<Vec<u8>>> = std::sync::OnceLock::new();
+    SEEDS.get_or_init(seeds)
+}
+
+const KINEMATICS: [&str; 6] =
+    ["knee_ant_r", "knee_sup_r", "knee_lat_r", "knee_flex_r", "knee_add_r", "knee_rot_r"];
+
+/// Use a parsed table as a scenario does; `Err` on a non-finite value.
+fn use_table(table: &Table) -> Result<(), String> {
+    let _ = table.require(&KINEMATICS).map_err(|e| e.to_string());
+    let (t0, t1) = match (table.time().first(), table.time().last()) {
+        (Some(a), Some(b)) => (*a, *b),
+        _ => return Err("a table without rows was accepted".into()),
+    };
+    if !(t0.is_finite() && t1.is_finite() && t0 <= t1) {
+        return Err(format!("times {t0} … {t1}"));
+    }
+    for name in table.names().iter().skip(1).map(String::as_str).chain(KINEMATICS) {
+        let _ = table.column(name).map_err(|e| e.to_string());
+        for (factor, time_factor) in [(1.0, 1.0), (1000.0, 0.01), (1e300, 1e300), (-1.0, -1.0), (0.0, 1.0)] {
+            match table.history(name, factor, time_factor) {
+                Ok(h) => {
+                    for k in 0..=8 {
+                        let t = (t0 + (t1 - t0) * k as f64 / 8.0) * time_factor;
+                        for at in [t, t - 1.0, t + 1e-9, -t] {
+                            let v = h.value(at);
+                            if !v.is_finite() && factor.abs() < 1e300 {
+                                return Err(format!("history of `{name}` × {factor}: {v} at t = {at}"));
+                            }
+                        }
+                    }
+                }
+                Err(e) => {
+                    let _ = e.to_string();
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Parse as OpenSim storage and as CSV and use what parses. `Err(message)` on a panic.
+fn exercise(bytes: &[u8]) -> Result<(), String> {
+    let text = String::from_utf8_lossy(bytes).into_owned();
+    let run = catch_unwind(AssertUnwindSafe(|| -> Result<(), String> {
+        for parsed in [Table::parse_storage(&text, "fuzz.sto"), Table::parse_csv(&text, "fuzz.csv")] {
+            match parsed {
+                Ok(t) => use_table(&t)?,
+                Err(e) => {
+                    let _ = e.to_string();
+                }
+            }
+        }
+        Ok(())
+    }));
+    match run {
+        Ok(r) => r,
+        Err(p) => Err(p
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
+            .unwrap_or_else(|| "panic".to_string())),
+    }
+}
+
+#[test]
+fn seeds_parse() {
+    for (i, b) in seeds_cached().iter().enumerate() {
+        let text = String::from_utf8_lossy(b);
+        let table = Table::parse_storage(&text, "seed.sto")
+            .or_else(|_| Table::parse_csv(&text, "seed.csv"))
+            .unwrap_or_else(|e| panic!("seed {i}: {e}"));
+        assert!(table.rows() >= 3, "seed {i}");
+        exercise(b).unwrap();
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: fuzz_cases(512),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn mutated_tables_never_panic((seed, muts) in mutated(60)) {
+        let seeds = seeds_cached();
+        let mut input = seeds[seed % seeds.len()].clone();
+        for m in &muts {
+            apply(&mut input, m, seeds, b"endheader");
+        }
+        let r = exercise(&input);
+        prop_assert!(r.is_ok(), "{:?} on input:\n{}", r, String::from_utf8_lossy(&input));
+    }
+}
