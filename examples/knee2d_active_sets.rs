@@ -19,7 +19,7 @@ use std::time::Instant;
 use synovia::nonlinear::ActiveSetStrategy;
 use synovia::pdas::Pdas;
 use synovia_models::knee2d::{
-    cycle_times, nonlinear_cycle_with, Carry, Knee2d, KneeError, NonlinearKneeStep,
+    cycle_times, nonlinear_cycle_with, Carry, FemurFrame, Knee2d, KneeError, NonlinearKneeStep,
 };
 
 fn main() -> Result<(), KneeError> {
@@ -38,7 +38,16 @@ fn main() -> Result<(), KneeError> {
     for (label, strategy) in strategies {
         let params = Knee2d::nonlinear_newton_params().with_active_sets(strategy);
         let t0 = Instant::now();
-        let steps = nonlinear_cycle_with(&knee, &times, &guesses, &solver, params, Carry::InSpace, false)?;
+        let steps = nonlinear_cycle_with(
+            &knee,
+            &times,
+            &guesses,
+            &solver,
+            params,
+            Carry::InSpace,
+            false,
+            FemurFrame::Placed,
+        )?;
         let wall = t0.elapsed().as_secs_f64();
         let newton: usize = steps.iter().map(|s| s.step.solver_iterations).sum();
         let solves: usize = steps.iter().map(|s| s.step.solves).sum();

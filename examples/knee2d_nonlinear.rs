@@ -14,8 +14,11 @@
 //! fastest of three runs, the neo-Hookean one of two, which must agree to the last bit) and
 //! their ratio, also in the JSON line (docs/nonlinear.md).
 //!
-//! Run: `cargo run --release --example knee2d_nonlinear [STEPS]` (default 40 uniform steps + the
-//! 13 % peak = 41 poses, the poses of the `knee2d` example).
+//! Run: `cargo run --release --example knee2d_nonlinear [STEPS] [--moved-mesh]` (default 40
+//! uniform steps + the 13 % peak = 41 poses, the poses of the `knee2d` example). The femur is
+//! placed at each pose in its own frame (`FemurFrame::Placed`, the tangent's factorisation
+//! kept); `--moved-mesh` rotates its meshes between poses instead (`FemurFrame::MovedMesh`,
+//! the way before 2026-11-29), for comparison.
 
 use std::time::Instant;
 
@@ -23,10 +26,23 @@ mod process_cpu;
 use process_cpu::process_cpu_s;
 
 use synovia::pdas::Pdas;
-use synovia_models::knee2d::{cycle_times, nonlinear_cycle, Knee2d, KneeError};
+use synovia_models::knee2d::{cycle_times, nonlinear_cycle_with, Carry, FemurFrame, Knee2d, KneeError};
 
 fn main() -> Result<(), KneeError> {
-    let n: usize = std::env::args().nth(1).map(|s| s.parse()).transpose()?.unwrap_or(40);
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let frame =
+        if args.iter().any(|a| a == "--moved-mesh") { FemurFrame::MovedMesh } else { FemurFrame::Placed };
+    let frame_name = match frame {
+        FemurFrame::Placed => "placed",
+        FemurFrame::MovedMesh => "moved_mesh",
+    };
+    let n: usize = match args.iter().find(|a| !a.starts_with("--")) {
+        Some(a) => a.parse().map_err(|e| format!("STEPS `{a}`: {e}"))?,
+        None => 40,
+    };
+    if let Some(bad) = args.iter().find(|a| a.starts_with("--") && *a != "--moved-mesh") {
+        return Err(format!("unknown option `{bad}` (usage: knee2d_nonlinear [STEPS] [--moved-mesh])").into());
+    }
     let knee = Knee2d::default();
     let times = cycle_times(n);
     let solver = Pdas::default();
@@ -53,7 +69,17 @@ fn main() -> Result<(), KneeError> {
     let c1 = process_cpu_s();
     for _ in 0..2 {
         let t1 = Instant::now();
-        runs.push(nonlinear_cycle(&knee, &times, &guesses, &solver, Knee2d::nonlinear_newton_params())?);
+        let params = Knee2d::nonlinear_newton_params();
+        runs.push(nonlinear_cycle_with(
+            &knee,
+            &times,
+            &guesses,
+            &solver,
+            params,
+            Carry::InSpace,
+            true,
+            frame,
+        )?);
         nonlinear_s = nonlinear_s.min(t1.elapsed().as_secs_f64());
     }
     let nonlinear_cpu_s = (process_cpu_s() - c1) / 2.0;
@@ -126,7 +152,7 @@ fn main() -> Result<(), KneeError> {
         "linear {linear_s:.3} s (fastest of 3), neo-Hookean {nonlinear_s:.2} s (fastest of 2, the same figures to the last bit; {cost_ratio:.1}x); CPU time {linear_cpu_s:.3} s (mean of 3) and {nonlinear_cpu_s:.2} s (mean of 2; {cpu_ratio:.1}x): {solves} Newton solves ({controlled} poses under load control inside the Newton iteration), {newton} Newton iterations, {factorisations} factorisations, {trials} load-control trials"
     );
     println!(
-        "{{\"problem\":\"knee2d_nonlinear\",\"poses\":{},\"peak_pressure_linear_mpa\":{:.4},\"peak_pressure_neo_hookean_mpa\":{:.4},\"min_peak_ratio\":{min_ratio:.4},\"max_peak_ratio\":{max_ratio:.4},\"max_balance_error\":{balance:.3e},\"max_kkt\":{kkt:.3e},\"max_gap_error_per_h\":{gap:.3e},\"h_mm\":{h:.4},\"max_penetration_mm\":{penetration:.3e},\"newton_solves\":{solves},\"load_controlled_poses\":{controlled},\"newton_iterations\":{newton},\"factorisations\":{factorisations},\"load_control_trials\":{trials},\"linear_s\":{linear_s:.3},\"nonlinear_s\":{nonlinear_s:.3},\"cost_ratio\":{cost_ratio:.2},\"linear_cpu_s\":{linear_cpu_s:.3},\"nonlinear_cpu_s\":{nonlinear_cpu_s:.3},\"cpu_ratio\":{cpu_ratio:.2}}}",
+        "{{\"problem\":\"knee2d_nonlinear\",\"femur_frame\":\"{frame_name}\",\"poses\":{},\"peak_pressure_linear_mpa\":{:.4},\"peak_pressure_neo_hookean_mpa\":{:.4},\"min_peak_ratio\":{min_ratio:.4},\"max_peak_ratio\":{max_ratio:.4},\"max_balance_error\":{balance:.3e},\"max_kkt\":{kkt:.3e},\"max_gap_error_per_h\":{gap:.3e},\"h_mm\":{h:.4},\"max_penetration_mm\":{penetration:.3e},\"newton_solves\":{solves},\"load_controlled_poses\":{controlled},\"newton_iterations\":{newton},\"factorisations\":{factorisations},\"load_control_trials\":{trials},\"linear_s\":{linear_s:.3},\"nonlinear_s\":{nonlinear_s:.3},\"cost_ratio\":{cost_ratio:.2},\"linear_cpu_s\":{linear_cpu_s:.3},\"nonlinear_cpu_s\":{nonlinear_cpu_s:.3},\"cpu_ratio\":{cpu_ratio:.2}}}",
         times.len(),
         peak(&mut linear.iter().map(|s| s.peak_pressure)),
         peak(&mut nonlinear.iter().map(|h| h.step.peak_pressure)),

@@ -469,6 +469,18 @@ impl<const D: usize> ContactGeometry<D> {
     ///
     /// # Errors
     /// As [`ContactGeometry::new_deformed`].
+    ///
+    /// A geometry built with placements ([`ContactGeometry::new_placed`]) keeps them: the
+    /// displacements are then in the bodies' frames, the configuration is the placed deformed
+    /// one, `y = P_b(x + u) = x + (P_b(x) − x) + R_b u`, and the gaps are in total form for
+    /// displacements from the placed configuration,
+    ///
+    /// ```text
+    /// d_r = φ_r(y) + [R u⁰]_r · n_r      (rows on u in the bodies' frames, R_bᵀ n_r)
+    /// ```
+    ///
+    /// so a finite-strain Newton iteration on bodies moved by large rigid motions keeps the
+    /// bodies' own stiffness (docs/model.md §12, "Bodies in their own frames").
     pub fn updated(
         &self,
         model: &Model<D>,
@@ -476,7 +488,32 @@ impl<const D: usize> ContactGeometry<D> {
         displacement: &[Vec<Vector<D>>],
     ) -> Result<Self, ContactError> {
         check_pose(model, displacement)?;
-        Self::build(model, pairs, Some(displacement), true, Some(self))
+        if self.placements.iter().all(BodyPlacement::is_identity) {
+            return Self::build(model, pairs, Some(displacement), true, Some(self));
+        }
+        if self.placements.len() != model.bodies().len() {
+            return Err(ContactError::InvalidParameter(format!(
+                "a geometry placed for {} bodies updated on a model of {}",
+                self.placements.len(),
+                model.bodies().len()
+            )));
+        }
+        // the placed deformed configuration as a displacement of the reference mesh:
+        // w = (P(x) − x) + R u, and the placement's own part o = P(x) − x
+        let (mut world, mut offsets) = (Vec::with_capacity(displacement.len()), Vec::new());
+        for ((body, u), p) in model.bodies().iter().zip(displacement).zip(&self.placements) {
+            let o: Vec<Vector<D>> = body.mesh.nodes().iter().map(|x| p.position(x) - x).collect();
+            world.push(o.iter().zip(u).map(|(o, u)| o + p.to_global(u)).collect::<Vec<_>>());
+            offsets.push(o);
+        }
+        let mut geometry = Self::build(model, pairs, Some(&world), true, Some(self))?;
+        // total form in w: φ + [w]·n; the rows act on u from the placed configuration, so
+        // the placement's part [o]·n comes off: φ + [R u]·n
+        for node in &mut geometry.nodes {
+            node.gap -= node.jump(&offsets).map_or(0.0, |j| j.dot(&node.normal));
+        }
+        geometry.placements.clone_from(&self.placements);
+        Ok(geometry)
     }
 
     /// Builds the contact nodes of every pair with body `b` placed at `placements[b]`
@@ -1184,5 +1221,71 @@ mod tests {
         // and the cache still serves the valid pairs afterwards
         let cached = ContactGeometry::new_cached(&model, &pairs, &mut cache).expect("cached");
         assert_eq!(cached, ContactGeometry::new(&model, &pairs).expect("fresh"));
+    }
+
+    /// A placed geometry updated on displacements in the bodies' frames equals the geometry
+    /// of the moved meshes updated on the same displacements in space (`R u`): nodes,
+    /// normals, weights and gaps in total form, and the jumps its rows measure.
+    #[test]
+    fn placed_deformed_geometry_equals_the_moved_meshes() {
+        let centre = Arc::new(Mutex::new(Point::<3>::new(0.5, 0.5, 2.02)));
+        let (model, pairs) = boxed(3, centre.clone());
+        // the wall turned by 0.05 rad about the box's right face's vertical axis
+        let axis = nalgebra::Unit::new_normalize(Vector::<3>::new(0.1, 0.2, 1.0));
+        let rotation = *nalgebra::Rotation3::from_axis_angle(&axis, 0.05).matrix();
+        let turned =
+            BodyPlacement::rotation_about(Point::<3>::new(1.0, 0.5, 0.5), rotation).expect("rotation");
+        let placements = vec![BodyPlacement::identity(), turned];
+        // smooth displacements in the bodies' frames, the wall's towards the box
+        let u: Vec<Vec<Vector<3>>> = model
+            .bodies()
+            .iter()
+            .enumerate()
+            .map(|(b, body)| {
+                body.mesh
+                    .nodes()
+                    .iter()
+                    .map(|x| {
+                        let s = if b == 0 { 1.0 } else { -1.0 };
+                        Vector::<3>::new(0.004 * s + 0.001 * x[1], 0.002 * x[2], -0.001 * x[0])
+                    })
+                    .collect()
+            })
+            .collect();
+        let placed = ContactGeometry::new_placed(&model, &pairs, &placements)
+            .expect("placed")
+            .updated(&model, &pairs, &u)
+            .expect("updated");
+        let (mut moved_model, _) = boxed(3, centre);
+        moved_model.body_mut(BodyId(1)).expect("wall").mesh.map_nodes(|x| turned.position(x)).expect("moved");
+        let w: Vec<Vec<Vector<3>>> =
+            u.iter().zip(&placements).map(|(u, p)| u.iter().map(|v| p.to_global(v)).collect()).collect();
+        let moved = ContactGeometry::new(&moved_model, &pairs)
+            .expect("moved")
+            .updated(&moved_model, &pairs, &w)
+            .expect("updated");
+        assert_eq!(placed.len(), moved.len());
+        assert_eq!(placed.placement(BodyId(1)), turned);
+        let mut near = 0;
+        for r in 0..placed.len() {
+            let (a, b) = (&placed.nodes[r], &moved.nodes[r]);
+            assert_eq!((a.node, a.partner), (b.node, b.partner), "row {r}");
+            assert!((a.normal - b.normal).norm() < 1e-12, "row {r}: normals");
+            assert!((a.weight - b.weight).abs() < 1e-12, "row {r}: weights");
+            assert!((a.gap - b.gap).abs() < 1e-12, "row {r}: gaps {} and {}", a.gap, b.gap);
+            let (ja, jb) = (placed.jump(r, &u).expect("jump"), moved.jump(r, &w).expect("jump"));
+            assert!((ja - jb).norm() < 1e-12, "row {r}: jumps");
+            near += usize::from(a.pair == 1 && a.gap < 0.05);
+        }
+        assert!(near > 0, "the turned wall is paired with the box's side");
+        // a model of another number of bodies does not fit the placements
+        let mut one = Model::<3>::new();
+        let body = model.body(BodyId(0)).expect("box");
+        one.add_body("box", body.mesh.clone(), body.material.clone()).expect("body");
+        let err = ContactGeometry::new_placed(&model, &pairs, &placements)
+            .expect("placed")
+            .updated(&one, &pairs[..1], &u[..1])
+            .expect_err("bodies");
+        assert!(err.to_string().contains("bodies"), "{err}");
     }
 }

@@ -684,9 +684,13 @@ impl Knee2d {
     /// most the geometry tolerance once the geometry has settled
     /// (`NewtonParams::settled_increment`: 207 → 149 Newton iterations over the cycle, the
     /// figures the same to the printed digits but two fifth digits of a peak pressure),
-    /// modified Newton (the tangent kept while full steps contract the residual by 0.7: 45
-    /// factorisations against 51 with 0.5, the same iterations). docs/nonlinear.md ("Fifth
-    /// round") gives the measurements behind these choices.
+    /// modified Newton (the tangent kept while full steps contract the residual by 0.5; with
+    /// the femur placed in its own frame, `FemurFrame::Placed`, the tangent is also kept across
+    /// poses: 176 Newton iterations and 28 factorisations over the 41 poses, against 194 and
+    /// 20 with 0.7 and 160 and 43 with 0.3, the cycle 4 % faster than with 0.7; with the femur's
+    /// meshes moved, 0.7 gave 45 factorisations against 51 with 0.5). docs/nonlinear.md
+    /// ("Fifth round", "The femur in its own frame") gives the measurements behind these
+    /// choices.
     pub fn nonlinear_newton_params() -> synovia::nonlinear::NewtonParams {
         synovia::nonlinear::NewtonParams::default()
             .with_tolerance(1e-7)
@@ -697,7 +701,7 @@ impl Knee2d {
             .with_geometry_pass_tolerance(Some(1e-3))
             .with_settled_increment(Some(1e-4))
             .with_max_geometry_passes(60)
-            .with_tangent_reuse(Some(0.7))
+            .with_tangent_reuse(Some(0.5))
     }
 
     /// The model of [`Knee2d::model`] at the pose `time` with both cartilage layers (the layers
@@ -714,10 +718,38 @@ impl Knee2d {
         &self,
         time: Real,
     ) -> Result<(Model<2>, Vec<ContactPair<2>>, Vec<synovia_fem::Kinematics>), KneeError> {
+        let (model, _) = self.model(time)?;
+        self.with_neo_hookean_layers(model)
+    }
+
+    /// [`Knee2d::neo_hookean_model`] with the femur in its body frame
+    /// ([`Knee2d::body_frame_model`]: the reference pose θ = 0, the driven arc moved by
+    /// `R(θ)ᵀ (0, −δ)` with `θ` read from `angle`), to be placed at each pose
+    /// ([`synovia::nonlinear::NonlinearContact::place_bodies`]). Returns the model, the pair,
+    /// one kinematics per body and the femur's two bodies (bone, layer).
+    ///
+    /// # Errors
+    /// Mesh, material or model errors.
+    #[allow(clippy::type_complexity)]
+    pub fn neo_hookean_body_frame_model(
+        &self,
+        angle: SharedValue,
+    ) -> Result<(Model<2>, Vec<ContactPair<2>>, Vec<synovia_fem::Kinematics>, [BodyId; 2]), KneeError> {
+        let (model, _, femur) = self.build_model(None, Some(angle))?;
+        let (model, pairs, kinematics) = self.with_neo_hookean_layers(model)?;
+        Ok((model, pairs, kinematics, femur))
+    }
+
+    /// The cartilage layers of `model` neo-Hookean in finite strain and the
+    /// [`SmoothNodeToSegment`] pair (see [`Knee2d::neo_hookean_model`]).
+    #[allow(clippy::type_complexity)]
+    fn with_neo_hookean_layers(
+        &self,
+        mut model: Model<2>,
+    ) -> Result<(Model<2>, Vec<ContactPair<2>>, Vec<synovia_fem::Kinematics>), KneeError> {
         use synovia_fem::Kinematics;
         let (e, nu) = self.cartilage;
         let law: Arc<dyn synovia_material::Material<2>> = Arc::new(synovia_material::neo_hookean(e, nu)?);
-        let (mut model, _) = self.model(time)?;
         let [_, n_fc, _, n_tc] = self.body_names;
         let mut kinematics = vec![Kinematics::SmallStrain; model.bodies().len()];
         for (name, layer) in [(n_fc, self.femur_layer_material), (n_tc, self.tibia_layer_material)] {
@@ -742,15 +774,15 @@ impl Knee2d {
 }
 
 /// The cycle with hyperelastic cartilage (docs/nonlinear.md): the model of
-/// [`Knee2d::neo_hookean_model`] built **once**, at the first pose, and one
-/// [`synovia::nonlinear::NonlinearContact`] (one symbolic analysis) for the cycle. Between
-/// poses the femur's two meshes are rotated about the condyle centre `c` by the change of
-/// flexion `Δθ`, `x ↦ c + R(Δθ)(x − c)` (the re-meshed pose of [`Knee2d::model`] up to
-/// rounding, so both runs solve the same poses on the same meshes), and the converged
-/// deformed state is carried along with them ([`synovia::nonlinear::NonlinearContact::map_state`]:
-/// femoral displacements `u ↦ R(Δθ)(u − t) + t` with `t = (0, −δ)` the arc's translation,
-/// contact forces `c ↦ R(Δθ) c`), so every pose continues from the previous pose's solution
-/// instead of ramping from the reference configuration. Each pose is solved by the Newton
+/// [`Knee2d::neo_hookean_body_frame_model`] built **once**, at the first pose, and one
+/// [`synovia::nonlinear::NonlinearContact`] (one symbolic analysis) for the cycle. At each
+/// pose the femur's two bodies are placed in space, turned about the condyle centre `c` by
+/// the flexion `θ` ([`synovia::nonlinear::NonlinearContact::place_bodies`], the poses of
+/// [`Knee2d::model`]; the meshes and the tangent's factorisation stay in the femur's frame),
+/// and the converged state is carried to the new placement — the femur's displacement field
+/// kept in space ([`nonlinear_cycle_with`] with [`Carry::InSpace`] and [`FemurFrame::Placed`]),
+/// so every pose continues from the previous pose's solution instead of ramping from the
+/// reference configuration. Each pose is solved by the Newton
 /// iteration with `params` (e.g. [`Knee2d::nonlinear_newton_params`]) under the same load
 /// control as the linear cycle: a secant iteration on the approach `δ` until the vertical
 /// contact resultant `Σ κ_r Λ_n,r n_r · e_y` equals `F(t) / w` within [`Knee2d::tolerance`],
@@ -769,7 +801,7 @@ pub fn nonlinear_cycle(
     solver: &dyn ContactSolver,
     params: synovia::nonlinear::NewtonParams,
 ) -> Result<Vec<NonlinearKneeStep>, KneeError> {
-    nonlinear_cycle_with(knee, times, guesses, solver, params, Carry::InSpace, true)
+    nonlinear_cycle_with(knee, times, guesses, solver, params, Carry::InSpace, true, FemurFrame::Placed)
 }
 
 /// How [`nonlinear_cycle_with`] carries the converged state of one pose to the next.
@@ -784,15 +816,30 @@ pub enum Carry {
     InSpace,
 }
 
+/// How [`nonlinear_cycle_with`] moves the femur between poses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FemurFrame {
+    /// The femur in its body frame, placed at each pose
+    /// ([`synovia::nonlinear::NonlinearContact::place_bodies`],
+    /// [`Knee2d::neo_hookean_body_frame_model`]): its meshes, and so the tangent's
+    /// factorisation, stay as they are; the contact geometry is that of the placed deformed
+    /// femur, `c + R(θ)(x + u − c)`.
+    Placed,
+    /// The femur's two meshes rotated about the condyle centre by the change of flexion
+    /// (the tangent refactorised at every pose).
+    MovedMesh,
+}
+
 /// [`nonlinear_cycle`] with the state carried between poses by `carry`, and with
 /// `load_control` the poses after the first solved under load control inside the Newton
 /// iteration ([`synovia::nonlinear::NonlinearContact::step_controlled`]: every iteration
 /// chooses the approach `δ` at which its linearised problem balances `F(t) / w`), falling back
 /// to the secant iteration on `δ` around whole Newton solves if that fails; without it, the
-/// secant iteration for every pose.
+/// secant iteration for every pose; `frame` chooses how the femur moves between poses.
 ///
 /// # Errors
 /// As [`nonlinear_cycle`].
+#[allow(clippy::too_many_arguments)]
 pub fn nonlinear_cycle_with(
     knee: &Knee2d,
     times: &[Real],
@@ -801,6 +848,7 @@ pub fn nonlinear_cycle_with(
     params: synovia::nonlinear::NewtonParams,
     carry: Carry,
     control: bool,
+    frame: FemurFrame,
 ) -> Result<Vec<NonlinearKneeStep>, KneeError> {
     use synovia::nonlinear::NonlinearContact;
     let force = iso14243_axial_force()?;
@@ -808,16 +856,35 @@ pub fn nonlinear_cycle_with(
     let mut steps = Vec::with_capacity(times.len());
     let Some(&first) = times.first() else { return Ok(steps) };
     let setup = Instant::now();
-    let (mut model, pairs, kinematics) = knee.neo_hookean_model(first)?;
+    let placed = frame == FemurFrame::Placed;
+    // the flexion read by the body-frame model's driven arc (`FemurFrame::Placed`)
+    let angle = SharedValue::new(flexion.value(first));
+    let (mut model, pairs, kinematics) = if placed {
+        let (model, pairs, kinematics, _) = knee.neo_hookean_body_frame_model(angle.clone())?;
+        (model, pairs, kinematics)
+    } else {
+        knee.neo_hookean_model(first)?
+    };
     let femur = [model.body_id(knee.body_names[0])?, model.body_id(knee.body_names[1])?];
+    let centre = knee.condyle_centre();
+    let n_bodies = model.bodies().len();
+    // the femur's two bodies turned by θ about the condyle centre, the tibia where it is
+    let placements_at = |theta: Real| -> Result<Vec<BodyPlacement<2>>, KneeError> {
+        let turned = BodyPlacement::planar_rotation(centre, theta)?;
+        Ok((0..n_bodies)
+            .map(|b| if femur.iter().any(|f| f.0 == b) { turned } else { BodyPlacement::identity() })
+            .collect())
+    };
     // the tangent is refactorised at most Newton iterations (56 times over the 41 poses of the
     // cycle): METIS nested dissection gives it a factor of 1.21M entries against AMD's 1.77M
     // (the 2D default), −10 % of the cycle's CPU time (docs/nonlinear.md, "Fourth round")
     let elastic = ElasticParams::default().with_ordering(synovia::fem::OrderingChoice::Metis);
     let mut nl = NonlinearContact::new(&model, &pairs, &kinematics, elastic, params)?;
-    let mut setup_s = setup.elapsed().as_secs_f64();
     let mut theta_model = flexion.value(first);
-    let centre = knee.condyle_centre();
+    if placed {
+        nl.place_bodies(&model, &placements_at(theta_model)?)?;
+    }
+    let mut setup_s = setup.elapsed().as_secs_f64();
     // the last pose's approach and its guess, and the slope dF/dδ of its last secant step
     let mut last_approach: Option<(Real, Option<Real>)> = None;
     let mut last_slope: Option<(Real, Real)> = None;
@@ -828,7 +895,52 @@ pub fn nonlinear_cycle_with(
         let target = load_n / knee.width;
         let tolerance = knee.tolerance * target;
         // the femur placed in this pose, its deformed state carried along
-        if theta != theta_model {
+        if placed && theta != theta_model {
+            let (old, new) = (placements_at(theta_model)?, placements_at(theta)?);
+            let (p_old, p_new) = (old[femur[0].0], new[femur[0].0]);
+            // the arc's translation t = (0, −δ) stays vertical in space
+            let t = Vector::<2>::new(0.0, -nl.time());
+            let fields = match carry {
+                Carry::Rotate => None,
+                Carry::InSpace => {
+                    // the femur's displacement in space, R_old u, on its placed meshes
+                    let lifts = nl.dofs().lifts(&model, nl.time())?;
+                    let disp = nl.dofs().expand(nl.reduced(), &lifts)?;
+                    let mut fields = Vec::with_capacity(femur.len());
+                    for &b in &femur {
+                        let mut mesh = model.body(b)?.mesh.clone();
+                        mesh.map_nodes(|x| p_old.position(x))?;
+                        let values: Vec<Vector<2>> = disp[b.0].iter().map(|u| p_old.to_global(u)).collect();
+                        fields.push(SpatialField::new(&mesh, &values, centre));
+                    }
+                    Some(fields)
+                }
+            };
+            let slot = |b: BodyId| femur.iter().position(|f| *f == b);
+            let model_ref = &model;
+            nl.map_state_in_frames(
+                |b, i, u| match (slot(b), &fields) {
+                    // the field in space at the node's new placed position, in the new frame
+                    (Some(k), Some(fields)) => model_ref
+                        .body(b)
+                        .ok()
+                        .and_then(|body| body.mesh.nodes().get(i))
+                        .map_or(*u, |x| p_new.to_body(&fields[k].value(&p_new.position(x)))),
+                    // the shape turned with the femur, the arc's translation kept vertical
+                    (Some(_), None) => u - p_old.to_body(&t) + p_new.to_body(&t),
+                    (None, _) => *u,
+                },
+                // contact forces kept in space (InSpace) or turned with the femur (Rotate)
+                |b, _, c| match (slot(b), &fields) {
+                    (Some(_), Some(_)) => p_new.to_body(&p_old.to_global(c)),
+                    _ => *c,
+                },
+            );
+            angle.set(theta);
+            nl.place_bodies(&model, &new)?;
+            theta_model = theta;
+        }
+        if !placed && theta != theta_model {
             let place = BodyPlacement::planar_rotation(centre, theta - theta_model)?;
             let carry = match carry {
                 Carry::Rotate => None,
@@ -969,14 +1081,19 @@ pub fn nonlinear_cycle_with(
         let (contact_length, peak_r, peak) = contact_length_and_peak(geo, &contact.solution.lambda_n);
         // the gaps of the solution on its own deformed configuration: d(x + u) = d_total − [u] · n
         let disp = &contact.displacement;
-        let deformed = ContactGeometry::new_deformed(&model, &pairs, disp)?;
+        let deformed = if placed {
+            ContactGeometry::new_placed(&model, &pairs, &placements_at(theta_model)?)?
+                .updated(&model, &pairs, disp)?
+        } else {
+            ContactGeometry::new_deformed(&model, &pairs, disp)?
+        };
         let active_nodes: std::collections::HashSet<usize> = (0..geo.len())
             .filter(|&r| contact.solution.lambda_n[r] > 0.0)
             .map(|r| geo.nodes[r].node.1)
             .collect();
         let (mut gap_error, mut penetration) = (0.0_f64, 0.0_f64);
-        for node in &deformed.nodes {
-            let jump = node.jump(disp).ok_or("contact node outside the displacement field")?;
+        for (r, node) in deformed.nodes.iter().enumerate() {
+            let jump = deformed.jump(r, disp).ok_or("contact node outside the displacement field")?;
             let d = node.gap - jump.dot(&node.normal);
             penetration = penetration.max(-d);
             if active_nodes.contains(&node.node.1) {

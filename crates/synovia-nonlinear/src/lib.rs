@@ -682,6 +682,44 @@ impl<const D: usize> NonlinearContact<D> {
         Ok(self.contact.rebuild_geometry(model, &self.pairs)?)
     }
 
+    /// Places the bodies rigidly, `x ↦ R_b x + t_b` ([`StaticContact::place_bodies`], one
+    /// [`BodyPlacement`](synovia_contact::operators::BodyPlacement) per body): the contact
+    /// geometry pairs and measures the placed bodies, and in finite strain every rebuild on
+    /// the deformed configuration keeps the placements (the configuration `P_b(x + u)`,
+    /// [`ContactGeometry::updated`]). Displacements, loads, prescribed displacements and
+    /// contact forces of a body stay in its own frame, so its stiffness does not change with
+    /// the placement and the factorised tangent is **kept** (modified Newton,
+    /// [`NewtonParams::tangent_reuse`], reuses it while it contracts): a body turned by a
+    /// large rigid motion between levels (a flexing femur) costs no refactorisation, where
+    /// moving its mesh ([`Self::map_state`]) does. The state is kept as it is; carry it with
+    /// [`Self::map_state_in_frames`] if the caller's state should change with the move.
+    /// [`Self::rebuild_geometry`] builds on the reference meshes without placements.
+    ///
+    /// # Errors
+    /// As [`StaticContact::place_bodies`].
+    pub fn place_bodies(
+        &mut self,
+        model: &Model<D>,
+        placements: &[synovia_contact::operators::BodyPlacement<D>],
+    ) -> Result<ContactGeometry<D>, NonlinearError> {
+        Ok(self.contact.place_bodies(model, &self.pairs, placements)?)
+    }
+
+    /// [`Self::map_state`] for a state that changes while the meshes do not (e.g. bodies
+    /// re-placed with [`Self::place_bodies`] and a displacement carried in space): the same
+    /// mapping of `ũ` and `c̃`, but the factorised tangent is kept for modified Newton (the
+    /// model's matrix is that of the same meshes; the next iterations contract on it or
+    /// refactorise, [`NewtonParams::tangent_reuse`]).
+    pub fn map_state_in_frames(
+        &mut self,
+        f_u: impl Fn(synovia_fem::BodyId, usize, &Vector<D>) -> Vector<D>,
+        f_c: impl Fn(synovia_fem::BodyId, usize, &Vector<D>) -> Vector<D>,
+    ) {
+        let kept = self.tangent_kept;
+        self.map_state(f_u, f_c);
+        self.tangent_kept = kept;
+    }
+
     /// Gap screening of the contact solves ([`StaticContact::set_screening_band`]).
     ///
     /// # Errors
