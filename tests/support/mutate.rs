@@ -6,6 +6,19 @@
 
 use proptest::prelude::*;
 
+/// Runs `f`, a panic turned into `Err` with its message (the fuzz targets' check that an
+/// input gives `Ok` or a typed error, never a panic).
+pub fn caught(f: impl FnOnce() -> Result<(), String>) -> Result<(), String> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(r) => r,
+        Err(p) => Err(p
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
+            .unwrap_or_else(|| "panic".to_string())),
+    }
+}
+
 /// Number of cases: `SYNOVIA_FUZZ_CASES`, default `default`.
 pub fn fuzz_cases(default: u32) -> u32 {
     std::env::var("SYNOVIA_FUZZ_CASES").ok().and_then(|s| s.trim().parse().ok()).unwrap_or(default)

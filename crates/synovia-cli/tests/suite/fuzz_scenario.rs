@@ -11,7 +11,6 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use proptest::prelude::*;
@@ -20,7 +19,7 @@ use synovia_cli::{Scenario, Source};
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, fuzz_cases, mutated};
+use mutate::{apply, caught, fuzz_cases, mutated};
 
 /// The seed corpus: `examples/scenarios/*.toml`, with their paths (a `gmsh` mesh is resolved
 /// relative to the scenario file, so the mutated text keeps its seed's path).
@@ -43,7 +42,7 @@ fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
 /// Parse, validate and build; format the error. `Err(message)` on a panic.
 fn exercise(path: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
     let text = String::from_utf8_lossy(bytes).into_owned();
-    catch_unwind(AssertUnwindSafe(|| {
+    caught(|| {
         match Scenario::parse(Source::new(path, text)).and_then(|sc| check(&sc).map(|_| ())) {
             Ok(()) => {}
             Err(e) => {
@@ -51,12 +50,7 @@ fn exercise(path: &std::path::Path, bytes: &[u8]) -> Result<(), String> {
                 let _ = format!("{e:?}");
             }
         }
-    }))
-    .map_err(|p| {
-        p.downcast_ref::<String>()
-            .cloned()
-            .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
-            .unwrap_or_else(|| "panic".to_string())
+        Ok(())
     })
 }
 

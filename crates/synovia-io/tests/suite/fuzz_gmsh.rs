@@ -11,7 +11,6 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use proptest::prelude::*;
@@ -19,7 +18,7 @@ use synovia_io::parse_msh;
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, fuzz_cases, mutated};
+use mutate::{apply, caught, fuzz_cases, mutated};
 
 /// The seed corpus: `tests/data/*.msh` and `examples/scenarios/block2d.msh`.
 fn seeds() -> Vec<Vec<u8>> {
@@ -42,24 +41,21 @@ fn seeds_cached() -> &'static [Vec<u8>] {
 
 /// Parse and build the bodies in 2D and 3D; format the errors. `Err(message)` on a panic.
 fn exercise(bytes: &[u8]) -> Result<(), String> {
-    catch_unwind(AssertUnwindSafe(|| match parse_msh(bytes) {
-        Ok(m) => {
-            let _ = m.physical_groups();
-            for r in [m.bodies::<2>().map(|_| ()), m.bodies::<3>().map(|_| ())] {
-                if let Err(e) = r {
-                    let _ = e.to_string();
+    caught(|| {
+        match parse_msh(bytes) {
+            Ok(m) => {
+                let _ = m.physical_groups();
+                for r in [m.bodies::<2>().map(|_| ()), m.bodies::<3>().map(|_| ())] {
+                    if let Err(e) = r {
+                        let _ = e.to_string();
+                    }
                 }
             }
+            Err(e) => {
+                let _ = e.to_string();
+            }
         }
-        Err(e) => {
-            let _ = e.to_string();
-        }
-    }))
-    .map_err(|p| {
-        p.downcast_ref::<String>()
-            .cloned()
-            .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
-            .unwrap_or_else(|| "panic".to_string())
+        Ok(())
     })
 }
 

@@ -18,7 +18,6 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use proptest::prelude::*;
@@ -28,7 +27,7 @@ use synovia::mesh::{Point, TriangleSurface};
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, fuzz_cases, mutated};
+use mutate::{apply, caught, fuzz_cases, mutated};
 
 /// The seed corpus: `tests/data/stl/*.stl` of the workspace.
 fn seeds() -> Vec<Vec<u8>> {
@@ -92,7 +91,7 @@ fn check_answers(obstacle: &SurfaceObstacle, points: &[Point<3>]) -> Result<(), 
 /// Parse, scale, build the obstacles a scenario can build, query them; format the errors.
 /// `Err(message)` on a panic or a non-finite answer.
 fn exercise(bytes: &[u8]) -> Result<(), String> {
-    let run = catch_unwind(AssertUnwindSafe(|| -> Result<(), String> {
+    caught(|| {
         let surface = match synovia::io::parse_stl(bytes) {
             Ok(s) => s,
             Err(e) => {
@@ -132,15 +131,7 @@ fn exercise(bytes: &[u8]) -> Result<(), String> {
             }
         }
         Ok(())
-    }));
-    match run {
-        Ok(r) => r,
-        Err(p) => Err(p
-            .downcast_ref::<String>()
-            .cloned()
-            .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
-            .unwrap_or_else(|| "panic".to_string())),
-    }
+    })
 }
 
 #[test]

@@ -13,7 +13,6 @@
 
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
 use proptest::prelude::*;
@@ -22,7 +21,7 @@ use synovia_time::table::Table;
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, fuzz_cases, mutated};
+use mutate::{apply, caught, fuzz_cases, mutated};
 
 /// The seed corpus: the gait kinematics `.sto` and `tests/data/tables/*.csv`.
 fn seeds() -> Vec<Vec<u8>> {
@@ -83,7 +82,7 @@ fn use_table(table: &Table) -> Result<(), String> {
 /// Parse as OpenSim storage and as CSV and use what parses. `Err(message)` on a panic.
 fn exercise(bytes: &[u8]) -> Result<(), String> {
     let text = String::from_utf8_lossy(bytes).into_owned();
-    let run = catch_unwind(AssertUnwindSafe(|| -> Result<(), String> {
+    caught(|| {
         for parsed in [Table::parse_storage(&text, "fuzz.sto"), Table::parse_csv(&text, "fuzz.csv")] {
             match parsed {
                 Ok(t) => use_table(&t)?,
@@ -93,15 +92,7 @@ fn exercise(bytes: &[u8]) -> Result<(), String> {
             }
         }
         Ok(())
-    }));
-    match run {
-        Ok(r) => r,
-        Err(p) => Err(p
-            .downcast_ref::<String>()
-            .cloned()
-            .or_else(|| p.downcast_ref::<&str>().map(|s| (*s).to_string()))
-            .unwrap_or_else(|| "panic".to_string())),
-    }
+    })
 }
 
 #[test]
