@@ -500,12 +500,13 @@ impl<const D: usize> ContactGeometry<D> {
         }
         // the placed deformed configuration as a displacement of the reference mesh:
         // w = (P(x) − x) + R u, and the placement's own part o = P(x) − x
-        let (mut world, mut offsets) = (Vec::with_capacity(displacement.len()), Vec::new());
-        for ((body, u), p) in model.bodies().iter().zip(displacement).zip(&self.placements) {
-            let o: Vec<Vector<D>> = body.mesh.nodes().iter().map(|x| p.position(x) - x).collect();
-            world.push(o.iter().zip(u).map(|(o, u)| o + p.to_global(u)).collect::<Vec<_>>());
-            offsets.push(o);
-        }
+        let offsets = placement_offsets(model, &self.placements);
+        let world: Vec<Vec<Vector<D>>> = offsets
+            .iter()
+            .zip(displacement)
+            .zip(&self.placements)
+            .map(|((o, u), p)| o.iter().zip(u).map(|(o, u)| o + p.to_global(u)).collect())
+            .collect();
         let mut geometry = Self::build(model, pairs, Some(&world), true, Some(self))?;
         // total form in w: φ + [w]·n; the rows act on u from the placed configuration, so
         // the placement's part [o]·n comes off: φ + [R u]·n
@@ -555,11 +556,7 @@ impl<const D: usize> ContactGeometry<D> {
             return Self::build(model, pairs, None, true, None);
         }
         // the placed configuration as a displacement u⁰ = R x + t − x of the reference mesh
-        let offsets: Vec<Vec<Vector<D>>> = bodies
-            .iter()
-            .zip(placements)
-            .map(|(b, p)| b.mesh.nodes().iter().map(|x| p.position(x) - x).collect())
-            .collect();
+        let offsets = placement_offsets(model, placements);
         // the rows act on the displacement from the placed configuration: gaps of the placed
         // bodies, not in total form
         let mut geometry = Self::build(model, pairs, Some(&offsets), false, None)?;
@@ -1140,6 +1137,20 @@ fn check_row<const D: usize>(model: &Model<D>, on_part: &[bool], row: &ContactRo
 }
 
 /// `Err` unless `displacement` has one finite vector per node of every body of `model`.
+/// The placed configuration of every body as a displacement of its reference mesh,
+/// `o = P_b(x) − x` per node (one placement per body).
+fn placement_offsets<const D: usize>(
+    model: &Model<D>,
+    placements: &[BodyPlacement<D>],
+) -> Vec<Vec<Vector<D>>> {
+    model
+        .bodies()
+        .iter()
+        .zip(placements)
+        .map(|(b, p)| b.mesh.nodes().iter().map(|x| p.position(x) - x).collect())
+        .collect()
+}
+
 fn check_pose<const D: usize>(model: &Model<D>, displacement: &[Vec<Vector<D>>]) -> Result<(), ContactError> {
     let bodies = model.bodies();
     let fits = displacement.len() == bodies.len()

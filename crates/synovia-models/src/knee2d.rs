@@ -493,10 +493,7 @@ impl KneeCycle {
     /// # Errors
     /// If `theta` is not finite.
     pub fn placements(&self, theta: Real) -> Result<Vec<BodyPlacement<2>>, KneeError> {
-        let femur = BodyPlacement::planar_rotation(self.knee.condyle_centre(), theta)?;
-        Ok((0..self.model.bodies().len())
-            .map(|b| if self.femur.iter().any(|f| f.0 == b) { femur } else { BodyPlacement::identity() })
-            .collect())
+        femur_placements(self.knee.condyle_centre(), theta, &self.femur, self.model.bodies().len())
     }
 
     /// Solves the pose of cycle fraction `time` under the ISO load: secant iteration on the
@@ -804,6 +801,42 @@ pub fn nonlinear_cycle(
     nonlinear_cycle_with(knee, times, guesses, solver, params, Carry::InSpace, true, FemurFrame::Placed)
 }
 
+/// One placement per body of a model of `n_bodies`: the femur's bodies turned by `theta`
+/// about the condyle centre `centre`, the others where their meshes are.
+fn femur_placements(
+    centre: Point<2>,
+    theta: Real,
+    femur: &[BodyId; 2],
+    n_bodies: usize,
+) -> Result<Vec<BodyPlacement<2>>, KneeError> {
+    let turned = BodyPlacement::planar_rotation(centre, theta)?;
+    Ok((0..n_bodies)
+        .map(|b| if femur.iter().any(|f| f.0 == b) { turned } else { BodyPlacement::identity() })
+        .collect())
+}
+
+/// The femur's displacement field in space at the converged state of `nl`: one
+/// [`SpatialField`] per femur body, on its meshes placed by `placement` (the identity for
+/// meshes moved in place), with the values `R u` (about `centre`).
+fn femur_fields_in_space(
+    nl: &synovia::nonlinear::NonlinearContact<2>,
+    model: &Model<2>,
+    femur: &[BodyId; 2],
+    placement: &BodyPlacement<2>,
+    centre: Point<2>,
+) -> Result<Vec<SpatialField>, KneeError> {
+    let lifts = nl.dofs().lifts(model, nl.time())?;
+    let disp = nl.dofs().expand(nl.reduced(), &lifts)?;
+    let mut fields = Vec::with_capacity(femur.len());
+    for &b in femur {
+        let mut mesh = model.body(b)?.mesh.clone();
+        mesh.map_nodes(|x| placement.position(x))?;
+        let values: Vec<Vector<2>> = disp[b.0].iter().map(|u| placement.to_global(u)).collect();
+        fields.push(SpatialField::new(&mesh, &values, centre));
+    }
+    Ok(fields)
+}
+
 /// How [`nonlinear_cycle_with`] carries the converged state of one pose to the next.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Carry {
@@ -868,13 +901,6 @@ pub fn nonlinear_cycle_with(
     let femur = [model.body_id(knee.body_names[0])?, model.body_id(knee.body_names[1])?];
     let centre = knee.condyle_centre();
     let n_bodies = model.bodies().len();
-    // the femur's two bodies turned by θ about the condyle centre, the tibia where it is
-    let placements_at = |theta: Real| -> Result<Vec<BodyPlacement<2>>, KneeError> {
-        let turned = BodyPlacement::planar_rotation(centre, theta)?;
-        Ok((0..n_bodies)
-            .map(|b| if femur.iter().any(|f| f.0 == b) { turned } else { BodyPlacement::identity() })
-            .collect())
-    };
     // the tangent is refactorised at most Newton iterations (56 times over the 41 poses of the
     // cycle): METIS nested dissection gives it a factor of 1.21M entries against AMD's 1.77M
     // (the 2D default), −10 % of the cycle's CPU time (docs/nonlinear.md, "Fourth round")
@@ -882,7 +908,7 @@ pub fn nonlinear_cycle_with(
     let mut nl = NonlinearContact::new(&model, &pairs, &kinematics, elastic, params)?;
     let mut theta_model = flexion.value(first);
     if placed {
-        nl.place_bodies(&model, &placements_at(theta_model)?)?;
+        nl.place_bodies(&model, &femur_placements(centre, theta_model, &femur, n_bodies)?)?;
     }
     let mut setup_s = setup.elapsed().as_secs_f64();
     // the last pose's approach and its guess, and the slope dF/dδ of its last secant step
@@ -895,84 +921,62 @@ pub fn nonlinear_cycle_with(
         let target = load_n / knee.width;
         let tolerance = knee.tolerance * target;
         // the femur placed in this pose, its deformed state carried along
-        if placed && theta != theta_model {
-            let (old, new) = (placements_at(theta_model)?, placements_at(theta)?);
-            let (p_old, p_new) = (old[femur[0].0], new[femur[0].0]);
-            // the arc's translation t = (0, −δ) stays vertical in space
-            let t = Vector::<2>::new(0.0, -nl.time());
+        if theta != theta_model {
+            // where the femur's meshes are in space: placed in its frame, or moved in place
+            let p_old = if placed {
+                BodyPlacement::planar_rotation(centre, theta_model)?
+            } else {
+                BodyPlacement::identity()
+            };
             let fields = match carry {
                 Carry::Rotate => None,
-                Carry::InSpace => {
-                    // the femur's displacement in space, R_old u, on its placed meshes
-                    let lifts = nl.dofs().lifts(&model, nl.time())?;
-                    let disp = nl.dofs().expand(nl.reduced(), &lifts)?;
-                    let mut fields = Vec::with_capacity(femur.len());
-                    for &b in &femur {
-                        let mut mesh = model.body(b)?.mesh.clone();
-                        mesh.map_nodes(|x| p_old.position(x))?;
-                        let values: Vec<Vector<2>> = disp[b.0].iter().map(|u| p_old.to_global(u)).collect();
-                        fields.push(SpatialField::new(&mesh, &values, centre));
-                    }
-                    Some(fields)
-                }
+                Carry::InSpace => Some(femur_fields_in_space(&nl, &model, &femur, &p_old, centre)?),
             };
             let slot = |b: BodyId| femur.iter().position(|f| *f == b);
-            let model_ref = &model;
-            nl.map_state_in_frames(
-                |b, i, u| match (slot(b), &fields) {
-                    // the field in space at the node's new placed position, in the new frame
-                    (Some(k), Some(fields)) => model_ref
-                        .body(b)
-                        .ok()
-                        .and_then(|body| body.mesh.nodes().get(i))
-                        .map_or(*u, |x| p_new.to_body(&fields[k].value(&p_new.position(x)))),
-                    // the shape turned with the femur, the arc's translation kept vertical
-                    (Some(_), None) => u - p_old.to_body(&t) + p_new.to_body(&t),
-                    (None, _) => *u,
-                },
-                // contact forces kept in space (InSpace) or turned with the femur (Rotate)
-                |b, _, c| match (slot(b), &fields) {
-                    (Some(_), Some(_)) => p_new.to_body(&p_old.to_global(c)),
-                    _ => *c,
-                },
-            );
-            angle.set(theta);
-            nl.place_bodies(&model, &new)?;
-            theta_model = theta;
-        }
-        if !placed && theta != theta_model {
-            let place = BodyPlacement::planar_rotation(centre, theta - theta_model)?;
-            let carry = match carry {
-                Carry::Rotate => None,
-                Carry::InSpace => {
-                    let lifts = nl.dofs().lifts(&model, nl.time())?;
-                    let disp = nl.dofs().expand(nl.reduced(), &lifts)?;
-                    Some(
-                        femur
-                            .iter()
-                            .map(|&b| Ok(SpatialField::new(&model.body(b)?.mesh, &disp[b.0], centre)))
-                            .collect::<Result<Vec<_>, KneeError>>()?,
-                    )
+            // the arc's translation t = (0, −δ) stays vertical in space
+            let t = Vector::<2>::new(0.0, -nl.time());
+            if placed {
+                let p_new = BodyPlacement::planar_rotation(centre, theta)?;
+                let model_ref = &model;
+                nl.map_state_in_frames(
+                    |b, i, u| match (slot(b), &fields) {
+                        // the field in space at the node's new placed position, in the new frame
+                        (Some(k), Some(fields)) => model_ref
+                            .body(b)
+                            .ok()
+                            .and_then(|body| body.mesh.nodes().get(i))
+                            .map_or(*u, |x| p_new.to_body(&fields[k].value(&p_new.position(x)))),
+                        // the shape turned with the femur, the arc's translation kept vertical
+                        (Some(_), None) => u - p_old.to_body(&t) + p_new.to_body(&t),
+                        (None, _) => *u,
+                    },
+                    // contact forces kept in space (InSpace) or turned with the femur (Rotate)
+                    |b, _, c| match (slot(b), &fields) {
+                        (Some(_), Some(_)) => p_new.to_body(&p_old.to_global(c)),
+                        _ => *c,
+                    },
+                );
+                angle.set(theta);
+                nl.place_bodies(&model, &femur_placements(centre, theta, &femur, n_bodies)?)?;
+            } else {
+                let place = BodyPlacement::planar_rotation(centre, theta - theta_model)?;
+                for &b in &femur {
+                    model.body_mut(b)?.mesh.map_nodes(|x| place.position(x))?;
                 }
-            };
-            for &b in &femur {
-                model.body_mut(b)?.mesh.map_nodes(|x| place.position(x))?;
+                let model_ref = &model;
+                nl.map_state(
+                    |b, i, u| match (slot(b), &fields) {
+                        (Some(k), Some(fields)) => model_ref
+                            .body(b)
+                            .ok()
+                            .and_then(|body| body.mesh.nodes().get(i))
+                            .map_or(*u, |x| fields[k].value(x)),
+                        (Some(_), None) => place.to_global(&(u - t)) + t,
+                        (None, _) => *u,
+                    },
+                    |b, _, c| if slot(b).is_some() && fields.is_none() { place.to_global(c) } else { *c },
+                );
             }
-            let shift = Vector::<2>::new(0.0, -nl.time());
-            let slot = |b: BodyId| femur.iter().position(|f| *f == b);
-            let model_ref = &model;
-            nl.map_state(
-                |b, i, u| match (slot(b), &carry) {
-                    (Some(k), Some(fields)) => model_ref
-                        .body(b)
-                        .ok()
-                        .and_then(|body| body.mesh.nodes().get(i))
-                        .map_or(*u, |x| fields[k].value(x)),
-                    (Some(_), None) => place.to_global(&(u - shift)) + shift,
-                    (None, _) => *u,
-                },
-                |b, _, c| if slot(b).is_some() && carry.is_none() { place.to_global(c) } else { *c },
-            );
             theta_model = theta;
         }
         let (mut solves, mut newton, mut factorisations) = (0usize, 0usize, 0usize);
@@ -1082,8 +1086,12 @@ pub fn nonlinear_cycle_with(
         // the gaps of the solution on its own deformed configuration: d(x + u) = d_total − [u] · n
         let disp = &contact.displacement;
         let deformed = if placed {
-            ContactGeometry::new_placed(&model, &pairs, &placements_at(theta_model)?)?
-                .updated(&model, &pairs, disp)?
+            ContactGeometry::new_placed(
+                &model,
+                &pairs,
+                &femur_placements(centre, theta_model, &femur, n_bodies)?,
+            )?
+            .updated(&model, &pairs, disp)?
         } else {
             ContactGeometry::new_deformed(&model, &pairs, disp)?
         };
