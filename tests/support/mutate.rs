@@ -19,6 +19,37 @@ pub fn caught(f: impl FnOnce() -> Result<(), String>) -> Result<(), String> {
     }
 }
 
+/// The files of `dir` whose extension is `ext`, sorted (a seed corpus).
+pub fn files_with_extension(dir: &std::path::Path, ext: &str) -> Vec<std::path::PathBuf> {
+    let mut paths: Vec<std::path::PathBuf> = std::fs::read_dir(dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("dir entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    paths.sort();
+    paths
+}
+
+/// The proptest configuration of the fuzz targets: [`fuzz_cases`]`(default)` cases, failing
+/// inputs printed (shrunk) rather than persisted.
+pub fn fuzz_config(default: u32) -> ProptestConfig {
+    ProptestConfig { cases: fuzz_cases(default), failure_persistence: None, ..ProptestConfig::default() }
+}
+
+/// Seed `seed` (modulo the number of seeds) with `mutations` applied in order ([`apply`]).
+pub fn mutated_input(
+    seeds: &[Vec<u8>],
+    seed: usize,
+    mutations: &[Mutation],
+    section_start: &[u8],
+) -> Vec<u8> {
+    let mut input = seeds[seed % seeds.len()].clone();
+    for m in mutations {
+        apply(&mut input, m, seeds, section_start);
+    }
+    input
+}
+
 /// Number of cases: `SYNOVIA_FUZZ_CASES`, default `default`.
 pub fn fuzz_cases(default: u32) -> u32 {
     std::env::var("SYNOVIA_FUZZ_CASES").ok().and_then(|s| s.trim().parse().ok()).unwrap_or(default)

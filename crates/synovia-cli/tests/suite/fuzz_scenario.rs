@@ -19,22 +19,19 @@ use synovia_cli::{Scenario, Source};
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, caught, fuzz_cases, mutated};
+use mutate::{caught, files_with_extension, fuzz_config, mutated, mutated_input};
 
 /// The seed corpus: `examples/scenarios/*.toml`, with their paths (a `gmsh` mesh is resolved
 /// relative to the scenario file, so the mutated text keeps its seed's path).
 fn seeds() -> Vec<(PathBuf, Vec<u8>)> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenarios");
-    let mut out: Vec<(PathBuf, Vec<u8>)> = std::fs::read_dir(&dir)
-        .expect("examples/scenarios")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+    let out: Vec<(PathBuf, Vec<u8>)> = files_with_extension(&dir, "toml")
+        .into_iter()
         .map(|p| {
             let b = std::fs::read(&p).expect("seed");
             (p, b)
         })
         .collect();
-    out.sort();
     assert!(out.len() >= 5, "seed corpus missing: {}", dir.display());
     out
 }
@@ -76,22 +73,15 @@ fn seeds_build() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: fuzz_cases(256),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    })]
+    #![proptest_config(fuzz_config(256))]
 
     #[test]
     fn mutated_scenarios_never_panic((seed, muts) in mutated(60)) {
         fuzz_limits();
         let seeds = seeds_cached();
-        let (path, original) = &seeds[seed % seeds.len()];
+        let path = &seeds[seed % seeds.len()].0;
         let corpus: Vec<Vec<u8>> = seeds.iter().map(|(_, b)| b.clone()).collect();
-        let mut input = original.clone();
-        for m in &muts {
-            apply(&mut input, m, &corpus, b"[");
-        }
+        let input = mutated_input(&corpus, seed, &muts, b"[");
         if let Ok(last) = std::env::var("SYNOVIA_FUZZ_LAST") {
             // The input about to run, for a case that ends the process (out of memory, abort).
             std::fs::write(last, &input).unwrap();

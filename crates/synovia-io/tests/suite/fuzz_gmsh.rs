@@ -18,17 +18,12 @@ use synovia_io::parse_msh;
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, caught, fuzz_cases, mutated};
+use mutate::{caught, files_with_extension, fuzz_config, mutated, mutated_input};
 
 /// The seed corpus: `tests/data/*.msh` and `examples/scenarios/block2d.msh`.
 fn seeds() -> Vec<Vec<u8>> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(root.join("tests/data"))
-        .expect("tests/data")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "msh"))
-        .collect();
-    paths.sort();
+    let mut paths = files_with_extension(&root.join("tests/data"), "msh");
     paths.push(root.join("../../examples/scenarios/block2d.msh"));
     assert!(paths.len() >= 5, "seed corpus missing");
     paths.iter().map(|p| std::fs::read(p).expect("seed")).collect()
@@ -69,19 +64,11 @@ fn seeds_parse() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: fuzz_cases(512),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    })]
+    #![proptest_config(fuzz_config(512))]
 
     #[test]
     fn mutated_msh_files_never_panic((seed, muts) in mutated(60)) {
-        let seeds = seeds_cached();
-        let mut input = seeds[seed % seeds.len()].clone();
-        for m in &muts {
-            apply(&mut input, m, seeds, b"$");
-        }
+        let input = mutated_input(seeds_cached(), seed, &muts, b"$");
         let r = exercise(&input);
         prop_assert!(r.is_ok(), "panic {:?} on input:\n{:?}", r, String::from_utf8_lossy(&input));
     }

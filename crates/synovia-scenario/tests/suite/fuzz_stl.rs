@@ -27,17 +27,12 @@ use synovia::mesh::{Point, TriangleSurface};
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, caught, fuzz_cases, mutated};
+use mutate::{caught, files_with_extension, fuzz_config, mutated, mutated_input};
 
 /// The seed corpus: `tests/data/stl/*.stl` of the workspace.
 fn seeds() -> Vec<Vec<u8>> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../tests/data/stl");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("tests/data/stl")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "stl"))
-        .collect();
-    paths.sort();
+    let paths = files_with_extension(&dir, "stl");
     assert!(paths.len() >= 4, "seed corpus missing");
     paths.iter().map(|p| std::fs::read(p).expect("seed")).collect()
 }
@@ -263,19 +258,11 @@ fn apply_structural(triangles: &mut Vec<[f32; 9]>, m: &Structural) {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: fuzz_cases(256),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    })]
+    #![proptest_config(fuzz_config(256))]
 
     #[test]
     fn mutated_stl_files_never_panic((seed, muts) in mutated(60)) {
-        let seeds = seeds_cached();
-        let mut input = seeds[seed % seeds.len()].clone();
-        for m in &muts {
-            apply(&mut input, m, seeds, b"  facet");
-        }
+        let input = mutated_input(seeds_cached(), seed, &muts, b"  facet");
         let r = exercise(&input);
         prop_assert!(r.is_ok(), "{:?} on input:\n{:?}", r, input);
     }

@@ -21,17 +21,12 @@ use synovia_time::table::Table;
 
 #[path = "../../../../tests/support/mutate.rs"]
 mod mutate;
-use mutate::{apply, caught, fuzz_cases, mutated};
+use mutate::{caught, files_with_extension, fuzz_config, mutated, mutated_input};
 
 /// The seed corpus: the gait kinematics `.sto` and `tests/data/tables/*.csv`.
 fn seeds() -> Vec<Vec<u8>> {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(root.join("tests/data/tables"))
-        .expect("tests/data/tables")
-        .map(|e| e.expect("dir entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "csv"))
-        .collect();
-    paths.sort();
+    let mut paths = files_with_extension(&root.join("tests/data/tables"), "csv");
     paths.push(root.join("data/tka-grand-challenge-dm/fluoroscopic_gait_kinematics.sto"));
     assert!(paths.len() >= 4, "seed corpus missing");
     paths.iter().map(|p| std::fs::read(p).expect("seed")).collect()
@@ -108,19 +103,11 @@ fn seeds_parse() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: fuzz_cases(512),
-        failure_persistence: None,
-        ..ProptestConfig::default()
-    })]
+    #![proptest_config(fuzz_config(512))]
 
     #[test]
     fn mutated_tables_never_panic((seed, muts) in mutated(60)) {
-        let seeds = seeds_cached();
-        let mut input = seeds[seed % seeds.len()].clone();
-        for m in &muts {
-            apply(&mut input, m, seeds, b"endheader");
-        }
+        let input = mutated_input(seeds_cached(), seed, &muts, b"endheader");
         let r = exercise(&input);
         prop_assert!(r.is_ok(), "{:?} on input:\n{}", r, String::from_utf8_lossy(&input));
     }
