@@ -10,3 +10,4 @@ mod hertz_small_load;
 mod homogeneous;
 mod linear_bodies;
 mod multipliers_only;
+mod placed_friction;
