@@ -371,6 +371,9 @@ pub struct CholeskySolver {
     factorized: bool,
     info: CholeskyInfo,
     trailing_dofs: Option<Vec<usize>>,
+    /// The supernodes that hold the trailing block in place ([`Self::trailing_supernodes`] of
+    /// the symbolic analysis, computed once in [`Self::analyse`]); `None`: the block is copied.
+    trailing_layout: Option<Vec<(usize, usize, usize)>>,
     trailing: Option<Arc<TrailingBlock>>,
     memory_limit: Option<u64>,
     /// faer's workspace of the numeric factorisation (from the symbolic analysis and
@@ -456,6 +459,10 @@ impl CholeskySolver {
             }
         }
         .map_err(|e| LinalgError::Sparse(format!("symbolic Cholesky: {e:?}")))?;
+        let trailing_layout = trailing_dofs
+            .as_ref()
+            .filter(|d| !d.is_empty() && d.len() <= n)
+            .and_then(|d| Self::trailing_supernodes(&symbolic, n - d.len()));
         let len = symbolic.len_val();
         let info = CholeskyInfo { symbolic_s: t0.elapsed().as_secs_f64(), numeric_s: 0.0, factor_nnz: len };
         let par = numeric_par_of(&symbolic);
@@ -465,6 +472,7 @@ impl CholeskySolver {
             factor: Arc::new(Vec::new()),
             factorized: false,
             info,
+            trailing_layout,
             trailing_dofs,
             trailing: None,
             memory_limit: None,
@@ -497,7 +505,7 @@ impl CholeskySolver {
         let k = self.trailing_dofs.as_ref().map_or(0, Vec::len);
         let n = self.symbolic.nrows();
         // a block read in place from the factor costs nothing besides it
-        let copied = k > 0 && k <= n && Self::trailing_supernodes(&self.symbolic, n - k).is_none();
+        let copied = k > 0 && k <= n && self.trailing_layout.is_none();
         let k = if copied { k as u64 } else { 0 };
         MemoryEstimate {
             dofs: n,
@@ -658,10 +666,12 @@ impl CholeskySolver {
         for (p, &d) in dofs.iter().enumerate() {
             position[d] = p;
         }
-        if let Some(supernodes) = Self::trailing_supernodes(&self.symbolic, t0) {
+        // the layout belongs to the analysed trailing dofs (the only caller's `dofs`)
+        let layout = self.trailing_layout.as_ref().filter(|_| Some(dofs) == self.trailing_dofs.as_deref());
+        if let Some(supernodes) = layout {
             let mut blocks = Vec::with_capacity(supernodes.len());
             let mut start = 0;
-            for &(_, ncols, first) in &supernodes {
+            for &(_, ncols, first) in supernodes {
                 blocks.push(start..start + ncols - first);
                 start += ncols - first;
             }
@@ -669,7 +679,10 @@ impl CholeskySolver {
                 dofs: dofs.to_vec(),
                 position,
                 blocks,
-                storage: TrailingStorage::InFactor { values: self.factor.clone(), supernodes },
+                storage: TrailingStorage::InFactor {
+                    values: self.factor.clone(),
+                    supernodes: supernodes.clone(),
+                },
                 generation: next_generation(),
             });
         }

@@ -606,14 +606,11 @@ fn trailing_solves(
     Ok(cols.iter().copied().zip(solved).collect())
 }
 
-/// A fingerprint of a trailing block: its generation (one per factorisation). (Its address is
-/// not enough: a refactorisation may allocate the new block where the old one was.)
+/// A fingerprint of a trailing block: its generation (one per factorisation, never reused in
+/// the process). (Its address is not enough: a refactorisation may allocate the new block
+/// where the old one was.)
 fn block_fingerprint(block: &TrailingBlock) -> usize {
-    use std::hash::{Hash, Hasher};
-    // the generation alone: one per factorisation, never reused in the process
-    let mut h = std::collections::hash_map::DefaultHasher::new();
-    block.generation().hash(&mut h);
-    h.finish() as usize
+    block.generation() as usize
 }
 
 #[cfg(test)]
