@@ -21,6 +21,8 @@ use synovia_nonlinear::{
 };
 use synovia_pdas::{AuPdas, Pdas};
 
+use crate::common::{finite_strain, level_times, max_rel};
+
 fn model_2d(push: f64) -> (Model<2>, Vec<ContactPair<2>>) {
     let mut mesh = half_disc_refined(Point::<2>::new(0.0, 1.0), 1.0, 8, Point::<2>::new(0.0, 0.0), 0.25, 9)
         .expect("mesh");
@@ -56,22 +58,13 @@ fn solve<const D: usize>(
     strategy: ActiveSetStrategy,
 ) -> NonlinearResult<D> {
     let params = NewtonParams::default().with_active_sets(strategy);
-    let mut nl =
-        NonlinearContact::new(model, pairs, &[Kinematics::FiniteStrain], ElasticParams::default(), params)
-            .expect("set-up");
-    let times: Vec<f64> = (1..=levels).map(|k| k as f64 / levels as f64).collect();
-    let results = nl.run(model, &times, &Pdas::default(), |_| Ok(())).expect("converges");
+    let mut nl = finite_strain(model, pairs, params);
+    let results = nl.run(model, &level_times(levels), &Pdas::default(), |_| Ok(())).expect("converges");
     for r in &results {
         assert!(r.contact.kkt.max() <= 1e-8, "{strategy:?}: KKT {:e}", r.contact.kkt.max());
         assert!(r.report.residual() <= 1e-10, "{strategy:?}: residual {:e}", r.report.residual());
     }
     results.into_iter().last().expect("levels")
-}
-
-fn max_rel(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
-    a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs())) / scale
 }
 
 fn agree<const D: usize>(model: &Model<D>, pairs: &[ContactPair<D>], levels: usize) {

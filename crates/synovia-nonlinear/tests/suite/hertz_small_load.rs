@@ -9,13 +9,15 @@ use std::sync::Arc;
 use synovia_contact::obstacle::PlaneObstacle;
 use synovia_contact::operators::ContactPair;
 use synovia_contact::StaticContact;
-use synovia_fem::{ElasticParams, Kinematics, Model};
+use synovia_fem::{ElasticParams, Model};
 use synovia_material::{isotropic, neo_hookean, plane_strain, Material};
 use synovia_mesh::generators::{half_disc_refined, hemisphere_refined};
 use synovia_mesh::math::{Point, Vector};
 use synovia_mesh::BoundaryKind;
-use synovia_nonlinear::{NewtonParams, NonlinearContact};
+use synovia_nonlinear::NewtonParams;
 use synovia_pdas::Pdas;
+
+use crate::common::{finite_strain, level_times};
 
 const E: f64 = 10.0;
 const NU: f64 = 0.3;
@@ -73,16 +75,8 @@ fn nonlinear<const D: usize>(
     pairs: &[ContactPair<D>],
     levels: usize,
 ) -> (f64, f64, f64, usize) {
-    let mut nl = NonlinearContact::new(
-        model,
-        pairs,
-        &[Kinematics::FiniteStrain],
-        ElasticParams::default(),
-        NewtonParams::default(),
-    )
-    .expect("set-up");
-    let times: Vec<f64> = (1..=levels).map(|k| k as f64 / levels as f64).collect();
-    let results = nl.run(model, &times, &Pdas::default(), |_| Ok(())).expect("converges");
+    let mut nl = finite_strain(model, pairs, NewtonParams::default());
+    let results = nl.run(model, &level_times(levels), &Pdas::default(), |_| Ok(())).expect("converges");
     let last = results.last().expect("levels");
     let it = &last.report.iterations;
     // quadratic convergence: the last residual is below the square of the one before (scaled)

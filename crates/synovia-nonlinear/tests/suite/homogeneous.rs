@@ -44,8 +44,8 @@ fn solve(model: &Model<3>, levels: usize) -> Vec<Vec<f64>> {
         NewtonParams::default().with_tolerance(1e-13),
     )
     .expect("set-up");
-    let times: Vec<f64> = (1..=levels).map(|k| k as f64 / levels as f64).collect();
-    let results = nl.run(model, &times, &Pdas::default(), |_| Ok(())).expect("converges");
+    let results =
+        nl.run(model, &crate::common::level_times(levels), &Pdas::default(), |_| Ok(())).expect("converges");
     let last = results.last().expect("levels");
     assert!(
         last.report.residual() <= 1e-12

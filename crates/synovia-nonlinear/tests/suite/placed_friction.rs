@@ -13,13 +13,15 @@ use std::sync::Arc;
 
 use synovia_contact::obstacle::PlaneObstacle;
 use synovia_contact::operators::{BodyPlacement, ContactPair};
-use synovia_fem::{ElasticParams, Kinematics, Model};
+use synovia_fem::Model;
 use synovia_material::neo_hookean;
 use synovia_mesh::generators::{half_disc_refined, hemisphere_refined};
 use synovia_mesh::math::{Point, Tensor, Vector};
 use synovia_mesh::{BoundaryKind, Mesh};
-use synovia_nonlinear::{NewtonParams, NonlinearContact, NonlinearResult};
+use synovia_nonlinear::{NewtonParams, NonlinearResult};
 use synovia_pdas::Pdas;
+
+use crate::common::{finite_strain, level_times, max_rel};
 
 /// The model of `mesh` (its `top` part prescribed to `motion`) on the flat `z = 0` (2D: `y = 0`)
 /// with friction 0.3, its mesh moved into the body frame of `placement` (the identity: as it is).
@@ -47,28 +49,14 @@ fn solve<const D: usize>(
     placement: &BodyPlacement<D>,
     levels: usize,
 ) -> NonlinearResult<D> {
-    let mut nl = NonlinearContact::new(
-        model,
-        pairs,
-        &[Kinematics::FiniteStrain],
-        ElasticParams::default(),
-        NewtonParams::default(),
-    )
-    .expect("set-up");
+    let mut nl = finite_strain(model, pairs, NewtonParams::default());
     nl.place_bodies(model, std::slice::from_ref(placement)).expect("placed");
-    let times: Vec<f64> = (1..=levels).map(|k| k as f64 / levels as f64).collect();
-    let results = nl.run(model, &times, &Pdas::default(), |_| Ok(())).expect("converges");
+    let results = nl.run(model, &level_times(levels), &Pdas::default(), |_| Ok(())).expect("converges");
     for r in &results {
         assert!(r.contact.kkt.max() <= 1e-8, "KKT {:e}", r.contact.kkt.max());
         assert!(r.report.residual() <= 1e-10, "residual {:e}", r.report.residual());
     }
     results.into_iter().last().expect("levels")
-}
-
-fn max_rel(a: &[f64], b: &[f64]) -> f64 {
-    assert_eq!(a.len(), b.len());
-    let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs())).max(f64::MIN_POSITIVE);
-    a.iter().zip(b).fold(0.0_f64, |m, (x, y)| m.max((x - y).abs())) / scale
 }
 
 /// Solves the moved mesh (identity placement) and the placed body frame; compares.
