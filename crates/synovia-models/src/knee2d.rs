@@ -935,47 +935,40 @@ pub fn nonlinear_cycle_with(
             let slot = |b: BodyId| femur.iter().position(|f| *f == b);
             // the arc's translation t = (0, −δ) stays vertical in space
             let t = Vector::<2>::new(0.0, -nl.time());
+            // the femur's frame after the move (placed: its body frame turned by θ; moved
+            // meshes: space) and the turn of its shape within that frame (moved meshes only)
+            let (p_new, shape) = if placed {
+                (BodyPlacement::planar_rotation(centre, theta)?, BodyPlacement::identity())
+            } else {
+                (BodyPlacement::identity(), BodyPlacement::planar_rotation(centre, theta - theta_model)?)
+            };
+            for &b in femur.iter().filter(|_| !placed) {
+                model.body_mut(b)?.mesh.map_nodes(|x| shape.position(x))?;
+            }
+            let model_ref = &model;
+            let displacement = |b: BodyId, i: usize, u: &Vector<2>| match (slot(b), &fields) {
+                // the field in space at the node's new position, in the new frame
+                (Some(k), Some(fields)) => model_ref
+                    .body(b)
+                    .ok()
+                    .and_then(|body| body.mesh.nodes().get(i))
+                    .map_or(*u, |x| p_new.to_body(&fields[k].value(&p_new.position(x)))),
+                // the shape turned with the femur, the arc's translation kept vertical
+                (Some(_), None) => shape.to_global(&(u - p_old.to_body(&t))) + p_new.to_body(&t),
+                (None, _) => *u,
+            };
+            // contact forces kept in space (InSpace) or turned with the femur (Rotate)
+            let force = |b: BodyId, _: usize, c: &Vector<2>| match (slot(b), &fields) {
+                (Some(_), Some(_)) => p_new.to_body(&p_old.to_global(c)),
+                (Some(_), None) => shape.to_global(c),
+                (None, _) => *c,
+            };
             if placed {
-                let p_new = BodyPlacement::planar_rotation(centre, theta)?;
-                let model_ref = &model;
-                nl.map_state_in_frames(
-                    |b, i, u| match (slot(b), &fields) {
-                        // the field in space at the node's new placed position, in the new frame
-                        (Some(k), Some(fields)) => model_ref
-                            .body(b)
-                            .ok()
-                            .and_then(|body| body.mesh.nodes().get(i))
-                            .map_or(*u, |x| p_new.to_body(&fields[k].value(&p_new.position(x)))),
-                        // the shape turned with the femur, the arc's translation kept vertical
-                        (Some(_), None) => u - p_old.to_body(&t) + p_new.to_body(&t),
-                        (None, _) => *u,
-                    },
-                    // contact forces kept in space (InSpace) or turned with the femur (Rotate)
-                    |b, _, c| match (slot(b), &fields) {
-                        (Some(_), Some(_)) => p_new.to_body(&p_old.to_global(c)),
-                        _ => *c,
-                    },
-                );
+                nl.map_state_in_frames(displacement, force);
                 angle.set(theta);
                 nl.place_bodies(&model, &femur_placements(centre, theta, &femur, n_bodies)?)?;
             } else {
-                let place = BodyPlacement::planar_rotation(centre, theta - theta_model)?;
-                for &b in &femur {
-                    model.body_mut(b)?.mesh.map_nodes(|x| place.position(x))?;
-                }
-                let model_ref = &model;
-                nl.map_state(
-                    |b, i, u| match (slot(b), &fields) {
-                        (Some(k), Some(fields)) => model_ref
-                            .body(b)
-                            .ok()
-                            .and_then(|body| body.mesh.nodes().get(i))
-                            .map_or(*u, |x| fields[k].value(x)),
-                        (Some(_), None) => place.to_global(&(u - t)) + t,
-                        (None, _) => *u,
-                    },
-                    |b, _, c| if slot(b).is_some() && fields.is_none() { place.to_global(c) } else { *c },
-                );
+                nl.map_state(displacement, force);
             }
             theta_model = theta;
         }
